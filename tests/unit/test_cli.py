@@ -1,0 +1,252 @@
+"""The command line: exit codes 0/1/2/130 and one-line error messages."""
+
+from __future__ import annotations
+
+import logging
+import sys
+import types
+from pathlib import Path
+
+import pytest
+from click.testing import CliRunner
+
+from xfemslip import __version__
+from xfemslip.cli import cli
+from xfemslip.errors import ConvergenceError, OutputError, UsageError
+
+VALID_CASE = """\
+name = "tiny"
+
+[domain]
+size = [1.0, 1.0]
+
+[mesh]
+elements = [4, 4]
+
+[material]
+E = 1.0e9
+nu = 0.25
+model = "plane_strain"
+
+[loading]
+steps = 1
+
+[boundary]
+bottom = { uy = 0.0 }
+top = { uy = -0.001 }
+left = "free"
+right = "free"
+"""
+
+
+@pytest.fixture
+def runner() -> CliRunner:
+    try:  # click < 8.2 mixes stderr into stdout unless told otherwise
+        return CliRunner(mix_stderr=False)
+    except TypeError:
+        return CliRunner()
+
+
+@pytest.fixture
+def case_file(tmp_path: Path) -> Path:
+    path = tmp_path / "tiny.toml"
+    path.write_text(VALID_CASE)
+    return path
+
+
+def _stderr_lines(result) -> list[str]:
+    return result.stderr.splitlines()
+
+
+def _assert_one_error_line(result) -> str:
+    lines = _stderr_lines(result)
+    assert len(lines) == 1, result.stderr
+    assert lines[0].startswith("Error: "), lines[0]
+    assert "Traceback" not in result.stderr
+    return lines[0]
+
+
+# --------------------------------------------------------------------------- info
+
+
+def test_info_prints_versions(runner):
+    result = runner.invoke(cli, ["info"])
+    assert result.exit_code == 0, result.output
+    for name in (
+        "xfemslip",
+        "python",
+        "numpy",
+        "scipy",
+        "numba",
+        "h5py",
+        "meshio",
+        "threading layer",
+        "NUMBA_NUM_THREADS",
+        "cache dir",
+    ):
+        assert name in result.stdout
+    assert __version__ in result.stdout
+    import numpy
+
+    assert numpy.__version__ in result.stdout
+
+
+def test_version_option(runner):
+    result = runner.invoke(cli, ["--version"])
+    assert result.exit_code == 0
+    assert __version__ in result.stdout
+
+
+# --------------------------------------------------------------------------- check
+
+
+def test_check_valid_case(runner, case_file):
+    result = runner.invoke(cli, ["check", str(case_file)])
+    assert result.exit_code == 0, result.stderr
+    assert result.stdout.strip()
+
+
+def test_check_invalid_case_names_the_key(runner, tmp_path):
+    path = tmp_path / "bad.toml"
+    path.write_text(VALID_CASE.replace("nu = 0.25", "nu = 0.7"))
+    result = runner.invoke(cli, ["check", str(path)])
+    assert result.exit_code == 2
+    line = _assert_one_error_line(result)
+    assert "nu" in line and "bad.toml" in line
+
+
+def test_check_missing_file(runner, tmp_path):
+    result = runner.invoke(cli, ["check", str(tmp_path / "missing.toml")])
+    assert result.exit_code == 2
+    assert "missing.toml" in _assert_one_error_line(result)
+
+
+def test_run_missing_file(runner, tmp_path):
+    result = runner.invoke(cli, ["run", str(tmp_path / "missing.toml")])
+    assert result.exit_code == 2
+    _assert_one_error_line(result)
+
+
+# --------------------------------------------------------------------------- run
+
+
+class FakeSimulation:
+    """Stands in for ``xfemslip.simulation`` and ``load_case``; records calls."""
+
+    def __init__(self, outcome=None):
+        self.outcome = outcome
+        self.calls = []
+
+    def load_case(self, path):
+        return types.SimpleNamespace(name="tiny", path=Path(path))
+
+    def run_case(self, spec, out_dir=None, *, overwrite=False):
+        self.calls.append((spec, out_dir, overwrite))
+        log = logging.getLogger("xfemslip.simulation")
+        log.debug("debug detail")
+        log.info("step 1: converged")
+        log.warning("pinned x at (0, 0)")
+        if isinstance(self.outcome, BaseException):
+            raise self.outcome
+        return types.SimpleNamespace(
+            out_dir=Path(out_dir or "out/tiny"),
+            converged=True,
+            load_steps=1,
+            newton_iterations=4,
+            iterations_per_step=[4],
+            wall_time_s=0.42,
+        )
+
+
+@pytest.fixture
+def fake(monkeypatch) -> FakeSimulation:
+    """Insert a fake ``xfemslip.simulation`` module and a fake ``load_case``."""
+    sim = FakeSimulation()
+    module = types.ModuleType("xfemslip.simulation")
+    module.run_case = sim.run_case
+    monkeypatch.setitem(sys.modules, "xfemslip.simulation", module)
+    monkeypatch.setattr("xfemslip.case.load_case", sim.load_case, raising=False)
+    return sim
+
+
+def test_run_success_prints_summary(runner, fake, case_file):
+    result = runner.invoke(cli, ["run", str(case_file)])
+    assert result.exit_code == 0, result.stderr
+    assert result.stdout.splitlines() == [
+        "tiny: converged in 1 step(s), 4 Newton iterations, 0.42 s -> "
+        + str(Path("out/tiny"))
+    ]
+    ((spec, out_dir, overwrite),) = fake.calls
+    assert spec.name == "tiny" and out_dir is None and overwrite is False
+
+
+def test_run_passes_output_and_overwrite(runner, fake, case_file, tmp_path):
+    out = tmp_path / "results"
+    result = runner.invoke(cli, ["run", str(case_file), "-o", str(out), "--overwrite"])
+    assert result.exit_code == 0, result.stderr
+    ((_, out_dir, overwrite),) = fake.calls
+    assert out_dir == out and overwrite is True
+    assert str(out) in result.stdout
+
+
+def test_run_logging_levels(runner, fake, case_file):
+    default = runner.invoke(cli, ["run", str(case_file)])
+    assert _stderr_lines(default) == [
+        "step 1: converged",
+        "WARNING: pinned x at (0, 0)",
+    ]
+    quiet = runner.invoke(cli, ["run", "-q", str(case_file)])
+    assert _stderr_lines(quiet) == ["WARNING: pinned x at (0, 0)"]
+    verbose = runner.invoke(cli, ["run", "-v", str(case_file)])
+    assert "debug detail" in _stderr_lines(verbose)
+    both = runner.invoke(cli, ["run", "-v", "-q", str(case_file)])
+    assert both.exit_code == 2
+
+
+@pytest.mark.parametrize(
+    ("error", "code"),
+    [
+        (
+            ConvergenceError(
+                "step 2: no convergence after 30 iterations\n(eta = 1e-3)",
+                step=2,
+                iteration=30,
+                residual=1e-3,
+            ),
+            1,
+        ),
+        (OutputError("cannot write out/tiny/result.h5: disk full"), 1),
+        (UsageError("out/tiny exists; use --overwrite"), 2),
+    ],
+)
+def test_run_library_errors(runner, fake, case_file, error, code):
+    fake.outcome = error
+    result = runner.invoke(cli, ["run", "-q", str(case_file)])
+    assert result.exit_code == code
+    lines = _stderr_lines(result)
+    assert lines[-1] == "Error: " + " ".join(str(error).split())
+    assert "Traceback" not in result.stderr
+    assert not result.stdout
+
+
+def test_run_debug_shows_traceback(runner, fake, case_file):
+    fake.outcome = ConvergenceError("step 1 failed", step=1, iteration=30, residual=1.0)
+    result = runner.invoke(cli, ["run", "-q", "--debug", str(case_file)])
+    assert result.exit_code == 1
+    assert "Traceback" in result.stderr
+    assert _stderr_lines(result)[-1] == "Error: step 1 failed"
+
+
+def test_run_interrupted(runner, fake, case_file):
+    fake.outcome = KeyboardInterrupt()
+    result = runner.invoke(cli, ["run", "-q", str(case_file)])
+    assert result.exit_code == 130
+    assert _stderr_lines(result)[-1] == "Error: interrupted"
+    assert "Traceback" not in result.stderr
+
+
+def test_run_programming_error_propagates(runner, fake, case_file):
+    fake.outcome = ValueError("a bug")
+    result = runner.invoke(cli, ["run", "-q", str(case_file)])
+    assert isinstance(result.exception, ValueError)
+    assert result.exit_code != 0

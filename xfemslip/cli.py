@@ -1,0 +1,221 @@
+"""Command-line interface: ``xfemslip run | check | info``.
+
+This module parses arguments, configures logging, calls the library and maps
+its errors to messages and exit codes.  It does no numerics.
+
+Exit codes:
+
+- 0: success;
+- 1: the run failed (``ConvergenceError``, ``OutputError``, ``MeshError``,
+  ``GeometryError``, any other ``XfemslipError``);
+- 2: bad input (``CaseError``, ``xfemslip.errors.UsageError``, a missing case
+  file, bad command-line options);
+- 130: interrupted (Ctrl-C).
+
+A library error is reported as one line ``Error: <message>`` on stderr; the
+traceback is shown only with ``--debug``.  Any other exception is a bug and
+propagates with its traceback.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import importlib.metadata
+import logging
+import platform
+import sys
+import traceback
+from collections.abc import Iterator
+from pathlib import Path
+
+import click
+
+from xfemslip import __version__
+from xfemslip.errors import CaseError, UsageError, XfemslipError
+
+logger = logging.getLogger(__name__)
+
+EXIT_FAILURE = 1
+EXIT_USAGE = 2
+EXIT_INTERRUPTED = 130  # 128 + SIGINT, the shell convention
+
+_HANDLER_NAME = "xfemslip-cli"
+
+
+class _EchoHandler(logging.Handler):
+    """Log handler writing to the *current* ``sys.stderr`` through click.
+
+    Resolving stderr at emit time keeps it working under ``CliRunner``, which
+    swaps the streams for every invocation.
+    """
+
+    def emit(self, record: logging.LogRecord) -> None:
+        try:
+            click.echo(self.format(record), err=True)
+        except Exception:  # logging must never raise
+            self.handleError(record)
+
+
+class _CompactFormatter(logging.Formatter):
+    """``message`` alone below WARNING, ``LEVEL: message`` from WARNING up."""
+
+    def format(self, record: logging.LogRecord) -> str:
+        message = super().format(record)
+        if record.levelno >= logging.WARNING:
+            return f"{record.levelname}: {message}"
+        return message
+
+
+def _configure_logging(verbose: bool, quiet: bool) -> None:
+    """Log ``xfemslip.*`` to stderr: INFO by default, -q WARNING, -v DEBUG."""
+    if verbose and quiet:
+        raise UsageError("--verbose and --quiet cannot be used together")
+    level = logging.DEBUG if verbose else logging.WARNING if quiet else logging.INFO
+    package_logger = logging.getLogger("xfemslip")
+    for handler in list(package_logger.handlers):
+        if handler.get_name() == _HANDLER_NAME:
+            package_logger.removeHandler(handler)
+    handler = _EchoHandler()
+    handler.set_name(_HANDLER_NAME)
+    handler.setFormatter(_CompactFormatter("%(message)s"))
+    package_logger.addHandler(handler)
+    package_logger.setLevel(level)
+
+
+def _one_line(err: BaseException) -> str:
+    """The error's message on one line (falls back to the class name)."""
+    text = " ".join(str(err).split())
+    return text or type(err).__name__
+
+
+@contextlib.contextmanager
+def _reported_errors(debug: bool) -> Iterator[None]:
+    """Turn library errors and Ctrl-C into ``Error: ...`` and an exit code."""
+    try:
+        yield
+    except XfemslipError as err:
+        if debug:
+            click.secho(traceback.format_exc().rstrip(), err=True, dim=True)
+        click.echo(f"Error: {_one_line(err)}", err=True)
+        usage = isinstance(err, CaseError | UsageError)
+        raise click.exceptions.Exit(EXIT_USAGE if usage else EXIT_FAILURE) from None
+    except KeyboardInterrupt:
+        if debug:
+            click.secho(traceback.format_exc().rstrip(), err=True, dim=True)
+        click.echo("Error: interrupted", err=True)
+        raise click.exceptions.Exit(EXIT_INTERRUPTED) from None
+
+
+def _load(case: Path):
+    """Load and validate a case file (``CaseError`` on any problem)."""
+    if not case.exists():
+        raise UsageError(f"{case}: no such file")
+    if case.is_dir():
+        raise UsageError(f"{case}: is a directory, expected a case file (.toml)")
+    from xfemslip.case import load_case
+
+    return load_case(case)
+
+
+_debug_option = click.option(
+    "--debug", is_flag=True, help="Show the traceback of a reported error."
+)
+_case_argument = click.argument("case", type=click.Path(path_type=Path))
+
+
+@click.group(context_settings={"help_option_names": ["-h", "--help"]})
+@click.version_option(__version__, prog_name="xfemslip")
+def cli() -> None:
+    """XFEM frictional contact on 2D fractures, driven by TOML case files."""
+
+
+@cli.command()
+@_case_argument
+@click.option(
+    "-o",
+    "--output",
+    "output",
+    type=click.Path(file_okay=False, path_type=Path),
+    default=None,
+    help="Output directory [default: output.directory of the case, else out/<name>].",
+)
+@click.option(
+    "--overwrite", is_flag=True, help="Replace the results of an earlier run."
+)
+@click.option("-v", "--verbose", is_flag=True, help="Log debug messages.")
+@click.option("-q", "--quiet", is_flag=True, help="Log warnings and errors only.")
+@_debug_option
+def run(
+    case: Path,
+    output: Path | None,
+    overwrite: bool,
+    verbose: bool,
+    quiet: bool,
+    debug: bool,
+) -> None:
+    """Run the case file CASE and write its results."""
+    with _reported_errors(debug):
+        _configure_logging(verbose, quiet)
+        spec = _load(case)
+        from xfemslip.simulation import run_case
+
+        summary = run_case(spec, output, overwrite=overwrite)
+        status = "converged" if summary.converged else "did NOT converge"
+        click.echo(
+            f"{spec.name}: {status} in {summary.load_steps} step(s), "
+            f"{summary.newton_iterations} Newton iterations, "
+            f"{summary.wall_time_s:.2f} s -> {summary.out_dir}"
+        )
+        if not summary.converged:
+            raise click.exceptions.Exit(EXIT_FAILURE)
+
+
+@cli.command()
+@_case_argument
+@_debug_option
+def check(case: Path, debug: bool) -> None:
+    """Validate CASE and print its settings in SI units.
+
+    Nothing is built or solved.
+    """
+    with _reported_errors(debug):
+        spec = _load(case)
+        from xfemslip.case import describe
+
+        click.echo(describe(spec))
+
+
+@cli.command()
+def info() -> None:
+    """Print versions and Numba settings."""
+    import numba
+
+    rows = [("xfemslip", __version__), ("python", platform.python_version())]
+    rows += [
+        (name, _dist_version(name))
+        for name in ("numpy", "scipy", "numba", "h5py", "meshio", "click")
+    ]
+    cache_dir = numba.config.CACHE_DIR or "default (__pycache__ next to the sources)"
+    rows += [
+        ("numba threading layer", str(numba.config.THREADING_LAYER)),
+        ("NUMBA_NUM_THREADS", str(numba.config.NUMBA_NUM_THREADS)),
+        ("numba cache dir", str(cache_dir)),
+        ("NUMBA_DISABLE_JIT", str(numba.config.DISABLE_JIT)),
+        ("executable", sys.executable),
+    ]
+    width = max(len(name) for name, _ in rows)
+    for name, value in rows:
+        click.echo(f"{name:<{width}}  {value}")
+
+
+def _dist_version(name: str) -> str:
+    """Installed version of a distribution, or 'not installed'."""
+    try:
+        return importlib.metadata.version(name)
+    except importlib.metadata.PackageNotFoundError:
+        return "not installed"
+
+
+def main() -> None:
+    """Console-script entry point (``xfemslip``)."""
+    cli(prog_name="xfemslip")

@@ -1,0 +1,223 @@
+"""ParaView output via meshio: ``result.vtu``, ``fractures.vtu``, ``result.pvd``.
+
+- ``write_bulk``: the bulk mesh with cut elements split along the fractures
+  (:class:`~xfemslip.writers.VisMesh`), so that "Warp By Vector" on the point
+  field ``displacement`` shows the jump.  Points and displacement are padded to
+  3D with z = 0, as ParaView expects.
+- ``write_fractures``: every fracture as a polyline through its contact
+  integration points, with the contact fields as point data.
+- ``write_pvd``: a ParaView collection (time series over load steps).
+
+Every file is written atomically (:mod:`xfemslip.writers.atomic`).  meshio is
+given ``file_format="vtu"`` explicitly because the temporary name has another
+suffix.
+"""
+
+from __future__ import annotations
+
+import logging
+from collections.abc import Mapping, Sequence
+from pathlib import Path
+from xml.sax.saxutils import quoteattr
+
+import meshio
+import numpy as np
+
+from xfemslip.writers import FractureFields, VisMesh
+from xfemslip.writers.atomic import atomic_path
+
+logger = logging.getLogger(__name__)
+
+FRACTURE_POINT_DATA = ("slip", "opening", "normal_traction", "shear_traction")
+
+
+def write_bulk(
+    path: Path | str, vis: VisMesh, cell_data: Mapping[str, np.ndarray]
+) -> None:
+    """Write the visualisation mesh as an unstructured grid (``result.vtu``).
+
+    Parameters
+    ----------
+    path : Path
+        Final file name.
+    vis : VisMesh
+        Points (P, 2) [m], displacement (P, 2) [m], quads (Q, 4) and triangles
+        (T, 3) with their bulk element ids ``quad_cell`` (Q,) and
+        ``triangle_cell`` (T,).  An empty block is left out.
+    cell_data : mapping of name -> (M,) or (M, k) array
+        Values per BULK element (e.g. ``stress`` [Pa]); each vis cell gets the
+        value of its bulk element.  ``cell_id`` (the bulk element id) is added.
+
+    Raises
+    ------
+    ValueError
+        Inconsistent shapes, or ``cell_id`` given in ``cell_data``.
+    OutputError
+        The file cannot be written.
+    """
+    if "cell_id" in cell_data:
+        raise ValueError("write_bulk: 'cell_id' is reserved (added automatically)")
+    points = _pad_3d(vis.points, "points")
+    displacement = _pad_3d(vis.displacement, "displacement")
+    if displacement.shape != points.shape:
+        raise ValueError(
+            f"write_bulk: displacement has shape {vis.displacement.shape}"
+            f", points {np.shape(vis.points)}"
+        )
+    blocks = [
+        (
+            cell_type,
+            np.asarray(conn, dtype=np.int64).reshape(-1, n_vertices),
+            np.asarray(owner, dtype=np.int64).reshape(-1),
+        )
+        for cell_type, conn, owner, n_vertices in (
+            ("quad", vis.quads, vis.quad_cell, 4),
+            ("triangle", vis.triangles, vis.triangle_cell, 3),
+        )
+    ]
+    blocks = [block for block in blocks if block[1].shape[0] > 0]
+    for cell_type, conn, owner in blocks:
+        if owner.shape[0] != conn.shape[0]:
+            raise ValueError(
+                f"write_bulk: {cell_type} block has {conn.shape[0]} "
+                f"cells but {owner.shape[0]} bulk ids"
+            )
+    gathered = {"cell_id": [owner for _, _, owner in blocks]}
+    for name, values in cell_data.items():
+        values = np.asarray(values)
+        gathered[name] = [values[owner] for _, _, owner in blocks]
+    mesh = meshio.Mesh(
+        points,
+        [(cell_type, conn) for cell_type, conn, _ in blocks],
+        point_data={"displacement": displacement},
+        cell_data=gathered,
+    )
+    _write_vtu(path, mesh)
+
+
+def write_fractures(
+    path: Path | str, fractures: Sequence[tuple[int, FractureFields]]
+) -> bool:
+    """Write the fractures as polylines with their contact fields (``fractures.vtu``).
+
+    Parameters
+    ----------
+    path : Path
+        Final file name.
+    fractures : list of (index, FractureFields)
+        ``index`` is the fracture's position in the case file.  Each fracture's
+        K points, sorted by ``s``, are joined by "line" cells; a fracture with a
+        single point becomes a "vertex" cell, one with none is left out.
+
+    Point data: ``slip``, ``opening`` [m], ``normal_traction``,
+    ``shear_traction``, ``contact_pressure`` = max(0, -normal_traction) [Pa],
+    ``state`` (int32: 0 open, 1 stick, 2 slip), ``s`` [m] and ``fracture``
+    (the index).  Points are 3D with z = 0.
+
+    Returns
+    -------
+    bool
+        False when there is no fracture point at all: then nothing is written
+        (a VTU without cells cannot be read back by meshio), and the caller
+        decides whether to list the file anywhere.
+
+    Raises
+    ------
+    OutputError
+        The file cannot be written.
+    """
+    parts = [_fracture_part(index, fields) for index, fields in fractures]
+    parts = [part for part in parts if part["points"].shape[0] > 0]
+    if not parts:
+        logger.debug("%s: no fracture points, file not written", path)
+        return False
+    lines, vertices, offset = [], [], 0
+    for part in parts:
+        n_points = part["points"].shape[0]
+        ids = np.arange(offset, offset + n_points, dtype=np.int64)
+        if n_points >= 2:
+            lines.append(np.column_stack([ids[:-1], ids[1:]]))
+        else:
+            vertices.append(ids[:, None])
+        offset += n_points
+    cells = [
+        (name, np.concatenate(block))
+        for name, block in (("line", lines), ("vertex", vertices))
+        if block
+    ]
+    point_data = {
+        name: np.concatenate([part[name] for part in parts])
+        for name in parts[0]
+        if name != "points"
+    }
+    points = _pad_3d(np.concatenate([part["points"] for part in parts]), "points")
+    _write_vtu(path, meshio.Mesh(points, cells, point_data=point_data))
+    return True
+
+
+def write_pvd(path: Path | str, entries: Sequence[tuple[float, str]]) -> None:
+    """Write a ParaView collection file (``result.pvd``).
+
+    Parameters
+    ----------
+    path : Path
+        Final file name.
+    entries : list of (timestep, file)
+        ``timestep`` is typically the load factor; ``file`` is the data set's
+        path relative to the .pvd file.  Data sets that share a timestep (e.g.
+        the bulk mesh and the fractures of one load step) get consecutive
+        ``part`` numbers from 0, so ParaView shows them together.
+
+    Raises
+    ------
+    OutputError
+        The file cannot be written.
+    """
+    lines = [
+        '<?xml version="1.0"?>',
+        '<VTKFile type="Collection" version="0.1" byte_order="LittleEndian">',
+        "  <Collection>",
+    ]
+    parts: dict[float, int] = {}
+    for timestep, file in entries:
+        part = parts.get(float(timestep), 0)
+        parts[float(timestep)] = part + 1
+        lines.append(
+            f'    <DataSet timestep="{float(timestep)!r}" group="" '
+            f'part="{part}" file={quoteattr(str(file))}/>'
+        )
+    lines += ["  </Collection>", "</VTKFile>", ""]
+    with atomic_path(Path(path)) as tmp:
+        tmp.write_text("\n".join(lines), encoding="utf-8")
+
+
+def _fracture_part(index: int, fields: FractureFields) -> dict[str, np.ndarray]:
+    """Point arrays of one fracture, sorted by arc length s."""
+    s = np.asarray(fields.s, dtype=np.float64).reshape(-1)
+    order = np.argsort(s, kind="stable")
+    n_points = s.shape[0]
+    part = {"points": np.asarray(fields.points, dtype=np.float64).reshape(n_points, 2)}
+    for name in FRACTURE_POINT_DATA:
+        part[name] = np.asarray(getattr(fields, name), dtype=np.float64).reshape(
+            n_points
+        )
+    # + 0.0 turns the -0.0 of max(-0.0, 0.0) into 0.0.
+    part["contact_pressure"] = np.maximum(-part["normal_traction"], 0.0) + 0.0
+    part["state"] = np.asarray(fields.state, dtype=np.int32).reshape(n_points)
+    part["s"] = s
+    part["fracture"] = np.full(n_points, index, dtype=np.int32)
+    return {name: value[order] for name, value in part.items()}
+
+
+def _pad_3d(xy, name: str) -> np.ndarray:
+    """(P, 2) -> (P, 3) float64 with z = 0 (ParaView works in 3D)."""
+    xy = np.asarray(xy, dtype=np.float64)
+    if xy.ndim != 2 or xy.shape[1] != 2:
+        raise ValueError(f"{name} has shape {xy.shape}, expected (P, 2)")
+    return np.column_stack([xy, np.zeros(xy.shape[0])])
+
+
+def _write_vtu(path: Path | str, mesh: meshio.Mesh) -> None:
+    """Write ``mesh`` as VTU (binary, zlib) through a temporary file."""
+    with atomic_path(Path(path)) as tmp:
+        meshio.write(tmp, mesh, file_format="vtu")
