@@ -1,0 +1,117 @@
+"""Bulk stiffness: assembled once per run (linear elasticity does not change
+between Newton iterations or load steps; only the contact part does).
+
+Intact cells share one 2x2-Gauss rectangle stiffness per distinct (hx, hy);
+enriched cells go through the sub-cell kernel.  Global assembly is COO -> CSR
+(duplicates summed by scipy).
+"""
+
+from __future__ import annotations
+
+import logging
+from dataclasses import dataclass
+
+import numpy as np
+import scipy.sparse as sp
+
+from xfemslip import kernels
+from xfemslip.enrichment import (
+    Candidates,
+    DofMap,
+    EnrichedCells,
+    select_enrichment,
+)
+
+logger = logging.getLogger(__name__)
+
+
+@dataclass(frozen=True)
+class BulkSystem:
+    K: sp.csr_matrix  # (n_dofs, n_dofs) [N/m]
+    dofmap: DofMap
+    enr_dofs: np.ndarray  # (nc, 8+2S) int64 global dofs of enriched cells, -1 = none
+    enr_Bbar: np.ndarray  # (nc, 3, 8+2S) cell-average strain operator [1/m]
+    std_cells: np.ndarray  # (ns,) int64 intact cells
+    enriched_cells: np.ndarray  # (nc,) int64, same order as enr_dofs
+
+
+def std_cell_dofs(cells: np.ndarray) -> np.ndarray:
+    """(m, 8) standard dofs 2*node + c of cells (m, 4)."""
+    return np.stack([2 * cells, 2 * cells + 1], axis=2).reshape(cells.shape[0], 8)
+
+
+def _rect_stiffness_shared(hx, hy, D):
+    """Stiffness (m, 8, 8) computed once per distinct rectangle size."""
+    sizes = np.round(np.column_stack([hx, hy]), 15)
+    uniq, inverse = np.unique(sizes, axis=0, return_inverse=True)
+    K_u = kernels.rectangle_stiffness(np.ascontiguousarray(uniq[:, 0]),
+                                      np.ascontiguousarray(uniq[:, 1]), D)
+    return K_u, inverse.ravel()
+
+
+def assemble_bulk(mesh, D, cand: Candidates, ec: EnrichedCells) -> BulkSystem:
+    """Assemble the bulk stiffness and choose the kept enrichments (sliver rule)."""
+    is_enr = np.zeros(mesh.n_cells, bool)
+    is_enr[ec.cells] = True
+    std_cells = np.nonzero(~is_enr)[0]
+    b = mesh.bounds[std_cells]
+    K_u, which = _rect_stiffness_shared(b[:, 1] - b[:, 0], b[:, 3] - b[:, 2], D)
+    std_dofs = std_cell_dofs(mesh.cells[std_cells])
+
+    if ec.cells.size:
+        K_e, Bbar = kernels.enriched_cell_matrices(
+            np.ascontiguousarray(mesh.bounds[ec.cells]), ec.qp_offsets, ec.qp_xy, ec.qp_w,
+            ec.qp_F, ec.qp_gradF, ec.slot_node, ec.slot_fnode, np.ascontiguousarray(D))
+    else:
+        K_e = np.zeros((0, 8, 8))
+        Bbar = np.zeros((0, 3, 8))
+    enr_std = std_cell_dofs(mesh.cells[ec.cells])
+
+    n_std = 2 * mesh.n_nodes
+    std_diag = np.zeros(n_std)
+    np.add.at(std_diag, std_dofs, np.diagonal(K_u, axis1=1, axis2=2)[which])
+    np.add.at(std_diag, enr_std, np.diagonal(K_e[:, :8, :8], axis1=1, axis2=2))
+    dofmap = select_enrichment(mesh, cand, ec, K_e, std_diag)
+
+    S = ec.slot_cand.shape[1]
+    enr_dofs = -np.ones((ec.cells.size, 8 + 2 * S), np.int64)
+    enr_dofs[:, :8] = enr_std
+    for s in range(S):
+        k = ec.slot_cand[:, s]
+        base = np.where(k >= 0, dofmap.cand_dof[np.maximum(k, 0)], -1)
+        enr_dofs[:, 8 + 2 * s] = np.where(base >= 0, base, -1)
+        enr_dofs[:, 9 + 2 * s] = np.where(base >= 0, base + 1, -1)
+
+    rows = [np.repeat(std_dofs, 8, axis=1).ravel(), _pairs(enr_dofs)[0]]
+    cols = [np.tile(std_dofs, (1, 8)).ravel(), _pairs(enr_dofs)[1]]
+    vals = [K_u[which].ravel(), K_e.ravel()]
+    rows, cols, vals = (np.concatenate(v) for v in (rows, cols, vals))
+    keep = (rows >= 0) & (cols >= 0)
+    n = dofmap.n_dofs
+    K = sp.coo_matrix((vals[keep], (rows[keep], cols[keep])), shape=(n, n)).tocsr()
+    logger.info("bulk: %d cells (%d enriched), %d dofs (%d enriched)", mesh.n_cells,
+                ec.cells.size, n, n - n_std)
+    return BulkSystem(K=K, dofmap=dofmap, enr_dofs=enr_dofs, enr_Bbar=Bbar,
+                      std_cells=std_cells, enriched_cells=ec.cells)
+
+
+def _pairs(dofs):
+    """Row and column index arrays of every (i, j) entry of per-cell blocks."""
+    nd = dofs.shape[1]
+    return np.repeat(dofs, nd, axis=1).ravel(), np.tile(dofs, (1, nd)).ravel()
+
+
+def coo_block(dofs: np.ndarray, blocks: np.ndarray, n: int) -> sp.csr_matrix:
+    """Sum of per-item blocks (m, k, k) on dofs (m, k) (-1 ignored) as CSR (n, n)."""
+    r, c = _pairs(dofs)
+    v = blocks.ravel()
+    keep = (r >= 0) & (c >= 0)
+    return sp.coo_matrix((v[keep], (r[keep], c[keep])), shape=(n, n)).tocsr()
+
+
+def scatter_vector(dofs: np.ndarray, values: np.ndarray, n: int) -> np.ndarray:
+    """Sum of per-item vectors (m, k) on dofs (m, k) (-1 ignored) into (n,)."""
+    out = np.zeros(n)
+    keep = dofs >= 0
+    np.add.at(out, dofs[keep], values[keep])
+    return out

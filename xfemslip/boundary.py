@@ -1,0 +1,190 @@
+"""Boundary conditions: prescribed displacements, edge tractions, rigid-body pins.
+
+Tractions on an edge are t = sigma . n_out with the outward normal of the edge;
+with an initial stress sigma0 the body starts in equilibrium with it and the
+edges receive the increment lambda (sigma - sigma0) . n_out (``loading.stress``
+is the final total far-field stress).  The traction is integrated with the
+enriched shape functions too, so a fracture reaching a loaded edge is loaded
+consistently.
+"""
+
+from __future__ import annotations
+
+import logging
+from dataclasses import dataclass
+
+import numpy as np
+
+from xfemslip.enrichment import candidate_values
+from xfemslip.errors import GeometryError
+from xfemslip.kernels.shape import q4_shape
+from xfemslip.quadrature import LINE_POINTS, LINE_WEIGHTS
+
+logger = logging.getLogger(__name__)
+
+OUTWARD = {"bottom": (0.0, -1.0), "top": (0.0, 1.0), "left": (-1.0, 0.0), "right": (1.0, 0.0)}
+# Prescribed values at a corner shared by two edges may differ by this much
+# (relative to the largest prescribed magnitude) before it is an error.
+CORNER_TOL = 1.0e-9
+
+
+@dataclass(frozen=True)
+class Dirichlet:
+    dofs: np.ndarray  # (m,) int64, sorted
+    values: np.ndarray  # (m,) final prescribed values [m]
+    pinned: np.ndarray  # (p,) int64 dofs pinned to remove rigid-body modes (value 0)
+
+
+def dirichlet(mesh, boundary) -> Dirichlet:
+    """Prescribed dofs and their final values from the four edges, plus pins."""
+    values = {}
+    owner = {}
+    scale = 0.0
+    for name in ("bottom", "top", "left", "right"):
+        edge = getattr(boundary, name)
+        if edge.kind != "displacement":
+            continue
+        nodes = mesh.edge_nodes(name)
+        v = np.asarray(edge.values, dtype=float)
+        if v.shape != (nodes.size, 2):
+            raise ValueError(f"boundary.{name}: values shape {v.shape} != {(nodes.size, 2)}")
+        scale = max(scale, float(np.nanmax(np.abs(v), initial=0.0)))
+        for node, row in zip(nodes, v):
+            for c in range(2):
+                if np.isnan(row[c]):
+                    continue
+                dof = 2 * int(node) + c
+                if dof in values and abs(values[dof] - row[c]) > CORNER_TOL * max(scale, 1e-300):
+                    comp = "xy"[c]
+                    raise GeometryError(
+                        f"boundary.{owner[dof]} and boundary.{name} prescribe different "
+                        f"u{comp} at their common corner ({mesh.nodes[node, 0]:g}, "
+                        f"{mesh.nodes[node, 1]:g}): {values[dof]:g} and {row[c]:g} m")
+                values[dof] = float(row[c])
+                owner[dof] = name
+    dofs = np.array(sorted(values), dtype=np.int64)
+    vals = np.array([values[d] for d in dofs], dtype=float)
+    pinned = rigid_body_pins(mesh, dofs)
+    if pinned.size:
+        dofs_all = np.concatenate([dofs, pinned])
+        order = np.argsort(dofs_all)
+        return Dirichlet(dofs=dofs_all[order],
+                         values=np.concatenate([vals, np.zeros(pinned.size)])[order],
+                         pinned=pinned)
+    return Dirichlet(dofs=dofs, values=vals, pinned=pinned)
+
+
+def _rigid_modes(mesh, dofs):
+    """Rows of the three rigid-body modes (ux, uy, rotation about the centre) at dofs."""
+    centre = mesh.nodes.mean(axis=0)
+    node, comp = dofs // 2, dofs % 2
+    rel = mesh.nodes[node] - centre
+    return np.column_stack([comp == 0, comp == 1,
+                            np.where(comp == 0, -rel[:, 1], rel[:, 0])]).astype(float)
+
+
+def rigid_body_pins(mesh, fixed) -> np.ndarray:
+    """The fewest extra dofs that remove the rigid-body modes the boundary leaves free.
+
+    Candidates, in order: ux and uy at the node nearest the middle of the
+    bottom edge, then of the top, left and right edges; a candidate is taken
+    when it removes a mode (raises the rank of the constrained modes).
+    """
+    rank = np.linalg.matrix_rank(_rigid_modes(mesh, fixed)) if fixed.size else 0
+    if rank == 3:
+        return np.zeros(0, np.int64)
+    cands = []
+    for name in ("bottom", "top", "left", "right"):
+        nodes = mesh.edge_nodes(name)
+        mid = nodes[np.argmin(np.abs(np.arange(nodes.size) - (nodes.size - 1) / 2.0))]
+        cands += [2 * int(mid), 2 * int(mid) + 1]
+    pins = []
+    current = list(fixed)
+    for d in cands:
+        if d in current:
+            continue
+        r = np.linalg.matrix_rank(_rigid_modes(mesh, np.array(current + [d])))
+        if r > rank:
+            pins.append(d)
+            current.append(d)
+            rank = r
+            node = d // 2
+            logger.info("rigid-body mode left free by the boundary: pinned u%s = 0 at node %d "
+                        "(%g, %g)", "xy"[d % 2], node, mesh.nodes[node, 0], mesh.nodes[node, 1])
+        if rank == 3:
+            break
+    return np.array(pins, dtype=np.int64)
+
+
+def traction_load(mesh, boundary, loading, ec, cand, dofmap, fractures) -> np.ndarray:
+    """External force (n_dofs,) [N/m] at load factor 1 from the traction edges."""
+    F = np.zeros(dofmap.n_dofs)
+    if loading.stress is None:
+        return F
+    sig = np.array(loading.stress, float)
+    if loading.initial_stress is not None:
+        sig = sig - np.array(loading.initial_stress, float)
+    sxx, syy, sxy = sig
+    S = np.array([[sxx, sxy], [sxy, syy]])
+    enr_pos = {int(c): e for e, c in enumerate(ec.cells)}
+    for name in ("bottom", "top", "left", "right"):
+        edge = getattr(boundary, name)
+        mask = np.ones(2)
+        if edge.kind == "displacement":
+            if not edge.traction:
+                continue
+            mask = np.isnan(np.asarray(edge.values, float)[0]).astype(float)
+        elif edge.kind != "traction":
+            continue
+        t = (S @ np.array(OUTWARD[name])) * mask
+        nodes = mesh.edge_nodes(name)
+        for p, q in zip(nodes[:-1], nodes[1:]):
+            length = np.linalg.norm(mesh.nodes[q] - mesh.nodes[p])
+            F[2 * p:2 * p + 2] += 0.5 * length * t
+            F[2 * q:2 * q + 2] += 0.5 * length * t
+            cell = _cell_of_edge(mesh, p, q)
+            if cell in enr_pos:
+                _enriched_edge_load(F, mesh, cell, enr_pos[cell], p, q, t, ec, cand, dofmap,
+                                    fractures)
+    return F
+
+
+def _cell_of_edge(mesh, p, q):
+    both = np.nonzero(np.isin(mesh.cells, [p, q]).sum(axis=1) == 2)[0]
+    return int(both[0])
+
+
+def _enriched_edge_load(F, mesh, cell, e, p, q, t, ec, cand, dofmap, fractures):
+    """int N_a (F - F_a) t ds over a boundary edge of an enriched cell."""
+    xp, xq = mesh.nodes[p], mesh.nodes[q]
+    cuts = [0.0, 1.0]
+    for fr in fractures:  # split where the edge crosses a kink line of F
+        for point, normal in _lines(fr):
+            den = (xq - xp) @ normal
+            if den != 0.0:
+                s = ((point - xp) @ normal) / den
+                if 0.0 < s < 1.0:
+                    cuts.append(s)
+    cuts = np.sort(cuts)
+    b = mesh.bounds[cell]
+    N = np.empty(4)
+    dN = np.empty((4, 2))
+    length = np.linalg.norm(xq - xp)
+    for a0, a1 in zip(cuts[:-1], cuts[1:]):
+        mid = xp + 0.5 * (a0 + a1) * (xq - xp)
+        for g, w in zip(LINE_POINTS, LINE_WEIGHTS):
+            s = 0.5 * (a0 + a1) + 0.5 * (a1 - a0) * g
+            x = xp + s * (xq - xp)
+            q4_shape(x[0], x[1], b[0], b[1], b[2], b[3], N, dN)
+            for slot, k in enumerate(ec.slot_cand[e]):
+                if k < 0 or dofmap.cand_dof[k] < 0:
+                    continue
+                fr = fractures[cand.fracture[k]]
+                Fx = candidate_values(fractures, cand, k, x[None], fr.side(mid[None]), 0.0)[0][0]
+                phi = N[ec.slot_node[e, slot]] * (Fx - ec.slot_fnode[e, slot])
+                d = dofmap.cand_dof[k]
+                F[d:d + 2] += 0.5 * (a1 - a0) * length * w * phi * t
+
+
+def _lines(fr):
+    return fr.kink_lines()

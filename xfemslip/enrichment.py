@@ -1,0 +1,244 @@
+"""Enrichment: which nodes carry shifted-Heaviside dofs, and the dof map.
+
+Enrichment function of fracture f (paper eqs. 11-12, with a tip ramp):
+
+    F(x) = H(phi(x)) * R(x),   H = +1 where phi >= 0 else -1,
+
+and each enriched node a contributes N_a(x) (F(x) - F(x_a)) a_a (shifted, so
+the nodal dofs stay the displacement at the node).  The jump across the
+fracture is [[u]] = 2 R sum_a N_a a_a (eq. 14 with the ramp).  R = 1 except in
+the tip cell, where it falls linearly to 0 at the geometric tip (geometry.py):
+the modelled discontinuity ends exactly at the tip, wherever the tip lies.
+A node x_a exactly on the fracture takes H = +1 (eq. 12).
+
+Candidate nodes: every node of a cell that holds a piece of the fracture.
+Sliver rule (conditioning): a candidate is dropped when the diagonal of its
+enriched stiffness is below ``ENRICHMENT_DIAG_RATIO`` times the diagonal of
+its standard dofs (minimum over x and y).  For a node whose support the
+fracture cuts into a sliver of area fraction eps the ratio is O(eps); for a
+fracture running along element edges it is exactly 0 for the nodes off the
+fracture, whose enrichment vanishes identically.  Dropping such a node changes
+the represented jump by O(eps) while keeping the matrix well conditioned.
+
+Dof numbering: standard ``2*node + c``; kept enrichments appended in candidate
+order as ``n_std + 2*k + c``.
+"""
+
+from __future__ import annotations
+
+import logging
+from dataclasses import dataclass
+
+import numpy as np
+
+from xfemslip.geometry import GEOMETRY_TOL
+from xfemslip.branch import branch_functions
+from xfemslip.quadrature import cell_subtriangles, duffy_rule, triangle_rule
+
+logger = logging.getLogger(__name__)
+
+ENRICHMENT_DIAG_RATIO = 1.0e-4
+
+HEAVISIDE = 0  # candidate function codes: 0 = F = H R, 1..4 = branch B1..B4
+
+
+@dataclass(frozen=True)
+class EnrichedCells:
+    """Cells with at least one enriched node, with their sub-cell quadrature.
+
+    S is the largest number of enrichment slots of a cell; unused slots are -1.
+    """
+
+    cells: np.ndarray  # (nc,) int64 cell ids
+    slot_cand: np.ndarray  # (nc, S) int64 candidate id of each slot, -1 empty
+    slot_node: np.ndarray  # (nc, S) int64 local node 0..3 of each slot, -1 empty
+    slot_fnode: np.ndarray  # (nc, S) float64 F at the slot's node (the shift)
+    qp_offsets: np.ndarray  # (nc+1,) int64
+    qp_xy: np.ndarray  # (nq, 2) [m]
+    qp_w: np.ndarray  # (nq,) [m^2]
+    qp_F: np.ndarray  # (nq, S)
+    qp_gradF: np.ndarray  # (nq, S, 2) [1/m]
+    tri_offsets: np.ndarray  # (nc+1,) int64 sub-triangles of each cell
+    tris: np.ndarray  # (nt, 3, 2) [m]
+    tri_F: np.ndarray  # (nt, 3, S) F at the triangle's vertices, from its own side
+
+
+@dataclass(frozen=True)
+class Candidates:
+    """Node enrichments before the sliver rule: one row per (node, function)."""
+
+    fracture: np.ndarray  # (k,) int64 fracture position
+    node: np.ndarray  # (k,) int64 global node
+    func: np.ndarray  # (k,) int64: HEAVISIDE or 1..4 (branch B1..B4)
+    tip: np.ndarray  # (k,) int64 index in fracture.tips for branch functions, else -1
+
+
+@dataclass(frozen=True)
+class DofMap:
+    n_std: int
+    n_dofs: int
+    cand_dof: np.ndarray  # (k,) int64 first dof of each candidate, -1 if dropped
+
+    @property
+    def n_enriched_nodes(self) -> int:
+        return int(np.count_nonzero(self.cand_dof >= 0))
+
+
+def find_candidates(mesh, fractures) -> Candidates:
+    """Heaviside candidates on the nodes of cut cells; branch candidates within
+    ``tip_radius`` of each tip (and always on the tip cell's nodes) when the
+    fracture's tip mode is "branch".  A branch-enriched node gets no Heaviside."""
+    rows = []
+    for fi, fr in enumerate(fractures):
+        cut_nodes = np.unique(mesh.cells[np.unique(fr.piece_cell)].ravel())
+        branch = set()
+        if fr.tip_mode == "branch":
+            for ti, tip in enumerate(fr.tips):
+                dist = np.linalg.norm(mesh.nodes - tip.point, axis=1)
+                near = set(np.nonzero(dist <= fr.tip_radius)[0].tolist())
+                k = 0 if tip.end == 0 else -1
+                near |= set(mesh.cells[fr.piece_cell[k]].tolist())
+                branch |= near
+                rows += [(fi, n, j, ti) for n in sorted(near) for j in (1, 2, 3, 4)]
+        rows += [(fi, int(n), HEAVISIDE, -1) for n in cut_nodes if int(n) not in branch]
+    arr = np.array(rows, dtype=np.int64).reshape(-1, 4)
+    return Candidates(*(np.ascontiguousarray(arr[:, i]) for i in range(4)))
+
+
+def candidate_values(fractures, cand, k, pts, side, tol):
+    """F (n,) and grad F (n, 2) of candidate k at points with fracture side (n,)."""
+    fr = fractures[cand.fracture[k]]
+    if cand.func[k] == HEAVISIDE:
+        R, gR = fr.ramp(pts)
+        return side * R, side[:, None] * gR
+    F, grad = branch_functions(fr.tips[cand.tip[k]], pts, side, tol)
+    j = cand.func[k] - 1
+    return F[:, j], grad[:, j]
+
+
+def _cell_lines(fr, b, tol):
+    """Kink lines of fracture fr that can cross the cell with bounds b."""
+    out = []
+    lo = np.minimum(fr.points[:-1], fr.points[1:]) - tol
+    hi = np.maximum(fr.points[:-1], fr.points[1:]) + tol
+    for k in range(fr.normal.shape[0]):
+        if lo[k, 0] <= b[1] and hi[k, 0] >= b[0] and lo[k, 1] <= b[3] and hi[k, 1] >= b[2]:
+            out.append((fr.points[k], fr.normal[k]))
+    diag = np.hypot(b[1] - b[0], b[3] - b[2])
+    centre = np.array([0.5 * (b[0] + b[1]), 0.5 * (b[2] + b[3])])
+    for tip in fr.tips:
+        if np.linalg.norm(centre - tip.point) <= tip.ramp_length + diag:
+            out.append((tip.point, tip.direction))
+            out.append((tip.point - tip.ramp_length * tip.direction, tip.direction))
+    return out
+
+
+def _node_side(fractures, mesh, tol):
+    """H at the nodes per fracture: a node on the fracture takes +1 (eq. 12)."""
+    return [np.where(fr.signed_distance(mesh.nodes) >= -tol, 1.0, -1.0) for fr in fractures]
+
+
+def _cell_rule(mesh, c, fractures, frs, has_branch, tol):
+    """Sub-triangles, quadrature points and weights of one enriched cell."""
+    b = mesh.bounds[c]
+    lines = [ln for fi in frs for ln in _cell_lines(fractures[fi], b, tol)]
+    if not has_branch:
+        tris = cell_subtriangles(b, lines, tol)
+        return (tris, *triangle_rule(tris))
+    apexes = [t.point for fi in frs for t in fractures[fi].tips]
+    tris = cell_subtriangles(b, lines, tol, apexes=apexes)
+    return (tris, *duffy_rule(tris))
+
+
+def build_enriched_cells(mesh, fractures, cand: Candidates) -> EnrichedCells:
+    """Slots, sub-cell quadrature and enrichment values of every enriched cell."""
+    tol = GEOMETRY_TOL * mesh.h_min
+    node_side = _node_side(fractures, mesh, tol)
+    slots_of = {}
+    if cand.node.size:
+        node_cells = _node_cells(mesh)
+        for k, node in enumerate(cand.node):
+            for c in node_cells[node]:
+                slots_of.setdefault(int(c), []).append(k)
+    cand_cells = np.array(sorted(slots_of), dtype=np.int64)
+    nc = cand_cells.size
+    S = max((len(v) for v in slots_of.values()), default=0)
+    slot_cand = -np.ones((nc, S), np.int64)
+    slot_node = -np.ones((nc, S), np.int64)
+    slot_fnode = np.zeros((nc, S))
+    parts = {key: [] for key in ("xy", "w", "F", "gF", "tris", "Fv")}
+    qp_off, tri_off = [0], [0]
+    for e, c in enumerate(cand_cells):
+        ks = slots_of[int(c)]
+        frs = sorted({int(cand.fracture[k]) for k in ks})
+        has_branch = any(cand.func[k] != HEAVISIDE for k in ks)
+        tris, xy, w = _cell_rule(mesh, c, fractures, frs, has_branch, tol)
+        per = xy.shape[0] // tris.shape[0]
+        centroids = tris.mean(axis=1)
+        side_t = {fi: fractures[fi].side(centroids) for fi in frs}
+        F = np.zeros((xy.shape[0], S))
+        gF = np.zeros((xy.shape[0], S, 2))
+        Fv = np.zeros((tris.shape[0], 3, S))
+        for s, k in enumerate(ks):
+            node = cand.node[k]
+            slot_cand[e, s] = k
+            slot_node[e, s] = int(np.nonzero(mesh.cells[c] == node)[0][0])
+            side_n = node_side[cand.fracture[k]][node:node + 1]
+            slot_fnode[e, s] = candidate_values(fractures, cand, k, mesh.nodes[node:node + 1],
+                                                side_n, tol)[0][0]
+            st = side_t[int(cand.fracture[k])]
+            F[:, s], gF[:, s] = candidate_values(fractures, cand, k, xy, np.repeat(st, per), tol)
+            Fv[:, :, s] = candidate_values(fractures, cand, k, tris.reshape(-1, 2),
+                                           np.repeat(st, 3), tol)[0].reshape(-1, 3)
+        for key, val in zip(("xy", "w", "F", "gF", "tris", "Fv"), (xy, w, F, gF, tris, Fv)):
+            parts[key].append(val)
+        qp_off.append(qp_off[-1] + xy.shape[0])
+        tri_off.append(tri_off[-1] + tris.shape[0])
+
+    def cat(key, shape):
+        p = parts[key]
+        return np.ascontiguousarray(np.concatenate(p)) if p else np.zeros(shape)
+
+    return EnrichedCells(
+        cells=cand_cells, slot_cand=slot_cand, slot_node=slot_node, slot_fnode=slot_fnode,
+        qp_offsets=np.array(qp_off, np.int64), qp_xy=cat("xy", (0, 2)), qp_w=cat("w", (0,)),
+        qp_F=cat("F", (0, S)), qp_gradF=cat("gF", (0, S, 2)),
+        tri_offsets=np.array(tri_off, np.int64), tris=cat("tris", (0, 3, 2)),
+        tri_F=cat("Fv", (0, 3, S)))
+
+
+def _node_cells(mesh):
+    """Cells around each node (list of arrays)."""
+    order = np.argsort(mesh.cells.ravel(), kind="stable")
+    nodes_sorted = mesh.cells.ravel()[order]
+    cells_sorted = order // 4
+    split = np.searchsorted(nodes_sorted, np.arange(mesh.n_nodes + 1))
+    return [cells_sorted[split[i]:split[i + 1]] for i in range(mesh.n_nodes)]
+
+
+def select_enrichment(mesh, cand: Candidates, ec: EnrichedCells, K_enr: np.ndarray,
+                      std_diag: np.ndarray) -> DofMap:
+    """Apply the sliver rule and number the kept enriched dofs.
+
+    K_enr : (nc, 8+2S, 8+2S) enriched-cell stiffness with every candidate slot.
+    std_diag : (n_std,) diagonal of the standard-dof bulk stiffness.
+    """
+    n_std = 2 * mesh.n_nodes
+    k = cand.node.size
+    diag = np.zeros((k, 2))
+    S = ec.slot_cand.shape[1]
+    for s in range(S):
+        m = ec.slot_cand[:, s] >= 0
+        for comp in range(2):
+            np.add.at(diag[:, comp], ec.slot_cand[m, s], K_enr[m, 8 + 2 * s + comp,
+                                                          8 + 2 * s + comp])
+    ref = np.stack([std_diag[2 * cand.node], std_diag[2 * cand.node + 1]], axis=1)
+    ratio = (diag / ref).min(axis=1) if k else np.zeros(0)
+    keep = ratio >= ENRICHMENT_DIAG_RATIO
+    cand_dof = -np.ones(k, np.int64)
+    cand_dof[keep] = n_std + 2 * np.arange(np.count_nonzero(keep))
+    if k and not keep.all():
+        logger.info("enrichment: dropped %d of %d node enrichments whose support the fracture "
+                    "cuts into a sliver (stiffness ratio < %.0e)", k - keep.sum(), k,
+                    ENRICHMENT_DIAG_RATIO)
+    return DofMap(n_std=n_std, n_dofs=n_std + 2 * int(keep.sum()), cand_dof=cand_dof)

@@ -1,0 +1,64 @@
+"""Exceptions of xfemslip.
+
+Library code raises these; only ``cli.py`` turns them into messages and exit
+codes (``CaseError`` and ``UsageError`` -> exit 2, the others -> exit 1).
+"""
+
+from __future__ import annotations
+
+
+class XfemslipError(Exception):
+    """Base class of every error xfemslip reports to a user."""
+
+
+class CaseError(XfemslipError):
+    """Invalid case file: every problem of the file, each with its key path.
+
+    ``problems`` is a list of ``(key_path, message)``; ``str(err)`` is one line:
+    ``cases/x.toml: fractures[0].friction: must be >= 0, got -0.1`` or, with
+    several problems, ``cases/x.toml: 2 problems: a: ...; b: ...``.
+    """
+
+    def __init__(self, path, problems):
+        self.path = str(path)
+        self.problems = [(str(k), str(m)) for k, m in problems]
+        parts = [f"{k}: {m}" if k else m for k, m in self.problems]
+        if len(parts) == 1:
+            text = f"{self.path}: {parts[0]}"
+        else:
+            text = f"{self.path}: {len(parts)} problems: " + "; ".join(parts)
+        super().__init__(text.replace("\n", " "))
+
+
+class UsageError(XfemslipError):
+    """A command-line usage problem found by the library (e.g. output exists)."""
+
+
+class MeshError(XfemslipError):
+    """A mesh that cannot be built or is not supported."""
+
+
+class GeometryError(XfemslipError):
+    """Fracture geometry that cannot be represented (names the case key)."""
+
+
+class ConvergenceError(XfemslipError):
+    """Newton did not converge in a load step.
+
+    Attributes: ``step`` (1-based), ``iteration``, ``residual`` (eta),
+    ``increment`` (relative increment norm), ``flips`` (stick/slip switches in
+    the last iteration).
+    """
+
+    def __init__(self, message, *, step, iteration, residual, increment=float("nan"),
+                 flips=0):
+        self.step = step
+        self.iteration = iteration
+        self.residual = residual
+        self.increment = increment
+        self.flips = flips
+        super().__init__(message)
+
+
+class OutputError(XfemslipError):
+    """Output that cannot be written (unwritable directory, disk full, ...)."""

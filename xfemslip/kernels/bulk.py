@@ -1,0 +1,122 @@
+"""Bulk element matrices: intact rectangles and enriched (cut / blending) cells.
+
+Local dof order of a cell: standard ``2*a + c`` (a = 0..3 local node, c = 0 x,
+1 y), then enriched slot s: ``8 + 2*s + c``.  A slot is one (node, fracture)
+enrichment with the shifted function (paper eq. 11)
+
+    Phi_s(x) = N_a(x) * (F(x) - F(x_a)),   F = H(phi) * R,
+
+H = +/-1 the side of the fracture and R the tip ramp (see enrichment.py), so
+grad Phi_s = grad N_a * (F - F_a) + N_a * grad F.  Strain B (3 x ndof) uses the
+Voigt order [exx, eyy, gxy] (paper eq. 16); K_e = sum_qp B^T D B w (eq. 22).
+"""
+
+import numpy as np
+from numba import njit
+
+from xfemslip.kernels._config import NUMBA_CACHE
+from xfemslip.kernels.shape import q4_shape
+
+_GAUSS2 = np.array([-1.0 / np.sqrt(3.0), 1.0 / np.sqrt(3.0)])
+
+
+@njit(cache=NUMBA_CACHE)
+def rectangle_stiffness(hx, hy, D):
+    """Stiffness of intact rectangles, 2x2 Gauss (exact for bilinear fields).
+
+    Parameters
+    ----------
+    hx, hy : (m,) float64, rectangle sizes [m]
+    D : (3, 3) float64, elasticity matrix [Pa] (eqs. 24-25)
+
+    Returns
+    -------
+    K : (m, 8, 8) float64 [N/m per unit thickness]
+    """
+    m = hx.shape[0]
+    K = np.zeros((m, 8, 8))
+    N = np.empty(4)
+    dN = np.empty((4, 2))
+    B = np.zeros((3, 8))
+    for e in range(m):
+        for gi in range(2):
+            for gj in range(2):
+                x = 0.5 * hx[e] * (1.0 + _GAUSS2[gi])
+                y = 0.5 * hy[e] * (1.0 + _GAUSS2[gj])
+                q4_shape(x, y, 0.0, hx[e], 0.0, hy[e], N, dN)
+                for a in range(4):
+                    B[0, 2 * a] = dN[a, 0]
+                    B[1, 2 * a + 1] = dN[a, 1]
+                    B[2, 2 * a] = dN[a, 1]
+                    B[2, 2 * a + 1] = dN[a, 0]
+                w = 0.25 * hx[e] * hy[e]
+                K[e] += (B.T @ D @ B) * w
+    return K
+
+
+@njit(cache=NUMBA_CACHE)
+def _enriched_B(x, y, x0, x1, y0, y1, slot_node, slot_fnode, F, gradF, N, dN, out_B):
+    """Fill out_B (3, 8 + 2S) at one point; returns nothing (writes out_B)."""
+    q4_shape(x, y, x0, x1, y0, y1, N, dN)
+    out_B[:, :] = 0.0
+    for a in range(4):
+        out_B[0, 2 * a] = dN[a, 0]
+        out_B[1, 2 * a + 1] = dN[a, 1]
+        out_B[2, 2 * a] = dN[a, 1]
+        out_B[2, 2 * a + 1] = dN[a, 0]
+    for s in range(slot_node.shape[0]):
+        a = slot_node[s]
+        if a < 0:
+            continue
+        shift = F[s] - slot_fnode[s]
+        gx = dN[a, 0] * shift + N[a] * gradF[s, 0]
+        gy = dN[a, 1] * shift + N[a] * gradF[s, 1]
+        c = 8 + 2 * s
+        out_B[0, c] = gx
+        out_B[1, c + 1] = gy
+        out_B[2, c] = gy
+        out_B[2, c + 1] = gx
+
+
+@njit(cache=NUMBA_CACHE)
+def enriched_cell_matrices(bounds, qp_offsets, qp_xy, qp_w, qp_F, qp_gradF,
+                           slot_node, slot_fnode, D):
+    """Stiffness and area-averaged strain operator of enriched cells.
+
+    Parameters
+    ----------
+    bounds : (nc, 4) float64, [x0, x1, y0, y1] of each cell [m]
+    qp_offsets : (nc + 1,) int64, qp range of each cell in the flat arrays
+    qp_xy : (nq, 2) float64 [m]; qp_w : (nq,) float64 [m^2] (sub-cell rules)
+    qp_F : (nq, S) float64, enrichment function F of each slot's fracture [-]
+    qp_gradF : (nq, S, 2) float64 [1/m]
+    slot_node : (nc, S) int64, local node (0..3) of each slot, -1 = empty
+    slot_fnode : (nc, S) float64, F at the slot's node (the shift of eq. 11)
+    D : (3, 3) float64 [Pa]
+
+    Returns
+    -------
+    K : (nc, 8 + 2S, 8 + 2S) float64, sum_qp B^T D B w
+    Bbar : (nc, 3, 8 + 2S) float64, (1/A) sum_qp B w (cell-average strain)
+    """
+    nc = bounds.shape[0]
+    S = slot_node.shape[1]
+    nd = 8 + 2 * S
+    K = np.zeros((nc, nd, nd))
+    Bbar = np.zeros((nc, 3, nd))
+    N = np.empty(4)
+    dN = np.empty((4, 2))
+    B = np.zeros((3, nd))
+    for e in range(nc):
+        x0, x1, y0, y1 = bounds[e, 0], bounds[e, 1], bounds[e, 2], bounds[e, 3]
+        area = 0.0
+        for q in range(qp_offsets[e], qp_offsets[e + 1]):
+            _enriched_B(qp_xy[q, 0], qp_xy[q, 1], x0, x1, y0, y1, slot_node[e],
+                        slot_fnode[e], qp_F[q], qp_gradF[q], N, dN, B)
+            w = qp_w[q]
+            DB = D @ B
+            K[e] += (B.T @ DB) * w
+            Bbar[e] += B * w
+            area += w
+        Bbar[e] /= area
+    return K, Bbar

@@ -1,0 +1,133 @@
+"""Penalty contact with Coulomb friction and cohesion at fracture integration points.
+
+Layering (house style): a scalar return map ``coulomb_return_map`` and a batched
+loop ``contact_response`` over the interface points; the Python driver is
+``xfemslip/contact.py``.  No fastmath here: the law is made of sign tests.
+
+Signs (tension positive): p_N = k_N g_N + p_N0 <= 0 in contact (paper eqs. 5-6,
+with p_N0 the in-situ normal traction), open when that is > 0 (no traction);
+Coulomb bound |p_T| <= c_f - f p_N (eqs. 7-8); trial p_T = k_T (g_T - g_T^p)
+with g_T^p the committed plastic slip (eq. 26), returned onto the bound when it
+is exceeded (eqs. 27-28).
+"""
+
+import numpy as np
+from numba import njit
+
+from xfemslip.kernels._config import NUMBA_CACHE
+
+OPEN = 0
+STICK = 1
+SLIP = 2
+
+TANGENT_CONSISTENT = 0
+TANGENT_SECANT = 1
+
+# |Delta g_T| below this (m) has no usable secant; the elastic k_T is used.
+_SECANT_MIN_INCREMENT = 1.0e-300
+
+
+@njit(cache=NUMBA_CACHE)
+def coulomb_return_map(gn, gt, slip_old, pn0, kn, kt, friction, cohesion):
+    """Return map of one contact point.
+
+    Parameters
+    ----------
+    gn, gt : float, normal and tangential jump [m] (gn > 0 opens)
+    slip_old : float, committed plastic slip g_T^p [m]
+    pn0 : float, in-situ normal traction at zero jump [Pa] (<= 0)
+    kn, kt : float, penalty stiffnesses [Pa/m]; friction f [-]; cohesion [Pa]
+
+    Returns
+    -------
+    pn, pt : tractions [Pa]; state : OPEN | STICK | SLIP; slip_new : [m];
+    d_nn, d_nt, d_tn, d_tt : consistent tangent d(pn, pt)/d(gn, gt) [Pa/m]
+    """
+    pn = kn * gn + pn0
+    if pn > 0.0:
+        return 0.0, 0.0, OPEN, gt, 0.0, 0.0, 0.0, 0.0
+    pt_trial = kt * (gt - slip_old)
+    bound = cohesion - friction * pn
+    if abs(pt_trial) <= bound:
+        return pn, pt_trial, STICK, slip_old, kn, 0.0, 0.0, kt
+    sgn = 1.0 if pt_trial > 0.0 else -1.0
+    pt = sgn * bound
+    return pn, pt, SLIP, gt - pt / kt, kn, 0.0, -sgn * friction * kn, 0.0
+
+
+@njit(cache=NUMBA_CACHE)
+def contact_response(u, ip_dofs, ip_coef, ip_normal, ip_tangent, ip_weight, pn0,
+                     slip_old, kn, kt, friction, cohesion, tangent_mode, pt_prev,
+                     gt_prev, out_f, out_K, out_gn, out_gt, out_pn, out_pt,
+                     out_state, out_slip):
+    """Contact forces and tangent of every interface point.
+
+    The jump at point i is [[u]] = sum_k ip_coef[i, k] * (u[ip_dofs[i, 2k]],
+    u[ip_dofs[i, 2k+1]]) over its J jumping enrichments (paper eq. 14 with
+    the tip functions; dof -1 = absent).  The point's
+    contribution to the internal force is w * coef_k * T with the traction
+    T = p_N n + p_T t (eq. 20, f_int^con), its tangent w coef_k coef_l C with
+    C = d T / d[[u]] (eq. 22 with the return-map tangent).
+
+    Parameters
+    ----------
+    u : (n_dofs,) float64 [m]
+    ip_dofs : (n, 2J) int64; ip_coef : (n, J) float64 [-]
+    ip_normal, ip_tangent : (n, 2) float64; ip_weight : (n,) float64 [m]
+    pn0 : (n,) [Pa]; slip_old : (n,) [m]; kn, kt : (n,) [Pa/m];
+    friction : (n,) [-]; cohesion : (n,) [Pa]
+    tangent_mode : TANGENT_CONSISTENT or TANGENT_SECANT (paper eq. 28)
+    pt_prev, gt_prev : (n,) p_T [Pa] and g_T [m] of the previous iteration
+        (used by the secant tangent only)
+    out_f : (n, 2J) [N/m]; out_K : (n, 2J, 2J) [N/m^2]; out_gn, out_gt : (n,) [m];
+    out_pn, out_pt : (n,) [Pa]; out_state : (n,) int8; out_slip : (n,) [m]
+    """
+    n_ip = ip_dofs.shape[0]
+    J = ip_coef.shape[1]
+    C = np.empty((2, 2))
+    for i in range(n_ip):
+        n0, n1 = ip_normal[i, 0], ip_normal[i, 1]
+        t0, t1 = ip_tangent[i, 0], ip_tangent[i, 1]
+        j0 = 0.0
+        j1 = 0.0
+        for k in range(J):
+            dx = ip_dofs[i, 2 * k]
+            dy = ip_dofs[i, 2 * k + 1]
+            if dx >= 0:
+                j0 += ip_coef[i, k] * u[dx]
+            if dy >= 0:
+                j1 += ip_coef[i, k] * u[dy]
+        gn = j0 * n0 + j1 * n1
+        gt = j0 * t0 + j1 * t1
+        pn, pt, state, slip, dnn, dnt, dtn, dtt = coulomb_return_map(
+            gn, gt, slip_old[i], pn0[i], kn[i], kt[i], friction[i], cohesion[i])
+        if tangent_mode == TANGENT_SECANT and state == SLIP:
+            # paper eq. 28: k_T = (p_T^{n+1} - p_T^n) / |Delta w_T|, no n-t coupling
+            dg = abs(gt - gt_prev[i])
+            dtt = kt[i] if dg <= _SECANT_MIN_INCREMENT else abs(pt - pt_prev[i]) / dg
+            dtt = min(dtt, kt[i])
+            dtn = 0.0
+        out_gn[i] = gn
+        out_gt[i] = gt
+        out_pn[i] = pn
+        out_pt[i] = pt
+        out_state[i] = state
+        out_slip[i] = slip
+        T0 = pn * n0 + pt * t0
+        T1 = pn * n1 + pt * t1
+        # C = n (dnn n + dnt t)^T + t (dtn n + dtt t)^T
+        C[0, 0] = n0 * (dnn * n0 + dnt * t0) + t0 * (dtn * n0 + dtt * t0)
+        C[0, 1] = n0 * (dnn * n1 + dnt * t1) + t0 * (dtn * n1 + dtt * t1)
+        C[1, 0] = n1 * (dnn * n0 + dnt * t0) + t1 * (dtn * n0 + dtt * t0)
+        C[1, 1] = n1 * (dnn * n1 + dnt * t1) + t1 * (dtn * n1 + dtt * t1)
+        w = ip_weight[i]
+        for k in range(J):
+            ck = w * ip_coef[i, k]
+            out_f[i, 2 * k] = ck * T0
+            out_f[i, 2 * k + 1] = ck * T1
+            for m in range(J):
+                ckm = ck * ip_coef[i, m]
+                out_K[i, 2 * k, 2 * m] = ckm * C[0, 0]
+                out_K[i, 2 * k, 2 * m + 1] = ckm * C[0, 1]
+                out_K[i, 2 * k + 1, 2 * m] = ckm * C[1, 0]
+                out_K[i, 2 * k + 1, 2 * m + 1] = ckm * C[1, 1]

@@ -1,0 +1,28 @@
+"""Linear elastic constants (paper eqs. 24-25) and contact parameters."""
+
+from __future__ import annotations
+
+from typing import NamedTuple
+
+import numpy as np
+
+
+def elasticity_matrix(young_modulus: float, poisson_ratio: float, model: str) -> np.ndarray:
+    """D (3, 3) [Pa] in Voigt order [xx, yy, xy(engineering shear)]."""
+    E, nu = young_modulus, poisson_ratio
+    if model == "plane_stress":  # eq. 24
+        c = E / (1.0 - nu**2)
+        return c * np.array([[1.0, nu, 0.0], [nu, 1.0, 0.0], [0.0, 0.0, (1.0 - nu) / 2.0]])
+    if model == "plane_strain":  # eq. 25
+        c = E * (1.0 - nu) / ((1.0 + nu) * (1.0 - 2.0 * nu))
+        r = nu / (1.0 - nu)
+        return c * np.array([[1.0, r, 0.0], [r, 1.0, 0.0],
+                             [0.0, 0.0, (1.0 - 2.0 * nu) / (2.0 * (1.0 - nu))]])
+    raise ValueError(f"unknown model {model!r}")
+
+
+class FrictionParams(NamedTuple):
+    friction_coefficient: float  # f [-]
+    normal_penalty: float  # k_N [Pa/m]
+    tangential_penalty: float  # k_T [Pa/m]
+    cohesion: float = 0.0  # c_f [Pa]

@@ -1,0 +1,108 @@
+"""Post-processing into the output sign convention (tension positive).
+
+Stress: sigma = sigma0 + D eps, averaged over each element (sub-cells included
+for enriched elements).  Out-of-plane stress in plane strain:
+sigma_zz = nu (sigma_xx + sigma_yy) (the in-situ sigma_zz is taken as
+nu (sigma0_xx + sigma0_yy), consistent with plane strain); zero in plane stress.
+Fracture fields: slip = [[u]] . t, opening = [[u]] . n, p_N, p_T, state codes
+OPEN = 0, STICK = 1, SLIP = 2 (as in kernels/contact.py).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from xfemslip.kernels.contact import OPEN, SLIP, STICK  # noqa: F401  (codes mirrored)
+from xfemslip.writers import FractureFields, VisMesh
+
+STATE_CODES = "0 open, 1 stick, 2 slip"
+
+
+def q4_shape_np(x, y, b):
+    """N (n, 4) at points (x, y) (n,) of cells with bounds b (n, 4)."""
+    xi = (2.0 * x - b[:, 0] - b[:, 1]) / (b[:, 1] - b[:, 0])
+    eta = (2.0 * y - b[:, 2] - b[:, 3]) / (b[:, 3] - b[:, 2])
+    xa = np.array([-1.0, 1.0, 1.0, -1.0])
+    ya = np.array([-1.0, -1.0, 1.0, 1.0])
+    return 0.25 * (1.0 + xi[:, None] * xa) * (1.0 + eta[:, None] * ya)
+
+
+def cell_strain(mesh, bulk, u) -> np.ndarray:
+    """Element-average strain (M, 3) [exx, eyy, gxy]."""
+    eps = np.zeros((mesh.n_cells, 3))
+    c = bulk.std_cells
+    b = mesh.bounds[c]
+    hx, hy = b[:, 1] - b[:, 0], b[:, 3] - b[:, 2]
+    U = u[:2 * mesh.n_nodes].reshape(-1, 2)[mesh.cells[c]]  # (ns, 4, 2)
+    xa = np.array([-1.0, 1.0, 1.0, -1.0])
+    ya = np.array([-1.0, -1.0, 1.0, 1.0])
+    dNdx = xa[None, :] / (2.0 * hx[:, None])  # gradient at the centre = cell average
+    dNdy = ya[None, :] / (2.0 * hy[:, None])
+    eps[c, 0] = np.sum(dNdx * U[:, :, 0], axis=1)
+    eps[c, 1] = np.sum(dNdy * U[:, :, 1], axis=1)
+    eps[c, 2] = np.sum(dNdy * U[:, :, 0] + dNdx * U[:, :, 1], axis=1)
+    if bulk.enr_dofs.shape[0]:
+        ue = np.where(bulk.enr_dofs >= 0, u[np.maximum(bulk.enr_dofs, 0)], 0.0)
+        eps[bulk.enriched_cells] = np.einsum("eij,ej->ei", bulk.enr_Bbar, ue)
+    return eps
+
+
+def bulk_fields(mesh, bulk, D, u, initial_stress, nu, model):
+    """stress (M, 3), stress_zz (M,), principal_stress (M, 2) [Pa]."""
+    stress = cell_strain(mesh, bulk, u) @ D.T
+    if initial_stress is not None:
+        stress = stress + np.asarray(initial_stress, float)[None, :]
+    szz = nu * (stress[:, 0] + stress[:, 1]) if model == "plane_strain" else np.zeros(len(stress))
+    centre = 0.5 * (stress[:, 0] + stress[:, 1])
+    radius = np.hypot(0.5 * (stress[:, 0] - stress[:, 1]), stress[:, 2])
+    principal = np.column_stack([centre + radius, centre - radius])
+    return stress, szz, principal
+
+
+def fracture_fields(ip, res, n_fractures) -> list[FractureFields]:
+    """Contact fields per fracture, ordered by arc length."""
+    out = []
+    for fi in range(n_fractures):
+        m = np.nonzero(ip.fracture == fi)[0]
+        m = m[np.argsort(ip.s[m], kind="stable")]
+        out.append(FractureFields(
+            s=ip.s[m].copy(), points=ip.xy[m].copy(), slip=res.gt[m].copy(),
+            opening=res.gn[m].copy(), normal_traction=res.pn[m].copy(),
+            shear_traction=res.pt[m].copy(), state=res.state[m].astype(np.int8)))
+    return out
+
+
+def vis_mesh(mesh, ec, bulk, u) -> VisMesh:
+    """Bulk mesh with enriched cells split into sub-triangles carrying their own side."""
+    n_std = 2 * mesh.n_nodes
+    U = u[:n_std].reshape(-1, 2)
+    is_enr = np.zeros(mesh.n_cells, bool)
+    is_enr[ec.cells] = True
+    quads = mesh.cells[~is_enr]
+    quad_cell = np.nonzero(~is_enr)[0]
+    nt = ec.tris.shape[0]
+    if nt == 0:
+        return VisMesh(points=mesh.nodes.copy(), displacement=U.copy(), quads=quads,
+                       quad_cell=quad_cell, triangles=np.zeros((0, 3), np.int64),
+                       triangle_cell=np.zeros(0, np.int64))
+    tri_owner = np.repeat(np.arange(ec.cells.size), np.diff(ec.tri_offsets))  # enriched index
+    cell = ec.cells[tri_owner]
+    pts = ec.tris.reshape(-1, 2)
+    owner_v = np.repeat(tri_owner, 3)
+    N = q4_shape_np(pts[:, 0], pts[:, 1], mesh.bounds[np.repeat(cell, 3)])  # (3nt, 4)
+    disp = np.einsum("va,vac->vc", N, U[mesh.cells[np.repeat(cell, 3)]])
+    Fv = ec.tri_F.reshape(-1, ec.tri_F.shape[2])  # (3nt, S)
+    dofs = bulk.enr_dofs[owner_v]  # (3nt, 8+2S)
+    for s in range(ec.slot_cand.shape[1]):
+        a = ec.slot_node[owner_v, s]
+        d = dofs[:, 8 + 2 * s]
+        ok = (a >= 0) & (d >= 0)
+        phi = np.where(ok, N[np.arange(len(a)), np.maximum(a, 0)]
+                       * (Fv[:, s] - ec.slot_fnode[owner_v, s]), 0.0)
+        amp = np.where(ok[:, None], u[np.stack([np.maximum(d, 0), np.maximum(d, 0) + 1], 1)], 0.0)
+        disp += phi[:, None] * amp
+    base = mesh.n_nodes
+    triangles = base + np.arange(3 * nt, dtype=np.int64).reshape(nt, 3)
+    return VisMesh(points=np.vstack([mesh.nodes, pts]), displacement=np.vstack([U, disp]),
+                   quads=quads, quad_cell=quad_cell, triangles=triangles,
+                   triangle_cell=cell.astype(np.int64))

@@ -1,0 +1,141 @@
+"""Load stepping and Newton-Raphson (paper eq. 21).
+
+Residual r(u) = K_bulk u + f_con(u) - f_con(0) - lambda F_ext on the free dofs
+(f_con(0) is the in-situ contact force that balances the initial stress, zero
+without one).  Convergence: eta = ||r_free|| / ||F_ref|| <= tolerance, where
+F_ref stacks the applied forces on the free dofs and the reactions on the
+prescribed ones, so displacement-driven cases (no applied force at all) have a
+meaningful reference (eta of the paper with F_ext including reactions).
+
+Tangents: "consistent" uses the exact derivative of the return map (not
+symmetric while slipping), which gives quadratic convergence once the
+stick/slip set has settled; "secant" is the paper's eq. 28 update.  The linear
+systems are solved with SuperLU (scipy), which handles the non-symmetric case.
+"""
+
+from __future__ import annotations
+
+import logging
+import math
+from dataclasses import dataclass
+
+import numpy as np
+import scipy.sparse as sp
+import scipy.sparse.linalg as spla
+
+from xfemslip import kernels
+from xfemslip.assembly import coo_block
+from xfemslip.contact import OPEN, SLIP, STICK, ContactResult, ContactSet
+from xfemslip.errors import ConvergenceError
+
+logger = logging.getLogger(__name__)
+
+TANGENTS = {"consistent": kernels.TANGENT_CONSISTENT, "secant": kernels.TANGENT_SECANT}
+
+
+@dataclass
+class Problem:
+    K: sp.csr_matrix  # bulk stiffness (n_dofs, n_dofs)
+    F_unit: np.ndarray  # external force at load factor 1 (n_dofs,)
+    fixed: np.ndarray  # prescribed dofs
+    fixed_values: np.ndarray  # their final values
+    contact: ContactSet
+    n_dofs: int
+
+
+@dataclass
+class StepResult:
+    step: int
+    load_factor: float
+    u: np.ndarray
+    contact: ContactResult
+    iterations: int
+    residuals: list
+
+
+class NewtonSolver:
+    """Newton-Raphson over load steps on a Problem; keeps the converged steps."""
+
+    def __init__(self, problem: Problem, tolerance: float, max_iterations: int, tangent: str):
+        self.p = problem
+        self.tol = tolerance
+        self.max_it = max_iterations
+        self.mode = TANGENTS[tangent]
+        n = problem.n_dofs
+        free = np.ones(n, bool)
+        free[problem.fixed] = False
+        self.free = np.nonzero(free)[0]
+        self.reduced = -np.ones(n, np.int64)
+        self.reduced[self.free] = np.arange(self.free.size)
+        self.K_ff = problem.K[self.free][:, self.free].tocsr()
+        c = problem.contact
+        self.c_dofs = np.where(c.dofs >= 0, self.reduced[np.maximum(c.dofs, 0)], -1)
+        zero = c.evaluate(np.zeros(n), self.mode, c.pt_committed, c.gt_committed)
+        self.f_c0 = zero.force
+        self.completed: list[StepResult] = []
+
+    def run(self, steps: int) -> list[StepResult]:
+        u = np.zeros(self.p.n_dofs)
+        for k in range(1, steps + 1):
+            u = self._step(u, k, steps)
+        return self.completed
+
+    def _residual(self, u, lam, res: ContactResult):
+        f_int = self.p.K @ u + res.force - self.f_c0
+        r = f_int - lam * self.p.F_unit
+        ref = math.sqrt(float(np.sum((lam * self.p.F_unit[self.free]) ** 2)
+                              + np.sum(r[self.p.fixed] ** 2)))
+        norm = float(np.linalg.norm(r[self.free]))
+        eta = norm / ref if ref > 0.0 else (0.0 if norm == 0.0 else math.inf)
+        return r[self.free], eta
+
+    def _step(self, u, k, steps):
+        lam = k / steps
+        c = self.p.contact
+        u = u.copy()
+        u[self.p.fixed] = lam * self.p.fixed_values
+        pt_prev, gt_prev = c.pt_committed.copy(), c.gt_committed.copy()
+        prev_state = c.state_committed
+        residuals = []
+        for it in range(self.max_it + 1):
+            res = c.evaluate(u, self.mode, pt_prev, gt_prev)
+            r, eta = self._residual(u, lam, res)
+            flips = int(np.count_nonzero(res.state != prev_state))
+            residuals.append(eta)
+            logger.info("step %d/%d iteration %d: eta = %.3e; contact points: %d slip, %d stick, "
+                        "%d open; %d switched", k, steps, it, eta,
+                        np.count_nonzero(res.state == SLIP), np.count_nonzero(res.state == STICK),
+                        np.count_nonzero(res.state == OPEN), flips)
+            if not np.isfinite(eta):
+                raise self._fail(k, it, eta, flips, "the residual is not finite")
+            if eta <= self.tol:
+                c.commit(res)
+                self.completed.append(StepResult(k, lam, u.copy(), res, it, residuals))
+                return u
+            if it == self.max_it:
+                raise self._fail(k, it, eta, flips, f"no convergence in {self.max_it} iterations")
+            du = self._solve(res, r, k, it, eta)
+            u[self.free] -= du
+            pt_prev, gt_prev, prev_state = res.pt, res.gt, res.state
+        raise AssertionError("unreachable")
+
+    def _solve(self, res, r, k, it, eta):
+        Kc = coo_block(self.c_dofs, res.blocks, self.free.size)
+        A = (self.K_ff + Kc).tocsc()
+        try:
+            lu = spla.splu(A, permc_spec="COLAMD")
+            du = lu.solve(r)
+        except RuntimeError as exc:  # "Factor is exactly singular"
+            raise self._fail(k, it, eta, 0, f"the tangent matrix is singular ({exc}); a part "
+                             "of the body may be free to move (e.g. a block cut off by a "
+                             "fracture with nothing holding it)") from None
+        if not np.all(np.isfinite(du)):
+            raise self._fail(k, it, eta, 0, "the linear solve gave non-finite values")
+        return du
+
+    def _fail(self, k, it, eta, flips, why):
+        return ConvergenceError(
+            f"load step {k} did not converge: {why}; iteration {it}, residual eta = {eta:.3e} "
+            f"(tolerance {self.tol:.1e}), {flips} stick/slip switches in the last iteration; "
+            f"{len(self.completed)} converged step(s) kept",
+            step=k, iteration=it, residual=eta, flips=flips)
