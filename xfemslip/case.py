@@ -68,8 +68,11 @@ class FractureSpec:
     cohesion: float  # c_f [Pa]
     kn: float  # normal penalty [Pa/m]
     kt: float  # tangential penalty [Pa/m]
+    tip: str = "branch"  # crack-tip treatment: "branch" | "ramp"
+    tip_radius: float | None = None  # branch enrichment radius [m]; None = automatic
     UNITS: ClassVar[dict[str, str]] = {
         "points": "m",
+        "tip_radius": "m",
         "friction": "-",
         "cohesion": "Pa",
         "kn": "Pa/m",
@@ -175,7 +178,10 @@ FRACTURE_KEYS = (
     "cohesion",
     "kn",
     "kt",
+    "tip",
 )
+TIP_KINDS = ("branch", "ramp")
+TIP_KEYS = ("kind", "radius")
 STRESS_KEYS = ("xx", "yy", "xy")
 EDGE_KEYS = ("ux", "uy", "traction", "file")
 EDGE_WORDS = ("traction", "free")
@@ -857,6 +863,7 @@ def _read_fracture(
     cohesion = table.number("cohesion", 0.0, rule=_NON_NEGATIVE)
     kn = table.number("kn", rule=_POSITIVE)
     kt = table.number("kt", rule=_POSITIVE)
+    tip, radius = _read_tip(table)
     if points is not None:
         _check_polyline(table, points, grid)
     if len(table.problems) > start:
@@ -868,7 +875,29 @@ def _read_fracture(
         cohesion=cohesion,
         kn=kn,
         kt=kt,
+        tip=tip,
+        tip_radius=radius,
     )
+
+
+def _read_tip(table: _Table) -> tuple[str, float | None]:
+    """``tip = "branch"`` / ``"ramp"``, or ``tip = { kind = .., radius = .. }``.
+
+    branch: near-tip branch functions on the nodes within ``radius`` (m) of each
+    tip (default: 4 tip-cell sizes); ramp: the jump falls linearly to zero
+    across the tip cell.  Default "branch".
+    """
+    if not table.has("tip"):
+        return "branch", None
+    value = table.data["tip"]
+    if isinstance(value, dict):
+        sub = _Table(value, table.key("tip"), table.problems, TIP_KEYS)
+        kind = sub.choice("kind", TIP_KINDS, "branch")
+        radius = sub.number("radius", None, rule=_POSITIVE)
+        if radius is not None and kind == "ramp":
+            sub.error("radius", "only used with kind = \"branch\"")
+        return kind, radius
+    return table.choice("tip", TIP_KINDS), None
 
 
 def _read_fractures(
@@ -1346,11 +1375,17 @@ def _describe_fracture(spec: FractureSpec) -> list[str]:
         f"{k} = {_with_unit(getattr(spec, k), units[k])}"
         for k in ("friction", "cohesion", "kn", "kt")
     )
+    tip = spec.tip + (
+        f", radius {_with_unit(spec.tip_radius, units['tip_radius'])}"
+        if spec.tip_radius is not None
+        else (", radius 4 tip-cell sizes (automatic)" if spec.tip == "branch" else "")
+    )
     return [
         f"  [{spec.index}] points [{units['points']}]: {points}",
         f"      length {_with_unit(float(np.hypot(*seg.T).sum()), units['points'])}, "
         f"angle {', '.join(_fmt(float(a)) for a in angles)} deg",
         f"      {params}",
+        f"      tip: {tip}",
     ]
 
 

@@ -892,3 +892,58 @@ def test_mutated_cases_raise_only_case_error(tmp_path_factory, data):
         assert err.problems and "\n" not in str(err)
     else:
         assert describe(spec).startswith("case ")
+
+
+# --- crack-tip option (extension of case-format v1) --------------------------
+
+
+def _tip_case(tmp_path, tip_line):
+    text = f"""
+[domain]
+size = [1.0, 1.0]
+[mesh]
+elements = [4, 4]
+[material]
+E = 1.0e9
+nu = 0.25
+[[fractures]]
+points = [[0.2, 0.3], [0.7, 0.6]]
+friction = 0.2
+kn = 1.0e12
+kt = 1.0e12
+{tip_line}
+[boundary]
+bottom = {{ uy = 0.0 }}
+top = {{ uy = -0.001 }}
+"""
+    path = tmp_path / "tip.toml"
+    path.write_text(text)
+    return path
+
+
+def test_tip_defaults_to_branch_with_automatic_radius(tmp_path):
+    spec = load_case(_tip_case(tmp_path, ""))
+    assert spec.fractures[0].tip == "branch"
+    assert spec.fractures[0].tip_radius is None
+
+
+def test_tip_string_and_table_forms(tmp_path):
+    assert load_case(_tip_case(tmp_path, 'tip = "ramp"')).fractures[0].tip == "ramp"
+    spec = load_case(_tip_case(tmp_path, 'tip = { kind = "branch", radius = 0.05 }'))
+    assert spec.fractures[0].tip == "branch"
+    assert spec.fractures[0].tip_radius == 0.05
+
+
+@pytest.mark.parametrize(
+    ("line", "key", "words"),
+    [
+        ('tip = "brnch"', "fractures[0].tip", "did you mean 'branch'"),
+        ("tip = { kind = \"branch\", radius = -1.0 }", "fractures[0].tip.radius", "> 0"),
+        ("tip = { kind = \"ramp\", radius = 0.1 }", "fractures[0].tip.radius", "only used"),
+        ("tip = { knd = \"ramp\" }", "fractures[0].tip.knd", "did you mean 'kind'"),
+    ],
+)
+def test_tip_errors(tmp_path, line, key, words):
+    with pytest.raises(CaseError) as info:
+        load_case(_tip_case(tmp_path, line))
+    assert any(k == key and words in m for k, m in info.value.problems), info.value.problems
