@@ -80,7 +80,8 @@ class DofMap:
     cand_dof: np.ndarray  # (k,) int64 first dof of each candidate, -1 if dropped
 
     @property
-    def n_enriched_nodes(self) -> int:
+    def n_enriched_functions(self) -> int:
+        """Kept (node, function) enrichments, each with 2 dofs."""
         return int(np.count_nonzero(self.cand_dof >= 0))
 
 
@@ -107,13 +108,18 @@ def find_candidates(mesh, fractures) -> Candidates:
 
 def candidate_values(fractures, cand, k, pts, side, tol):
     """F (n,) and grad F (n, 2) of candidate k at points with fracture side (n,)."""
-    fr = fractures[cand.fracture[k]]
-    if cand.func[k] == HEAVISIDE:
-        R, gR = fr.ramp(pts)
-        return side * R, side[:, None] * gR
-    F, grad = branch_functions(fr.tips[cand.tip[k]], pts, side, tol)
-    j = cand.func[k] - 1
+    F, grad = _group_values(fractures, cand.fracture[k], cand.tip[k], pts, side, tol)
+    j = 0 if cand.func[k] == HEAVISIDE else cand.func[k] - 1
     return F[:, j], grad[:, j]
+
+
+def _group_values(fractures, fi, tip, pts, side, tol):
+    """All functions of one (fracture, tip) group: (n, 1) Heaviside or (n, 4) branch."""
+    fr = fractures[fi]
+    if tip < 0:
+        R, gR = fr.ramp(pts)
+        return (side * R)[:, None], (side[:, None] * gR)[:, None, :]
+    return branch_functions(fr.tips[tip], pts, side, tol)
 
 
 def _cell_lines(fr, b, tol):
@@ -179,17 +185,25 @@ def build_enriched_cells(mesh, fractures, cand: Candidates) -> EnrichedCells:
         F = np.zeros((xy.shape[0], S))
         gF = np.zeros((xy.shape[0], S, 2))
         Fv = np.zeros((tris.shape[0], 3, S))
+        cache = {}
         for s, k in enumerate(ks):
             node = cand.node[k]
+            fi, tip = int(cand.fracture[k]), int(cand.tip[k])
             slot_cand[e, s] = k
             slot_node[e, s] = int(np.nonzero(mesh.cells[c] == node)[0][0])
-            side_n = node_side[cand.fracture[k]][node:node + 1]
+            side_n = node_side[fi][node:node + 1]
             slot_fnode[e, s] = candidate_values(fractures, cand, k, mesh.nodes[node:node + 1],
                                                 side_n, tol)[0][0]
-            st = side_t[int(cand.fracture[k])]
-            F[:, s], gF[:, s] = candidate_values(fractures, cand, k, xy, np.repeat(st, per), tol)
-            Fv[:, :, s] = candidate_values(fractures, cand, k, tris.reshape(-1, 2),
-                                           np.repeat(st, 3), tol)[0].reshape(-1, 3)
+            if (fi, tip) not in cache:
+                st = side_t[fi]
+                cache[fi, tip] = (
+                    _group_values(fractures, fi, tip, xy, np.repeat(st, per), tol),
+                    _group_values(fractures, fi, tip, tris.reshape(-1, 2), np.repeat(st, 3),
+                                  tol)[0])
+            (Fq, gq), Fvert = cache[fi, tip]
+            j = 0 if cand.func[k] == HEAVISIDE else cand.func[k] - 1
+            F[:, s], gF[:, s] = Fq[:, j], gq[:, j]
+            Fv[:, :, s] = Fvert[:, j].reshape(-1, 3)
         for key, val in zip(("xy", "w", "F", "gF", "tris", "Fv"), (xy, w, F, gF, tris, Fv)):
             parts[key].append(val)
         qp_off.append(qp_off[-1] + xy.shape[0])

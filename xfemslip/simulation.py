@@ -76,9 +76,10 @@ def build_model(spec) -> Model:
     F = traction_load(mesh, spec.boundary, spec.loading, ec, cand, bulk.dofmap, fractures)
     problem = Problem(K=bulk.K, F_unit=F, fixed=bc.dofs, fixed_values=bc.values,
                       contact=contact, n_dofs=bulk.dofmap.n_dofs)
-    logger.info("model: %d x %d cells, %d fracture(s), %d dofs (%d enriched nodes), "
-                "%d contact points", mesh.nx, mesh.ny, len(fractures), bulk.dofmap.n_dofs,
-                bulk.dofmap.n_enriched_nodes, ip.n)
+    logger.info("model: %d x %d cells, %d fracture(s), %d dofs (%d nodes enriched with %d "
+                "functions), %d contact points", mesh.nx, mesh.ny, len(fractures),
+                bulk.dofmap.n_dofs, np.unique(cand.node[bulk.dofmap.cand_dof >= 0]).size,
+                bulk.dofmap.n_enriched_functions, ip.n)
     return Model(spec=spec, mesh=mesh, D=D, fractures=fractures, ec=ec, bulk=bulk, ip=ip,
                  contact=contact, problem=problem)
 
