@@ -188,21 +188,15 @@ def check(case: Path, debug: bool) -> None:
 @cli.command()
 def info() -> None:
     """Print versions and Numba settings."""
-    import numba
+    from xfemslip.kernels._config import numba_settings
 
     rows = [("xfemslip", __version__), ("python", platform.python_version())]
     rows += [
         (name, _dist_version(name))
         for name in ("numpy", "scipy", "numba", "h5py", "meshio", "click")
     ]
-    cache_dir = numba.config.CACHE_DIR or "default (__pycache__ next to the sources)"
-    rows += [
-        ("numba threading layer", str(numba.config.THREADING_LAYER)),
-        ("NUMBA_NUM_THREADS", str(numba.config.NUMBA_NUM_THREADS)),
-        ("numba cache dir", str(cache_dir)),
-        ("NUMBA_DISABLE_JIT", str(numba.config.DISABLE_JIT)),
-        ("executable", sys.executable),
-    ]
+    rows += numba_settings()
+    rows += [("executable", sys.executable)]
     width = max(len(name) for name, _ in rows)
     for name, value in rows:
         click.echo(f"{name:<{width}}  {value}")

@@ -75,13 +75,27 @@ def build_model(spec) -> Model:
     bc = dirichlet(mesh, spec.boundary)
     F = traction_load(mesh, spec.boundary, spec.loading, ec, cand, bulk.dofmap, fractures)
     problem = Problem(K=bulk.K, F_unit=F, fixed=bc.dofs, fixed_values=bc.values,
-                      contact=contact, n_dofs=bulk.dofmap.n_dofs)
+                      contact=contact, n_dofs=bulk.dofmap.n_dofs,
+                      floating=floating_parts(mesh, fractures, ip, bc))
     logger.info("model: %d x %d cells, %d fracture(s), %d dofs (%d nodes enriched with %d "
                 "functions), %d contact points", mesh.nx, mesh.ny, len(fractures),
                 bulk.dofmap.n_dofs, np.unique(cand.node[bulk.dofmap.cand_dof >= 0]).size,
                 bulk.dofmap.n_enriched_functions, ip.n)
     return Model(spec=spec, mesh=mesh, D=D, fractures=fractures, ec=ec, bulk=bulk, ip=ip,
                  contact=contact, problem=problem)
+
+
+def floating_parts(mesh, fractures, ip, bc):
+    """Fractures that cut the domain in two and leave one part without prescribed dofs."""
+    fixed_nodes = np.unique(bc.dofs // 2)
+    out = []
+    for fi, fr in enumerate(fractures):
+        if fr.tips:
+            continue
+        side = fr.side(mesh.nodes[fixed_nodes]) if fixed_nodes.size else np.zeros(0)
+        if not (np.any(side > 0) and np.any(side < 0)):
+            out.append((fr.index, ip.fracture == fi))
+    return out
 
 
 def step_fields(model: Model, r: StepResult) -> StepFields:

@@ -41,6 +41,10 @@ class Problem:
     fixed_values: np.ndarray  # their final values
     contact: ContactSet
     n_dofs: int
+    # (fracture index in the case file, mask of its contact points) for each
+    # fracture that cuts the domain in two with one part left without any
+    # prescribed displacement: that part is held by the fracture alone.
+    floating: list = None
 
 
 @dataclass
@@ -109,6 +113,7 @@ class NewtonSolver:
             if not np.isfinite(eta):
                 raise self._fail(k, it, eta, flips, "the residual is not finite")
             if eta <= self.tol:
+                self._check_floating(res, k, it, eta)
                 c.commit(res)
                 self.completed.append(StepResult(k, lam, u.copy(), res, it, residuals))
                 return u
@@ -118,6 +123,18 @@ class NewtonSolver:
             u[self.free] -= du
             pt_prev, gt_prev, prev_state = res.pt, res.gt, res.state
         raise AssertionError("unreachable")
+
+    def _check_floating(self, res, k, it, eta):
+        """A block held only by a fracture on which no point sticks slides without bound."""
+        for index, mask in self.p.floating or []:
+            if mask.any() and not np.any(res.state[mask] == STICK):
+                raise self._fail(
+                    k, it, eta, 0,
+                    f"fractures[{index}] cuts the domain in two and one part has no prescribed "
+                    "displacement, so only the fracture holds it; no point of the fracture "
+                    "sticks, so that part slides without bound (no static equilibrium). "
+                    "Prescribe a displacement on that part (e.g. on its edge) or raise the "
+                    "friction or cohesion")
 
     def _solve(self, res, r, k, it, eta):
         Kc = coo_block(self.c_dofs, res.blocks, self.free.size)
