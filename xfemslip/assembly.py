@@ -44,8 +44,9 @@ def _rect_stiffness_shared(hx, hy, D):
     """Stiffness (m, 8, 8) computed once per distinct rectangle size."""
     sizes = np.round(np.column_stack([hx, hy]), 15)
     uniq, inverse = np.unique(sizes, axis=0, return_inverse=True)
-    K_u = kernels.rectangle_stiffness(np.ascontiguousarray(uniq[:, 0]),
-                                      np.ascontiguousarray(uniq[:, 1]), D)
+    K_u = kernels.rectangle_stiffness(
+        np.ascontiguousarray(uniq[:, 0]), np.ascontiguousarray(uniq[:, 1]), D
+    )
     return K_u, inverse.ravel()
 
 
@@ -60,8 +61,16 @@ def assemble_bulk(mesh, D, cand: Candidates, ec: EnrichedCells) -> BulkSystem:
 
     if ec.cells.size:
         K_e, Bbar = kernels.enriched_cell_matrices(
-            np.ascontiguousarray(mesh.bounds[ec.cells]), ec.qp_offsets, ec.qp_xy, ec.qp_w,
-            ec.qp_F, ec.qp_gradF, ec.slot_node, ec.slot_fnode, np.ascontiguousarray(D))
+            np.ascontiguousarray(mesh.bounds[ec.cells]),
+            ec.qp_offsets,
+            ec.qp_xy,
+            ec.qp_w,
+            ec.qp_F,
+            ec.qp_gradF,
+            ec.slot_node,
+            ec.slot_fnode,
+            np.ascontiguousarray(D),
+        )
     else:
         K_e = np.zeros((0, 8, 8))
         Bbar = np.zeros((0, 3, 8))
@@ -89,10 +98,21 @@ def assemble_bulk(mesh, D, cand: Candidates, ec: EnrichedCells) -> BulkSystem:
     keep = (rows >= 0) & (cols >= 0)
     n = dofmap.n_dofs
     K = sp.coo_matrix((vals[keep], (rows[keep], cols[keep])), shape=(n, n)).tocsr()
-    logger.info("bulk: %d cells (%d enriched), %d dofs (%d enriched)", mesh.n_cells,
-                ec.cells.size, n, n - n_std)
-    return BulkSystem(K=K, dofmap=dofmap, enr_dofs=enr_dofs, enr_Bbar=Bbar,
-                      std_cells=std_cells, enriched_cells=ec.cells)
+    logger.info(
+        "bulk: %d cells (%d enriched), %d dofs (%d enriched)",
+        mesh.n_cells,
+        ec.cells.size,
+        n,
+        n - n_std,
+    )
+    return BulkSystem(
+        K=K,
+        dofmap=dofmap,
+        enr_dofs=enr_dofs,
+        enr_Bbar=Bbar,
+        std_cells=std_cells,
+        enriched_cells=ec.cells,
+    )
 
 
 def _pairs(dofs):

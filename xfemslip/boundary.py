@@ -22,7 +22,12 @@ from xfemslip.quadrature import LINE_POINTS, LINE_WEIGHTS
 
 logger = logging.getLogger(__name__)
 
-OUTWARD = {"bottom": (0.0, -1.0), "top": (0.0, 1.0), "left": (-1.0, 0.0), "right": (1.0, 0.0)}
+OUTWARD = {
+    "bottom": (0.0, -1.0),
+    "top": (0.0, 1.0),
+    "left": (-1.0, 0.0),
+    "right": (1.0, 0.0),
+}
 # Prescribed values at a corner shared by two edges may differ by this much
 # (relative to the largest prescribed magnitude) before it is an error.
 CORNER_TOL = 1.0e-9
@@ -47,19 +52,24 @@ def dirichlet(mesh, boundary) -> Dirichlet:
         nodes = mesh.edge_nodes(name)
         v = np.asarray(edge.values, dtype=float)
         if v.shape != (nodes.size, 2):
-            raise ValueError(f"boundary.{name}: values shape {v.shape} != {(nodes.size, 2)}")
+            raise ValueError(
+                f"boundary.{name}: values shape {v.shape} != {(nodes.size, 2)}"
+            )
         scale = max(scale, float(np.nanmax(np.abs(v), initial=0.0)))
         for node, row in zip(nodes, v):
             for c in range(2):
                 if np.isnan(row[c]):
                     continue
                 dof = 2 * int(node) + c
-                if dof in values and abs(values[dof] - row[c]) > CORNER_TOL * max(scale, 1e-300):
+                if dof in values and abs(values[dof] - row[c]) > CORNER_TOL * max(
+                    scale, 1e-300
+                ):
                     comp = "xy"[c]
                     raise GeometryError(
                         f"boundary.{owner[dof]} and boundary.{name} prescribe different "
                         f"u{comp} at their common corner ({mesh.nodes[node, 0]:g}, "
-                        f"{mesh.nodes[node, 1]:g}): {values[dof]:g} and {row[c]:g} m")
+                        f"{mesh.nodes[node, 1]:g}): {values[dof]:g} and {row[c]:g} m"
+                    )
                 values[dof] = float(row[c])
                 owner[dof] = name
     dofs = np.array(sorted(values), dtype=np.int64)
@@ -68,9 +78,11 @@ def dirichlet(mesh, boundary) -> Dirichlet:
     if pinned.size:
         dofs_all = np.concatenate([dofs, pinned])
         order = np.argsort(dofs_all)
-        return Dirichlet(dofs=dofs_all[order],
-                         values=np.concatenate([vals, np.zeros(pinned.size)])[order],
-                         pinned=pinned)
+        return Dirichlet(
+            dofs=dofs_all[order],
+            values=np.concatenate([vals, np.zeros(pinned.size)])[order],
+            pinned=pinned,
+        )
     return Dirichlet(dofs=dofs, values=vals, pinned=pinned)
 
 
@@ -79,8 +91,9 @@ def _rigid_modes(mesh, dofs):
     centre = mesh.nodes.mean(axis=0)
     node, comp = dofs // 2, dofs % 2
     rel = mesh.nodes[node] - centre
-    return np.column_stack([comp == 0, comp == 1,
-                            np.where(comp == 0, -rel[:, 1], rel[:, 0])]).astype(float)
+    return np.column_stack(
+        [comp == 0, comp == 1, np.where(comp == 0, -rel[:, 1], rel[:, 0])]
+    ).astype(float)
 
 
 def rigid_body_pins(mesh, fixed) -> np.ndarray:
@@ -109,8 +122,14 @@ def rigid_body_pins(mesh, fixed) -> np.ndarray:
             current.append(d)
             rank = r
             node = d // 2
-            logger.info("rigid-body mode left free by the boundary: pinned u%s = 0 at node %d "
-                        "(%g, %g)", "xy"[d % 2], node, mesh.nodes[node, 0], mesh.nodes[node, 1])
+            logger.info(
+                "rigid-body mode left free by the boundary: pinned u%s = 0 at node %d "
+                "(%g, %g)",
+                "xy"[d % 2],
+                node,
+                mesh.nodes[node, 0],
+                mesh.nodes[node, 1],
+            )
         if rank == 3:
             break
     return np.array(pins, dtype=np.int64)
@@ -138,20 +157,38 @@ def traction_load(mesh, boundary, loading, ec, cand, dofmap, fractures) -> np.nd
             continue
         t = (S @ np.array(OUTWARD[name])) * mask
         nodes = mesh.edge_nodes(name)
-        for p, q in zip(nodes[:-1], nodes[1:]):
+        cells = edge_cells(mesh, name)
+        for p, q, cell in zip(nodes[:-1], nodes[1:], cells):
             length = np.linalg.norm(mesh.nodes[q] - mesh.nodes[p])
-            F[2 * p:2 * p + 2] += 0.5 * length * t
-            F[2 * q:2 * q + 2] += 0.5 * length * t
-            cell = _cell_of_edge(mesh, p, q)
-            if cell in enr_pos:
-                _enriched_edge_load(F, mesh, cell, enr_pos[cell], p, q, t, ec, cand, dofmap,
-                                    fractures)
+            F[2 * p : 2 * p + 2] += 0.5 * length * t
+            F[2 * q : 2 * q + 2] += 0.5 * length * t
+            if int(cell) in enr_pos:
+                _enriched_edge_load(
+                    F,
+                    mesh,
+                    int(cell),
+                    enr_pos[int(cell)],
+                    p,
+                    q,
+                    t,
+                    ec,
+                    cand,
+                    dofmap,
+                    fractures,
+                )
     return F
 
 
-def _cell_of_edge(mesh, p, q):
-    both = np.nonzero(np.isin(mesh.cells, [p, q]).sum(axis=1) == 2)[0]
-    return int(both[0])
+def edge_cells(mesh, edge: str) -> np.ndarray:
+    """Cells along an edge, in the order of ``mesh.edge_nodes(edge)`` segments."""
+    nx, ny = mesh.nx, mesh.ny
+    i, j = np.arange(nx), np.arange(ny)
+    return {
+        "bottom": i,
+        "top": (ny - 1) * nx + i,
+        "left": j * nx,
+        "right": j * nx + nx - 1,
+    }[edge].astype(np.int64)
 
 
 def _enriched_edge_load(F, mesh, cell, e, p, q, t, ec, cand, dofmap, fractures):
@@ -180,10 +217,12 @@ def _enriched_edge_load(F, mesh, cell, e, p, q, t, ec, cand, dofmap, fractures):
                 if k < 0 or dofmap.cand_dof[k] < 0:
                     continue
                 fr = fractures[cand.fracture[k]]
-                Fx = candidate_values(fractures, cand, k, x[None], fr.side(mid[None]), 0.0)[0][0]
+                Fx = candidate_values(
+                    fractures, cand, k, x[None], fr.side(mid[None]), 0.0
+                )[0][0]
                 phi = N[ec.slot_node[e, slot]] * (Fx - ec.slot_fnode[e, slot])
                 d = dofmap.cand_dof[k]
-                F[d:d + 2] += 0.5 * (a1 - a0) * length * w * phi * t
+                F[d : d + 2] += 0.5 * (a1 - a0) * length * w * phi * t
 
 
 def _lines(fr):

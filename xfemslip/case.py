@@ -895,7 +895,7 @@ def _read_tip(table: _Table) -> tuple[str, float | None]:
         kind = sub.choice("kind", TIP_KINDS, "branch")
         radius = sub.number("radius", None, rule=_POSITIVE)
         if radius is not None and kind == "ramp":
-            sub.error("radius", "only used with kind = \"branch\"")
+            sub.error("radius", 'only used with kind = "branch"')
         return kind, radius
     return table.choice("tip", TIP_KINDS), None
 

@@ -72,13 +72,40 @@ class ContactSet:
         gn, gt, pn, pt, slip = (np.zeros(n) for _ in range(5))
         state = np.zeros(n, np.int8)
         kernels.contact_response(
-            np.ascontiguousarray(u, dtype=np.float64), self.dofs, self.coef, self.normal,
-            self.tangent, self.weight, self.pn0, self.slip_committed, self.kn, self.kt,
-            self.friction, self.cohesion, int(tangent_mode), pt_prev, gt_prev,
-            out_f, out_K, gn, gt, pn, pt, state, slip)
-        return ContactResult(force=scatter_vector(self.dofs, out_f, self.n_dofs),
-                             blocks=out_K, gn=gn, gt=gt, pn=pn, pt=pt, state=state,
-                             slip_plastic=slip)
+            np.ascontiguousarray(u, dtype=np.float64),
+            self.dofs,
+            self.coef,
+            self.normal,
+            self.tangent,
+            self.weight,
+            self.pn0,
+            self.slip_committed,
+            self.kn,
+            self.kt,
+            self.friction,
+            self.cohesion,
+            int(tangent_mode),
+            pt_prev,
+            gt_prev,
+            out_f,
+            out_K,
+            gn,
+            gt,
+            pn,
+            pt,
+            state,
+            slip,
+        )
+        return ContactResult(
+            force=scatter_vector(self.dofs, out_f, self.n_dofs),
+            blocks=out_K,
+            gn=gn,
+            gt=gt,
+            pn=pn,
+            pt=pt,
+            state=state,
+            slip_plastic=slip,
+        )
 
     def tangent_matrix(self, result: ContactResult):
         return coo_block(self.dofs, result.blocks, self.n_dofs)
@@ -136,8 +163,10 @@ def build_contact(mesh, fractures, ip, ec, cand, dofmap, initial_stress) -> Cont
     """
     n = ip.n
     coef, dofs = _jump_operators(mesh, fractures, ip, ec, cand, dofmap)
-    par = {name: np.array([getattr(fractures[f], name) for f in ip.fracture], dtype=float)
-           for name in ("kn", "kt", "friction", "cohesion")}
+    par = {
+        name: np.array([getattr(fractures[f], name) for f in ip.fracture], dtype=float)
+        for name in ("kn", "kt", "friction", "cohesion")
+    }
     if n == 0:
         par = {name: np.zeros(0) for name in ("kn", "kt", "friction", "cohesion")}
     pn0 = np.zeros(n)
@@ -149,12 +178,18 @@ def build_contact(mesh, fractures, ip, ec, cand, dofmap, initial_stress) -> Cont
         pn0 = np.einsum("nk,nk->n", trac, ip.normal)
         pt0 = np.einsum("nk,nk->n", trac, ip.tangent)
         slip0 = -pt0 / par["kt"]
-    cs = ContactSet(dofs=dofs, coef=coef, normal=np.ascontiguousarray(ip.normal),
-                    tangent=np.ascontiguousarray(ip.tangent), weight=ip.weight.copy(),
-                    pn0=pn0, n_dofs=dofmap.n_dofs, **par)
+    cs = ContactSet(
+        dofs=dofs,
+        coef=coef,
+        normal=np.ascontiguousarray(ip.normal),
+        tangent=np.ascontiguousarray(ip.tangent),
+        weight=ip.weight.copy(),
+        pn0=pn0,
+        n_dofs=dofmap.n_dofs,
+        **par,
+    )
     cs.slip_committed = slip0
     cs.state_committed = np.full(n, STICK, np.int8)
     cs.gt_committed = np.zeros(n)
     cs.pt_committed = -par["kt"] * slip0 if n else np.zeros(0)
     return cs
-

@@ -31,8 +31,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from xfemslip.geometry import GEOMETRY_TOL
 from xfemslip.branch import branch_functions
+from xfemslip.geometry import GEOMETRY_TOL
 from xfemslip.quadrature import cell_subtriangles, duffy_rule, triangle_rule
 
 logger = logging.getLogger(__name__)
@@ -128,7 +128,12 @@ def _cell_lines(fr, b, tol):
     lo = np.minimum(fr.points[:-1], fr.points[1:]) - tol
     hi = np.maximum(fr.points[:-1], fr.points[1:]) + tol
     for k in range(fr.normal.shape[0]):
-        if lo[k, 0] <= b[1] and hi[k, 0] >= b[0] and lo[k, 1] <= b[3] and hi[k, 1] >= b[2]:
+        if (
+            lo[k, 0] <= b[1]
+            and hi[k, 0] >= b[0]
+            and lo[k, 1] <= b[3]
+            and hi[k, 1] >= b[2]
+        ):
             out.append((fr.points[k], fr.normal[k]))
     diag = np.hypot(b[1] - b[0], b[3] - b[2])
     centre = np.array([0.5 * (b[0] + b[1]), 0.5 * (b[2] + b[3])])
@@ -141,7 +146,9 @@ def _cell_lines(fr, b, tol):
 
 def _node_side(fractures, mesh, tol):
     """H at the nodes per fracture: a node on the fracture takes +1 (eq. 12)."""
-    return [np.where(fr.signed_distance(mesh.nodes) >= -tol, 1.0, -1.0) for fr in fractures]
+    return [
+        np.where(fr.signed_distance(mesh.nodes) >= -tol, 1.0, -1.0) for fr in fractures
+    ]
 
 
 def _cell_rule(mesh, c, fractures, frs, has_branch, tol):
@@ -191,20 +198,25 @@ def build_enriched_cells(mesh, fractures, cand: Candidates) -> EnrichedCells:
             fi, tip = int(cand.fracture[k]), int(cand.tip[k])
             slot_cand[e, s] = k
             slot_node[e, s] = int(np.nonzero(mesh.cells[c] == node)[0][0])
-            side_n = node_side[fi][node:node + 1]
-            slot_fnode[e, s] = candidate_values(fractures, cand, k, mesh.nodes[node:node + 1],
-                                                side_n, tol)[0][0]
+            side_n = node_side[fi][node : node + 1]
+            slot_fnode[e, s] = candidate_values(
+                fractures, cand, k, mesh.nodes[node : node + 1], side_n, tol
+            )[0][0]
             if (fi, tip) not in cache:
                 st = side_t[fi]
                 cache[fi, tip] = (
                     _group_values(fractures, fi, tip, xy, np.repeat(st, per), tol),
-                    _group_values(fractures, fi, tip, tris.reshape(-1, 2), np.repeat(st, 3),
-                                  tol)[0])
+                    _group_values(
+                        fractures, fi, tip, tris.reshape(-1, 2), np.repeat(st, 3), tol
+                    )[0],
+                )
             (Fq, gq), Fvert = cache[fi, tip]
             j = 0 if cand.func[k] == HEAVISIDE else cand.func[k] - 1
             F[:, s], gF[:, s] = Fq[:, j], gq[:, j]
             Fv[:, :, s] = Fvert[:, j].reshape(-1, 3)
-        for key, val in zip(("xy", "w", "F", "gF", "tris", "Fv"), (xy, w, F, gF, tris, Fv)):
+        for key, val in zip(
+            ("xy", "w", "F", "gF", "tris", "Fv"), (xy, w, F, gF, tris, Fv)
+        ):
             parts[key].append(val)
         qp_off.append(qp_off[-1] + xy.shape[0])
         tri_off.append(tri_off[-1] + tris.shape[0])
@@ -214,11 +226,19 @@ def build_enriched_cells(mesh, fractures, cand: Candidates) -> EnrichedCells:
         return np.ascontiguousarray(np.concatenate(p)) if p else np.zeros(shape)
 
     return EnrichedCells(
-        cells=cand_cells, slot_cand=slot_cand, slot_node=slot_node, slot_fnode=slot_fnode,
-        qp_offsets=np.array(qp_off, np.int64), qp_xy=cat("xy", (0, 2)), qp_w=cat("w", (0,)),
-        qp_F=cat("F", (0, S)), qp_gradF=cat("gF", (0, S, 2)),
-        tri_offsets=np.array(tri_off, np.int64), tris=cat("tris", (0, 3, 2)),
-        tri_F=cat("Fv", (0, 3, S)))
+        cells=cand_cells,
+        slot_cand=slot_cand,
+        slot_node=slot_node,
+        slot_fnode=slot_fnode,
+        qp_offsets=np.array(qp_off, np.int64),
+        qp_xy=cat("xy", (0, 2)),
+        qp_w=cat("w", (0,)),
+        qp_F=cat("F", (0, S)),
+        qp_gradF=cat("gF", (0, S, 2)),
+        tri_offsets=np.array(tri_off, np.int64),
+        tris=cat("tris", (0, 3, 2)),
+        tri_F=cat("Fv", (0, 3, S)),
+    )
 
 
 def _node_cells(mesh):
@@ -227,11 +247,12 @@ def _node_cells(mesh):
     nodes_sorted = mesh.cells.ravel()[order]
     cells_sorted = order // 4
     split = np.searchsorted(nodes_sorted, np.arange(mesh.n_nodes + 1))
-    return [cells_sorted[split[i]:split[i + 1]] for i in range(mesh.n_nodes)]
+    return [cells_sorted[split[i] : split[i + 1]] for i in range(mesh.n_nodes)]
 
 
-def select_enrichment(mesh, cand: Candidates, ec: EnrichedCells, K_enr: np.ndarray,
-                      std_diag: np.ndarray) -> DofMap:
+def select_enrichment(
+    mesh, cand: Candidates, ec: EnrichedCells, K_enr: np.ndarray, std_diag: np.ndarray
+) -> DofMap:
     """Apply the sliver rule and number the kept enriched dofs.
 
     K_enr : (nc, 8+2S, 8+2S) enriched-cell stiffness with every candidate slot.
@@ -244,15 +265,22 @@ def select_enrichment(mesh, cand: Candidates, ec: EnrichedCells, K_enr: np.ndarr
     for s in range(S):
         m = ec.slot_cand[:, s] >= 0
         for comp in range(2):
-            np.add.at(diag[:, comp], ec.slot_cand[m, s], K_enr[m, 8 + 2 * s + comp,
-                                                          8 + 2 * s + comp])
+            np.add.at(
+                diag[:, comp],
+                ec.slot_cand[m, s],
+                K_enr[m, 8 + 2 * s + comp, 8 + 2 * s + comp],
+            )
     ref = np.stack([std_diag[2 * cand.node], std_diag[2 * cand.node + 1]], axis=1)
     ratio = (diag / ref).min(axis=1) if k else np.zeros(0)
     keep = ratio >= ENRICHMENT_DIAG_RATIO
     cand_dof = -np.ones(k, np.int64)
     cand_dof[keep] = n_std + 2 * np.arange(np.count_nonzero(keep))
     if k and not keep.all():
-        logger.info("enrichment: dropped %d of %d node enrichments whose support the fracture "
-                    "cuts into a sliver (stiffness ratio < %.0e)", k - keep.sum(), k,
-                    ENRICHMENT_DIAG_RATIO)
+        logger.info(
+            "enrichment: dropped %d of %d node enrichments whose support the fracture "
+            "cuts into a sliver (stiffness ratio < %.0e)",
+            k - keep.sum(),
+            k,
+            ENRICHMENT_DIAG_RATIO,
+        )
     return DofMap(n_std=n_std, n_dofs=n_std + 2 * int(keep.sum()), cand_dof=cand_dof)

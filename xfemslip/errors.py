@@ -50,8 +50,9 @@ class ConvergenceError(XfemslipError):
     the last iteration).
     """
 
-    def __init__(self, message, *, step, iteration, residual, increment=float("nan"),
-                 flips=0):
+    def __init__(
+        self, message, *, step, iteration, residual, increment=float("nan"), flips=0
+    ):
         self.step = step
         self.iteration = iteration
         self.residual = residual

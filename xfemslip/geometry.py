@@ -48,7 +48,9 @@ class Fracture:
     tangent: np.ndarray  # (k-1, 2) unit segment tangents
     normal: np.ndarray  # (k-1, 2) unit segment normals, n = (-t_y, t_x)
     length: np.ndarray  # (k-1,) segment lengths [m]
-    s_start: np.ndarray  # (k-1,) arc length at each segment's start, from the case file's first point [m]
+    s_start: (
+        np.ndarray
+    )  # (k-1,) arc length at each segment's start, from the case file's first point [m]
     tips: tuple[Tip, ...]
     piece_cell: np.ndarray  # (p,) int64: cell holding each piece
     piece_seg: np.ndarray  # (p,) int64: segment of each piece
@@ -66,7 +68,9 @@ class Fracture:
         a = self.points[:-1]
         d = self.points[1:] - a
         rel = pts[:, None, :] - a[None, :, :]
-        t = np.clip(np.einsum("nmk,mk->nm", rel, d) / (self.length**2)[None, :], 0.0, 1.0)
+        t = np.clip(
+            np.einsum("nmk,mk->nm", rel, d) / (self.length**2)[None, :], 0.0, 1.0
+        )
         diff = rel - t[..., None] * d[None, :, :]
         dist = np.linalg.norm(diff, axis=2)
         j = np.argmin(dist, axis=1)
@@ -157,10 +161,13 @@ def _clip_to_domain(points, box, tol, key):
     if not idx:
         raise GeometryError(f"{key}: the fracture misses the domain")
     if idx != list(range(idx[0], idx[-1] + 1)) or any(
-        (kept[k][3] < 1.0 and k != idx[-1]) or (kept[k][2] > 0.0 and k != idx[0]) for k in idx
+        (kept[k][3] < 1.0 and k != idx[-1]) or (kept[k][2] > 0.0 and k != idx[0])
+        for k in idx
     ):
-        raise GeometryError(f"{key}: the fracture leaves and re-enters the domain; "
-                            "split it into separate fractures")
+        raise GeometryError(
+            f"{key}: the fracture leaves and re-enters the domain; "
+            "split it into separate fractures"
+        )
     pts = [kept[idx[0]][0]] + [kept[k][1] for k in idx]
     pts = np.array(pts)
     seg_len = np.linalg.norm(np.diff(points, axis=0), axis=1)
@@ -171,8 +178,15 @@ def _clip_to_domain(points, box, tol, key):
 
 
 def _on_boundary(p, box, tol):
-    return min(abs(p[0] - box[0]), abs(p[0] - box[1]), abs(p[1] - box[2]),
-               abs(p[1] - box[3])) <= tol
+    return (
+        min(
+            abs(p[0] - box[0]),
+            abs(p[0] - box[1]),
+            abs(p[1] - box[2]),
+            abs(p[1] - box[3]),
+        )
+        <= tol
+    )
 
 
 def _cell_pieces(mesh, points, tol):
@@ -200,8 +214,11 @@ def _cell_pieces(mesh, points, tol):
             segs.append(k)
             tas.append(a)
             tbs.append(b)
-    return (np.array(cells, dtype=np.int64), np.array(segs, dtype=np.int64),
-            np.column_stack([tas, tbs]) if tas else np.zeros((0, 2)))
+    return (
+        np.array(cells, dtype=np.int64),
+        np.array(segs, dtype=np.int64),
+        np.column_stack([tas, tbs]) if tas else np.zeros((0, 2)),
+    )
 
 
 def build_fracture(mesh, spec, box) -> Fracture:
@@ -211,7 +228,9 @@ def build_fracture(mesh, spec, box) -> Fracture:
     raw = np.asarray(spec.points, dtype=float)
     pts, s_offset = _clip_to_domain(raw, box, tol, key)
     if pts.shape[0] < 2:
-        raise GeometryError(f"{key}: less than {tol:.1e} m of the fracture lies in the domain")
+        raise GeometryError(
+            f"{key}: less than {tol:.1e} m of the fracture lies in the domain"
+        )
     d = np.diff(pts, axis=0)
     length = np.linalg.norm(d, axis=1)
     tangent = d / length[:, None]
@@ -229,36 +248,73 @@ def build_fracture(mesh, spec, box) -> Fracture:
         k = 0 if end == 0 else -1
         ramp = (piece_t[k, 1] - piece_t[k, 0]) * length[piece_seg[k]]
         b = mesh.bounds[piece_cell[k]]
-        tips.append(Tip(point=p.copy(), direction=direction, end=end, ramp_length=float(ramp),
-                        cell_size=float(max(b[1] - b[0], b[3] - b[2])),
-                        sign=1.0 if end == 1 else -1.0))
+        tips.append(
+            Tip(
+                point=p.copy(),
+                direction=direction,
+                end=end,
+                ramp_length=float(ramp),
+                cell_size=float(max(b[1] - b[0], b[3] - b[2])),
+                sign=1.0 if end == 1 else -1.0,
+            )
+        )
     tip_mode = getattr(spec, "tip", None) or DEFAULT_TIP
     radius = getattr(spec, "tip_radius", None)
     if radius is None:
         radius = TIP_RADIUS_CELLS * max((t.cell_size for t in tips), default=0.0)
-    frac = Fracture(index=spec.index, points=pts, tangent=tangent, normal=normal,
-                    length=length, s_start=s_start, tips=tuple(tips), piece_cell=piece_cell,
-                    piece_seg=piece_seg, piece_t=piece_t, friction=spec.friction,
-                    cohesion=spec.cohesion, kn=spec.kn, kt=spec.kt,
-                    tip_mode=tip_mode, tip_radius=float(radius))
-    logger.debug("%s: %d segment(s), %d tip(s), %d cut cells", key, length.size, len(tips),
-                 len(np.unique(piece_cell)))
+    frac = Fracture(
+        index=spec.index,
+        points=pts,
+        tangent=tangent,
+        normal=normal,
+        length=length,
+        s_start=s_start,
+        tips=tuple(tips),
+        piece_cell=piece_cell,
+        piece_seg=piece_seg,
+        piece_t=piece_t,
+        friction=spec.friction,
+        cohesion=spec.cohesion,
+        kn=spec.kn,
+        kt=spec.kt,
+        tip_mode=tip_mode,
+        tip_radius=float(radius),
+    )
+    logger.debug(
+        "%s: %d segment(s), %d tip(s), %d cut cells",
+        key,
+        length.size,
+        len(tips),
+        len(np.unique(piece_cell)),
+    )
     return frac
 
 
 def _segments_cross(a0, a1, b0, b1):
     """True if closed segments a and b intersect."""
+
     def orient(p, q, r):
         return (q[0] - p[0]) * (r[1] - p[1]) - (q[1] - p[1]) * (r[0] - p[0])
+
     o1, o2 = orient(a0, a1, b0), orient(a0, a1, b1)
     o3, o4 = orient(b0, b1, a0), orient(b0, b1, a1)
     if o1 * o2 < 0 and o3 * o4 < 0:
         return True
+
     def on(p, q, r):
-        return (min(p[0], q[0]) <= r[0] <= max(p[0], q[0])
-                and min(p[1], q[1]) <= r[1] <= max(p[1], q[1]))
-    return any(o == 0 and on(p, q, r) for o, p, q, r in
-               ((o1, a0, a1, b0), (o2, a0, a1, b1), (o3, b0, b1, a0), (o4, b0, b1, a1)))
+        return min(p[0], q[0]) <= r[0] <= max(p[0], q[0]) and min(p[1], q[1]) <= r[
+            1
+        ] <= max(p[1], q[1])
+
+    return any(
+        o == 0 and on(p, q, r)
+        for o, p, q, r in (
+            (o1, a0, a1, b0),
+            (o2, a0, a1, b1),
+            (o3, b0, b1, a0),
+            (o4, b0, b1, a1),
+        )
+    )
 
 
 def build_fractures(mesh, specs, box) -> tuple[Fracture, ...]:
@@ -273,5 +329,6 @@ def build_fractures(mesh, specs, box) -> tuple[Fracture, ...]:
                         raise GeometryError(
                             f"fractures[{fracs[a].index}] and fractures[{fracs[b].index}] "
                             "intersect: intersecting fractures (networks) are not supported "
-                            "yet; move one so they do not touch")
+                            "yet; move one so they do not touch"
+                        )
     return fracs

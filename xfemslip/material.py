@@ -7,17 +7,26 @@ from typing import NamedTuple
 import numpy as np
 
 
-def elasticity_matrix(young_modulus: float, poisson_ratio: float, model: str) -> np.ndarray:
+def elasticity_matrix(
+    young_modulus: float, poisson_ratio: float, model: str
+) -> np.ndarray:
     """D (3, 3) [Pa] in Voigt order [xx, yy, xy(engineering shear)]."""
     E, nu = young_modulus, poisson_ratio
     if model == "plane_stress":  # eq. 24
         c = E / (1.0 - nu**2)
-        return c * np.array([[1.0, nu, 0.0], [nu, 1.0, 0.0], [0.0, 0.0, (1.0 - nu) / 2.0]])
+        return c * np.array(
+            [[1.0, nu, 0.0], [nu, 1.0, 0.0], [0.0, 0.0, (1.0 - nu) / 2.0]]
+        )
     if model == "plane_strain":  # eq. 25
         c = E * (1.0 - nu) / ((1.0 + nu) * (1.0 - 2.0 * nu))
         r = nu / (1.0 - nu)
-        return c * np.array([[1.0, r, 0.0], [r, 1.0, 0.0],
-                             [0.0, 0.0, (1.0 - 2.0 * nu) / (2.0 * (1.0 - nu))]])
+        return c * np.array(
+            [
+                [1.0, r, 0.0],
+                [r, 1.0, 0.0],
+                [0.0, 0.0, (1.0 - 2.0 * nu) / (2.0 * (1.0 - nu))],
+            ]
+        )
     raise ValueError(f"unknown model {model!r}")
 
 

@@ -48,8 +48,12 @@ class Mesh:
         """Node ids on an edge, ordered by increasing coordinate along it."""
         nx, ny = self.nx, self.ny
         ids = np.arange(self.n_nodes).reshape(ny + 1, nx + 1)
-        return {"bottom": ids[0, :], "top": ids[-1, :], "left": ids[:, 0],
-                "right": ids[:, -1]}[edge].copy()
+        return {
+            "bottom": ids[0, :],
+            "top": ids[-1, :],
+            "left": ids[:, 0],
+            "right": ids[:, -1],
+        }[edge].copy()
 
     def cell_of(self, i: np.ndarray, j: np.ndarray) -> np.ndarray:
         return j * self.nx + i

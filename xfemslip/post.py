@@ -33,7 +33,7 @@ def cell_strain(mesh, bulk, u) -> np.ndarray:
     c = bulk.std_cells
     b = mesh.bounds[c]
     hx, hy = b[:, 1] - b[:, 0], b[:, 3] - b[:, 2]
-    U = u[:2 * mesh.n_nodes].reshape(-1, 2)[mesh.cells[c]]  # (ns, 4, 2)
+    U = u[: 2 * mesh.n_nodes].reshape(-1, 2)[mesh.cells[c]]  # (ns, 4, 2)
     xa = np.array([-1.0, 1.0, 1.0, -1.0])
     ya = np.array([-1.0, -1.0, 1.0, 1.0])
     dNdx = xa[None, :] / (2.0 * hx[:, None])  # gradient at the centre = cell average
@@ -52,7 +52,11 @@ def bulk_fields(mesh, bulk, D, u, initial_stress, nu, model):
     stress = cell_strain(mesh, bulk, u) @ D.T
     if initial_stress is not None:
         stress = stress + np.asarray(initial_stress, float)[None, :]
-    szz = nu * (stress[:, 0] + stress[:, 1]) if model == "plane_strain" else np.zeros(len(stress))
+    szz = (
+        nu * (stress[:, 0] + stress[:, 1])
+        if model == "plane_strain"
+        else np.zeros(len(stress))
+    )
     centre = 0.5 * (stress[:, 0] + stress[:, 1])
     radius = np.hypot(0.5 * (stress[:, 0] - stress[:, 1]), stress[:, 2])
     principal = np.column_stack([centre + radius, centre - radius])
@@ -65,10 +69,17 @@ def fracture_fields(ip, res, n_fractures) -> list[FractureFields]:
     for fi in range(n_fractures):
         m = np.nonzero(ip.fracture == fi)[0]
         m = m[np.argsort(ip.s[m], kind="stable")]
-        out.append(FractureFields(
-            s=ip.s[m].copy(), points=ip.xy[m].copy(), slip=res.gt[m].copy(),
-            opening=res.gn[m].copy(), normal_traction=res.pn[m].copy(),
-            shear_traction=res.pt[m].copy(), state=res.state[m].astype(np.int8)))
+        out.append(
+            FractureFields(
+                s=ip.s[m].copy(),
+                points=ip.xy[m].copy(),
+                slip=res.gt[m].copy(),
+                opening=res.gn[m].copy(),
+                normal_traction=res.pn[m].copy(),
+                shear_traction=res.pt[m].copy(),
+                state=res.state[m].astype(np.int8),
+            )
+        )
     return out
 
 
@@ -82,10 +93,17 @@ def vis_mesh(mesh, ec, bulk, u) -> VisMesh:
     quad_cell = np.nonzero(~is_enr)[0]
     nt = ec.tris.shape[0]
     if nt == 0:
-        return VisMesh(points=mesh.nodes.copy(), displacement=U.copy(), quads=quads,
-                       quad_cell=quad_cell, triangles=np.zeros((0, 3), np.int64),
-                       triangle_cell=np.zeros(0, np.int64))
-    tri_owner = np.repeat(np.arange(ec.cells.size), np.diff(ec.tri_offsets))  # enriched index
+        return VisMesh(
+            points=mesh.nodes.copy(),
+            displacement=U.copy(),
+            quads=quads,
+            quad_cell=quad_cell,
+            triangles=np.zeros((0, 3), np.int64),
+            triangle_cell=np.zeros(0, np.int64),
+        )
+    tri_owner = np.repeat(
+        np.arange(ec.cells.size), np.diff(ec.tri_offsets)
+    )  # enriched index
     cell = ec.cells[tri_owner]
     pts = ec.tris.reshape(-1, 2)
     owner_v = np.repeat(tri_owner, 3)
@@ -97,12 +115,23 @@ def vis_mesh(mesh, ec, bulk, u) -> VisMesh:
         a = ec.slot_node[owner_v, s]
         d = dofs[:, 8 + 2 * s]
         ok = (a >= 0) & (d >= 0)
-        phi = np.where(ok, N[np.arange(len(a)), np.maximum(a, 0)]
-                       * (Fv[:, s] - ec.slot_fnode[owner_v, s]), 0.0)
-        amp = np.where(ok[:, None], u[np.stack([np.maximum(d, 0), np.maximum(d, 0) + 1], 1)], 0.0)
+        phi = np.where(
+            ok,
+            N[np.arange(len(a)), np.maximum(a, 0)]
+            * (Fv[:, s] - ec.slot_fnode[owner_v, s]),
+            0.0,
+        )
+        amp = np.where(
+            ok[:, None], u[np.stack([np.maximum(d, 0), np.maximum(d, 0) + 1], 1)], 0.0
+        )
         disp += phi[:, None] * amp
     base = mesh.n_nodes
     triangles = base + np.arange(3 * nt, dtype=np.int64).reshape(nt, 3)
-    return VisMesh(points=np.vstack([mesh.nodes, pts]), displacement=np.vstack([U, disp]),
-                   quads=quads, quad_cell=quad_cell, triangles=triangles,
-                   triangle_cell=cell.astype(np.int64))
+    return VisMesh(
+        points=np.vstack([mesh.nodes, pts]),
+        displacement=np.vstack([U, disp]),
+        quads=quads,
+        quad_cell=quad_cell,
+        triangles=triangles,
+        triangle_cell=cell.astype(np.int64),
+    )

@@ -18,11 +18,17 @@ import numpy as np
 # Dunavant (1985) degree-5 rule on the reference triangle: barycentric points, weights (sum 1).
 _A1, _B1 = 0.059715871789770, 0.470142064105115
 _A2, _B2 = 0.797426985353087, 0.101286507323456
-TRI_BARY = np.array([
-    [1 / 3, 1 / 3, 1 / 3],
-    [_A1, _B1, _B1], [_B1, _A1, _B1], [_B1, _B1, _A1],
-    [_A2, _B2, _B2], [_B2, _A2, _B2], [_B2, _B2, _A2],
-])
+TRI_BARY = np.array(
+    [
+        [1 / 3, 1 / 3, 1 / 3],
+        [_A1, _B1, _B1],
+        [_B1, _A1, _B1],
+        [_B1, _B1, _A1],
+        [_A2, _B2, _B2],
+        [_B2, _A2, _B2],
+        [_B2, _B2, _A2],
+    ]
+)
 TRI_W = np.array([0.225] + [0.132394152788506] * 3 + [0.125939180544827] * 3)
 
 # Gauss-Legendre points per fracture piece: exact for the degree-6 penalty
@@ -63,7 +69,9 @@ def polygon_area(poly: np.ndarray) -> float:
 
 def fan_triangles(poly: np.ndarray, min_area: float) -> np.ndarray:
     """Triangles (t, 3, 2) of a convex polygon, dropping degenerate ones."""
-    tris = np.array([[poly[0], poly[i], poly[i + 1]] for i in range(1, poly.shape[0] - 1)])
+    tris = np.array(
+        [[poly[0], poly[i], poly[i + 1]] for i in range(1, poly.shape[0] - 1)]
+    )
     if tris.size == 0:
         return np.zeros((0, 3, 2))
     e1 = tris[:, 1] - tris[:, 0]
@@ -81,7 +89,9 @@ def cell_subtriangles(bounds: np.ndarray, lines, tol: float, apexes=()) -> np.nd
     x0, x1, y0, y1 = bounds
     polys = [np.array([[x0, y0], [x1, y0], [x1, y1], [x0, y1]])]
     for point, normal in lines:
-        polys = [piece for poly in polys for piece in split_polygon(poly, point, normal, tol)]
+        polys = [
+            piece for poly in polys for piece in split_polygon(poly, point, normal, tol)
+        ]
     for i, poly in enumerate(polys):
         for apex in apexes:
             dist = np.linalg.norm(poly - apex, axis=1)
@@ -110,8 +120,9 @@ def duffy_rule(tris: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     area = 0.5 * np.abs(e1[:, 0] * e2[:, 1] - e1[:, 1] * e2[:, 0])
     u = _DU.ravel()
     v = _DV.ravel()
-    xy = (v0[:, None, :] + u[None, :, None]
-          * ((v1 - v0)[:, None, :] + v[None, :, None] * (v2 - v1)[:, None, :]))
+    xy = v0[:, None, :] + u[None, :, None] * (
+        (v1 - v0)[:, None, :] + v[None, :, None] * (v2 - v1)[:, None, :]
+    )
     w = 2.0 * area[:, None] * (u * _DW.ravel())[None, :]
     return xy.reshape(-1, 2), w.reshape(-1)
 
@@ -146,7 +157,9 @@ class InterfacePoints:
 
 def interface_points(fractures) -> InterfacePoints:
     """Gauss points on every piece of every fracture, split at the ramp kinks."""
-    cols = {k: [] for k in ("fracture", "cell", "xy", "s", "weight", "normal", "tangent")}
+    cols = {
+        k: [] for k in ("fracture", "cell", "xy", "s", "weight", "normal", "tangent")
+    }
     for fi, fr in enumerate(fractures):
         for cell, seg, (ta, tb) in zip(fr.piece_cell, fr.piece_seg, fr.piece_t):
             p0 = fr.points[seg]
@@ -170,14 +183,28 @@ def interface_points(fractures) -> InterfacePoints:
                 cols["tangent"].append(np.tile(fr.tangent[seg], (t.size, 1)))
     if not cols["fracture"]:
         empty2 = np.zeros((0, 2))
-        return InterfacePoints(np.zeros(0, np.int64), np.zeros(0, np.int64), empty2,
-                               np.zeros(0), np.zeros(0), empty2, empty2, np.zeros(0))
+        return InterfacePoints(
+            np.zeros(0, np.int64),
+            np.zeros(0, np.int64),
+            empty2,
+            np.zeros(0),
+            np.zeros(0),
+            empty2,
+            empty2,
+            np.zeros(0),
+        )
     arr = {k: np.concatenate(v) for k, v in cols.items()}
     ramp = np.empty(arr["s"].size)
     for fi, fr in enumerate(fractures):
         m = arr["fracture"] == fi
         ramp[m] = fr.ramp(arr["xy"][m])[0]
-    return InterfacePoints(fracture=arr["fracture"].astype(np.int64),
-                           cell=arr["cell"].astype(np.int64), xy=arr["xy"], s=arr["s"],
-                           weight=arr["weight"], normal=arr["normal"], tangent=arr["tangent"],
-                           ramp=ramp)
+    return InterfacePoints(
+        fracture=arr["fracture"].astype(np.int64),
+        cell=arr["cell"].astype(np.int64),
+        xy=arr["xy"],
+        s=arr["s"],
+        weight=arr["weight"],
+        normal=arr["normal"],
+        tangent=arr["tangent"],
+        ramp=ramp,
+    )

@@ -70,19 +70,44 @@ def build_model(spec) -> Model:
     ec = build_enriched_cells(mesh, fractures, cand)
     bulk = assemble_bulk(mesh, D, cand, ec)
     ip = interface_points(fractures)
-    contact = build_contact(mesh, fractures, ip, ec, cand, bulk.dofmap,
-                            spec.loading.initial_stress)
+    contact = build_contact(
+        mesh, fractures, ip, ec, cand, bulk.dofmap, spec.loading.initial_stress
+    )
     bc = dirichlet(mesh, spec.boundary)
-    F = traction_load(mesh, spec.boundary, spec.loading, ec, cand, bulk.dofmap, fractures)
-    problem = Problem(K=bulk.K, F_unit=F, fixed=bc.dofs, fixed_values=bc.values,
-                      contact=contact, n_dofs=bulk.dofmap.n_dofs,
-                      floating=floating_parts(mesh, fractures, ip, bc))
-    logger.info("model: %d x %d cells, %d fracture(s), %d dofs (%d nodes enriched with %d "
-                "functions), %d contact points", mesh.nx, mesh.ny, len(fractures),
-                bulk.dofmap.n_dofs, np.unique(cand.node[bulk.dofmap.cand_dof >= 0]).size,
-                bulk.dofmap.n_enriched_functions, ip.n)
-    return Model(spec=spec, mesh=mesh, D=D, fractures=fractures, ec=ec, bulk=bulk, ip=ip,
-                 contact=contact, problem=problem)
+    F = traction_load(
+        mesh, spec.boundary, spec.loading, ec, cand, bulk.dofmap, fractures
+    )
+    problem = Problem(
+        K=bulk.K,
+        F_unit=F,
+        fixed=bc.dofs,
+        fixed_values=bc.values,
+        contact=contact,
+        n_dofs=bulk.dofmap.n_dofs,
+        floating=floating_parts(mesh, fractures, ip, bc),
+    )
+    logger.info(
+        "model: %d x %d cells, %d fracture(s), %d dofs (%d nodes enriched with %d "
+        "functions), %d contact points",
+        mesh.nx,
+        mesh.ny,
+        len(fractures),
+        bulk.dofmap.n_dofs,
+        np.unique(cand.node[bulk.dofmap.cand_dof >= 0]).size,
+        bulk.dofmap.n_enriched_functions,
+        ip.n,
+    )
+    return Model(
+        spec=spec,
+        mesh=mesh,
+        D=D,
+        fractures=fractures,
+        ec=ec,
+        bulk=bulk,
+        ip=ip,
+        contact=contact,
+        problem=problem,
+    )
 
 
 def floating_parts(mesh, fractures, ip, bc):
@@ -100,26 +125,42 @@ def floating_parts(mesh, fractures, ip, bc):
 
 def step_fields(model: Model, r: StepResult) -> StepFields:
     spec = model.spec
-    stress, szz, principal = bulk_fields(model.mesh, model.bulk, model.D, r.u,
-                                         spec.loading.initial_stress, spec.material.nu,
-                                         spec.material.model)
+    stress, szz, principal = bulk_fields(
+        model.mesh,
+        model.bulk,
+        model.D,
+        r.u,
+        spec.loading.initial_stress,
+        spec.material.nu,
+        spec.material.model,
+    )
     n_std = 2 * model.mesh.n_nodes
-    return StepFields(step=r.step, load_factor=r.load_factor, newton_iterations=r.iterations,
-                      displacement=r.u[:n_std].reshape(-1, 2).copy(), stress=stress,
-                      stress_zz=szz, principal_stress=principal,
-                      fractures=fracture_fields(model.ip, r.contact, len(model.fractures)))
+    return StepFields(
+        step=r.step,
+        load_factor=r.load_factor,
+        newton_iterations=r.iterations,
+        displacement=r.u[:n_std].reshape(-1, 2).copy(),
+        stress=stress,
+        stress_zz=szz,
+        principal_stress=principal,
+        fractures=fracture_fields(model.ip, r.contact, len(model.fractures)),
+    )
 
 
 def _check_out_dir(out_dir: Path, overwrite: bool) -> None:
     existing = [name for name in OUTPUT_FILES if (out_dir / name).exists()]
     if existing and not overwrite:
-        raise UsageError(f"{out_dir} already holds {', '.join(existing)}; "
-                         "use --overwrite to replace it or -o to choose another directory")
+        raise UsageError(
+            f"{out_dir} already holds {', '.join(existing)}; "
+            "use --overwrite to replace it or -o to choose another directory"
+        )
     if out_dir.exists() and not out_dir.is_dir():
         raise UsageError(f"{out_dir} exists and is not a directory")
 
 
-def run_case(spec, out_dir: Path | None = None, *, overwrite: bool = False) -> RunSummary:
+def run_case(
+    spec, out_dir: Path | None = None, *, overwrite: bool = False
+) -> RunSummary:
     """Solve a case and write its output; returns a summary.
 
     Raises ConvergenceError (after writing the converged steps) when a load
@@ -129,8 +170,12 @@ def run_case(spec, out_dir: Path | None = None, *, overwrite: bool = False) -> R
     out_dir = Path(out_dir) if out_dir is not None else Path(spec.output.directory)
     _check_out_dir(out_dir, overwrite)
     model = build_model(spec)
-    solver = NewtonSolver(model.problem, spec.solver.tolerance, spec.solver.max_iterations,
-                          spec.solver.tangent)
+    solver = NewtonSolver(
+        model.problem,
+        spec.solver.tolerance,
+        spec.solver.max_iterations,
+        spec.solver.tangent,
+    )
     failure = None
     try:
         solver.run(spec.loading.steps)
@@ -139,15 +184,21 @@ def run_case(spec, out_dir: Path | None = None, *, overwrite: bool = False) -> R
     results = solver.completed
     iters = [r.iterations for r in results]
     wall = time.perf_counter() - start
-    write_output(model, results, out_dir, converged=failure is None, wall=wall,
-                 iterations=iters)
+    write_output(
+        model, results, out_dir, converged=failure is None, wall=wall, iterations=iters
+    )
     if failure is not None:
         raise failure
     logger.info("Newton iterations per load step: %s", iters)
-    return RunSummary(out_dir=out_dir, converged=True, load_steps=spec.loading.steps,
-                      newton_iterations=int(sum(iters)), iterations_per_step=iters,
-                      wall_time_s=time.perf_counter() - start,
-                      n_dofs=model.problem.n_dofs)
+    return RunSummary(
+        out_dir=out_dir,
+        converged=True,
+        load_steps=spec.loading.steps,
+        newton_iterations=int(sum(iters)),
+        iterations_per_step=iters,
+        wall_time_s=time.perf_counter() - start,
+        n_dofs=model.problem.n_dofs,
+    )
 
 
 def write_output(model: Model, results, out_dir: Path, *, converged, wall, iterations):
@@ -158,18 +209,31 @@ def write_output(model: Model, results, out_dir: Path, *, converged, wall, itera
     try:
         out_dir.mkdir(parents=True, exist_ok=True)
     except OSError as exc:
-        raise OutputError(f"cannot create output directory {out_dir}: {exc.strerror}") from None
+        raise OutputError(
+            f"cannot create output directory {out_dir}: {exc.strerror}"
+        ) from None
     fields = [step_fields(model, r) for r in results]
     attrs = {
-        "format_version": 1, "xfemslip_version": __version__, "case_toml": spec.text,
-        "converged": bool(converged), "load_steps": int(spec.loading.steps),
+        "format_version": 1,
+        "xfemslip_version": __version__,
+        "case_toml": spec.text,
+        "converged": bool(converged),
+        "load_steps": int(spec.loading.steps),
         "newton_iterations": int(sum(iterations)),
         "newton_iterations_per_step": np.array(iterations, dtype=np.int64),
-        "wall_time_s": float(wall), "tangent": spec.solver.tangent,
-        "n_dofs": int(model.problem.n_dofs), "status_codes": STATE_CODES,
+        "wall_time_s": float(wall),
+        "tangent": spec.solver.tangent,
+        "n_dofs": int(model.problem.n_dofs),
+        "status_codes": STATE_CODES,
     }
-    hdf5.write_result(out_dir / "result.h5", points=model.mesh.nodes, cells=model.mesh.cells,
-                      steps=fields, attrs=attrs, load_steps=spec.loading.steps)
+    hdf5.write_result(
+        out_dir / "result.h5",
+        points=model.mesh.nodes,
+        cells=model.mesh.cells,
+        steps=fields,
+        attrs=attrs,
+        load_steps=spec.loading.steps,
+    )
     if "vtu" not in spec.output.formats or not fields:
         return
     _write_vtu(model, results, fields, out_dir, spec.loading.steps > 1, vtu)
@@ -179,8 +243,11 @@ def _write_vtu(model, results, fields, out_dir, series, vtu):
     entries = []
     for r, f in zip(results, fields):
         vis = vis_mesh(model.mesh, model.ec, model.bulk, r.u)
-        cell_data = {"stress": f.stress, "stress_zz": f.stress_zz,
-                     "principal_stress": f.principal_stress}
+        cell_data = {
+            "stress": f.stress,
+            "stress_zz": f.stress_zz,
+            "principal_stress": f.principal_stress,
+        }
         fr = [(model.fractures[i].index, ff) for i, ff in enumerate(f.fractures)]
         is_last = r is results[-1]
         if series:

@@ -60,7 +60,9 @@ class StepResult:
 class NewtonSolver:
     """Newton-Raphson over load steps on a Problem; keeps the converged steps."""
 
-    def __init__(self, problem: Problem, tolerance: float, max_iterations: int, tangent: str):
+    def __init__(
+        self, problem: Problem, tolerance: float, max_iterations: int, tangent: str
+    ):
         self.p = problem
         self.tol = tolerance
         self.max_it = max_iterations
@@ -87,8 +89,12 @@ class NewtonSolver:
     def _residual(self, u, lam, res: ContactResult):
         f_int = self.p.K @ u + res.force - self.f_c0
         r = f_int - lam * self.p.F_unit
-        ref = math.sqrt(float(np.sum((lam * self.p.F_unit[self.free]) ** 2)
-                              + np.sum(r[self.p.fixed] ** 2)))
+        ref = math.sqrt(
+            float(
+                np.sum((lam * self.p.F_unit[self.free]) ** 2)
+                + np.sum(r[self.p.fixed] ** 2)
+            )
+        )
         norm = float(np.linalg.norm(r[self.free]))
         eta = norm / ref if ref > 0.0 else (0.0 if norm == 0.0 else math.inf)
         return r[self.free], eta
@@ -106,10 +112,18 @@ class NewtonSolver:
             r, eta = self._residual(u, lam, res)
             flips = int(np.count_nonzero(res.state != prev_state))
             residuals.append(eta)
-            logger.info("step %d/%d iteration %d: eta = %.3e; contact points: %d slip, %d stick, "
-                        "%d open; %d switched", k, steps, it, eta,
-                        np.count_nonzero(res.state == SLIP), np.count_nonzero(res.state == STICK),
-                        np.count_nonzero(res.state == OPEN), flips)
+            logger.info(
+                "step %d/%d iteration %d: eta = %.3e; contact points: %d slip, %d stick, "
+                "%d open; %d switched",
+                k,
+                steps,
+                it,
+                eta,
+                np.count_nonzero(res.state == SLIP),
+                np.count_nonzero(res.state == STICK),
+                np.count_nonzero(res.state == OPEN),
+                flips,
+            )
             if not np.isfinite(eta):
                 raise self._fail(k, it, eta, flips, "the residual is not finite")
             if eta <= self.tol:
@@ -118,7 +132,9 @@ class NewtonSolver:
                 self.completed.append(StepResult(k, lam, u.copy(), res, it, residuals))
                 return u
             if it == self.max_it:
-                raise self._fail(k, it, eta, flips, f"no convergence in {self.max_it} iterations")
+                raise self._fail(
+                    k, it, eta, flips, f"no convergence in {self.max_it} iterations"
+                )
             du = self._solve(res, r, k, it, eta)
             u[self.free] -= du
             pt_prev, gt_prev, prev_state = res.pt, res.gt, res.state
@@ -129,12 +145,16 @@ class NewtonSolver:
         for index, mask in self.p.floating or []:
             if mask.any() and not np.any(res.state[mask] == STICK):
                 raise self._fail(
-                    k, it, eta, 0,
+                    k,
+                    it,
+                    eta,
+                    0,
                     f"fractures[{index}] cuts the domain in two and one part has no prescribed "
                     "displacement, so only the fracture holds it; no point of the fracture "
                     "sticks, so that part slides without bound (no static equilibrium). "
                     "Prescribe a displacement on that part (e.g. on its edge) or raise the "
-                    "friction or cohesion")
+                    "friction or cohesion",
+                )
 
     def _solve(self, res, r, k, it, eta):
         Kc = coo_block(self.c_dofs, res.blocks, self.free.size)
@@ -143,9 +163,15 @@ class NewtonSolver:
             lu = spla.splu(A, permc_spec="COLAMD")
             du = lu.solve(r)
         except RuntimeError as exc:  # "Factor is exactly singular"
-            raise self._fail(k, it, eta, 0, f"the tangent matrix is singular ({exc}); a part "
-                             "of the body may be free to move (e.g. a block cut off by a "
-                             "fracture with nothing holding it)") from None
+            raise self._fail(
+                k,
+                it,
+                eta,
+                0,
+                f"the tangent matrix is singular ({exc}); a part "
+                "of the body may be free to move (e.g. a block cut off by a "
+                "fracture with nothing holding it)",
+            ) from None
         if not np.all(np.isfinite(du)):
             raise self._fail(k, it, eta, 0, "the linear solve gave non-finite values")
         return du
@@ -155,4 +181,8 @@ class NewtonSolver:
             f"load step {k} did not converge: {why}; iteration {it}, residual eta = {eta:.3e} "
             f"(tolerance {self.tol:.1e}), {flips} stick/slip switches in the last iteration; "
             f"{len(self.completed)} converged step(s) kept",
-            step=k, iteration=it, residual=eta, flips=flips)
+            step=k,
+            iteration=it,
+            residual=eta,
+            flips=flips,
+        )

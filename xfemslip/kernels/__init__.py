@@ -15,7 +15,13 @@ from xfemslip.kernels.contact import (
 )
 
 __all__ = [
-    "OPEN", "SLIP", "STICK", "TANGENT_CONSISTENT", "TANGENT_SECANT",
-    "contact_response", "coulomb_return_map", "enriched_cell_matrices",
+    "OPEN",
+    "SLIP",
+    "STICK",
+    "TANGENT_CONSISTENT",
+    "TANGENT_SECANT",
+    "contact_response",
+    "coulomb_return_map",
+    "enriched_cell_matrices",
     "rectangle_stiffness",
 ]

@@ -21,5 +21,8 @@ def numba_settings() -> list[tuple[str, str]]:
         ("NUMBA_NUM_THREADS", str(numba.config.NUMBA_NUM_THREADS)),
         ("numba cache dir", str(cache_dir)),
         ("NUMBA_DISABLE_JIT", str(numba.config.DISABLE_JIT)),
-        ("xfemslip numba cache", "on" if NUMBA_CACHE else "off (XFEMSLIP_NUMBA_CACHE=0)"),
+        (
+            "xfemslip numba cache",
+            "on" if NUMBA_CACHE else "off (XFEMSLIP_NUMBA_CACHE=0)",
+        ),
     ]

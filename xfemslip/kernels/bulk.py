@@ -79,8 +79,9 @@ def _enriched_B(x, y, x0, x1, y0, y1, slot_node, slot_fnode, F, gradF, N, dN, ou
 
 
 @njit(cache=NUMBA_CACHE)
-def enriched_cell_matrices(bounds, qp_offsets, qp_xy, qp_w, qp_F, qp_gradF,
-                           slot_node, slot_fnode, D):
+def enriched_cell_matrices(
+    bounds, qp_offsets, qp_xy, qp_w, qp_F, qp_gradF, slot_node, slot_fnode, D
+):
     """Stiffness and area-averaged strain operator of enriched cells.
 
     Parameters
@@ -111,8 +112,21 @@ def enriched_cell_matrices(bounds, qp_offsets, qp_xy, qp_w, qp_F, qp_gradF,
         x0, x1, y0, y1 = bounds[e, 0], bounds[e, 1], bounds[e, 2], bounds[e, 3]
         area = 0.0
         for q in range(qp_offsets[e], qp_offsets[e + 1]):
-            _enriched_B(qp_xy[q, 0], qp_xy[q, 1], x0, x1, y0, y1, slot_node[e],
-                        slot_fnode[e], qp_F[q], qp_gradF[q], N, dN, B)
+            _enriched_B(
+                qp_xy[q, 0],
+                qp_xy[q, 1],
+                x0,
+                x1,
+                y0,
+                y1,
+                slot_node[e],
+                slot_fnode[e],
+                qp_F[q],
+                qp_gradF[q],
+                N,
+                dN,
+                B,
+            )
             w = qp_w[q]
             DB = D @ B
             K[e] += (B.T @ DB) * w

@@ -56,10 +56,31 @@ def coulomb_return_map(gn, gt, slip_old, pn0, kn, kt, friction, cohesion):
 
 
 @njit(cache=NUMBA_CACHE)
-def contact_response(u, ip_dofs, ip_coef, ip_normal, ip_tangent, ip_weight, pn0,
-                     slip_old, kn, kt, friction, cohesion, tangent_mode, pt_prev,
-                     gt_prev, out_f, out_K, out_gn, out_gt, out_pn, out_pt,
-                     out_state, out_slip):
+def contact_response(
+    u,
+    ip_dofs,
+    ip_coef,
+    ip_normal,
+    ip_tangent,
+    ip_weight,
+    pn0,
+    slip_old,
+    kn,
+    kt,
+    friction,
+    cohesion,
+    tangent_mode,
+    pt_prev,
+    gt_prev,
+    out_f,
+    out_K,
+    out_gn,
+    out_gt,
+    out_pn,
+    out_pt,
+    out_state,
+    out_slip,
+):
     """Contact forces and tangent of every interface point.
 
     The jump at point i is [[u]] = sum_k ip_coef[i, k] * (u[ip_dofs[i, 2k]],
@@ -100,7 +121,8 @@ def contact_response(u, ip_dofs, ip_coef, ip_normal, ip_tangent, ip_weight, pn0,
         gn = j0 * n0 + j1 * n1
         gt = j0 * t0 + j1 * t1
         pn, pt, state, slip, dnn, dnt, dtn, dtt = coulomb_return_map(
-            gn, gt, slip_old[i], pn0[i], kn[i], kt[i], friction[i], cohesion[i])
+            gn, gt, slip_old[i], pn0[i], kn[i], kt[i], friction[i], cohesion[i]
+        )
         if tangent_mode == TANGENT_SECANT and state == SLIP:
             # paper eq. 28: k_T = (p_T^{n+1} - p_T^n) / |Delta w_T|, no n-t coupling
             dg = abs(gt - gt_prev[i])
