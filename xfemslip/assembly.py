@@ -19,6 +19,7 @@ from xfemslip.enrichment import (
     Candidates,
     DofMap,
     EnrichedCells,
+    carries_jump,
     select_enrichment,
 )
 
@@ -50,7 +51,7 @@ def _rect_stiffness_shared(hx, hy, D):
     return K_u, inverse.ravel()
 
 
-def assemble_bulk(mesh, D, cand: Candidates, ec: EnrichedCells) -> BulkSystem:
+def assemble_bulk(mesh, D, cand: Candidates, ec: EnrichedCells, ip=None) -> BulkSystem:
     """Assemble the bulk stiffness and choose the kept enrichments (sliver rule)."""
     is_enr = np.zeros(mesh.n_cells, bool)
     is_enr[ec.cells] = True
@@ -80,7 +81,8 @@ def assemble_bulk(mesh, D, cand: Candidates, ec: EnrichedCells) -> BulkSystem:
     std_diag = np.zeros(n_std)
     np.add.at(std_diag, std_dofs, np.diagonal(K_u, axis1=1, axis2=2)[which])
     np.add.at(std_diag, enr_std, np.diagonal(K_e[:, :8, :8], axis1=1, axis2=2))
-    dofmap = select_enrichment(mesh, cand, ec, K_e, std_diag)
+    jumps = carries_jump(mesh, cand, ip) if ip is not None else None
+    dofmap = select_enrichment(mesh, cand, ec, K_e, std_diag, jumps)
 
     S = ec.slot_cand.shape[1]
     enr_dofs = -np.ones((ec.cells.size, 8 + 2 * S), np.int64)

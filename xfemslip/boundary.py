@@ -86,6 +86,33 @@ def dirichlet(mesh, boundary) -> Dirichlet:
     return Dirichlet(dofs=dofs, values=vals, pinned=pinned)
 
 
+def hold_enriched(bc: Dirichlet, cand, dofmap) -> Dirichlet:
+    """Also fix (to 0) the enrichment dofs of every prescribed node component.
+
+    The prescribed values hold the whole edge, not just its nodes: with the
+    enrichment amplitudes of the edge's nodes at zero, the displacement along
+    the edge is the linear interpolation of the nodal values, as prescribed.
+    (A fracture reaching a fixed edge therefore cannot open or slip there in
+    the fixed component; along a roller it still slides.)  Rigid-body pins
+    are point constraints and do not fix enrichment dofs.
+    """
+    prescribed = np.setdiff1d(bc.dofs, bc.pinned)
+    node, comp = prescribed // 2, prescribed % 2
+    kept = dofmap.cand_dof >= 0
+    if not kept.any() or prescribed.size == 0:
+        return bc
+    by_node = {}
+    for k in np.nonzero(kept)[0]:
+        by_node.setdefault(int(cand.node[k]), []).append(int(dofmap.cand_dof[k]))
+    extra = [d + int(c) for n, c in zip(node, comp) for d in by_node.get(int(n), ())]
+    if not extra:
+        return bc
+    dofs = np.concatenate([bc.dofs, np.array(extra, np.int64)])
+    values = np.concatenate([bc.values, np.zeros(len(extra))])
+    order = np.argsort(dofs)
+    return Dirichlet(dofs=dofs[order], values=values[order], pinned=bc.pinned)
+
+
 def _rigid_modes(mesh, dofs):
     """Rows of the three rigid-body modes (ux, uy, rotation about the centre) at dofs."""
     centre = mesh.nodes.mean(axis=0)

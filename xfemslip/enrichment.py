@@ -12,6 +12,9 @@ the modelled discontinuity ends exactly at the tip, wherever the tip lies.
 A node x_a exactly on the fracture takes H = +1 (eq. 12).
 
 Candidate nodes: every node of a cell that holds a piece of the fracture.
+A Heaviside candidate is kept only if its shape function is non-zero somewhere
+on the fracture (``carries_jump``): a node whose support the fracture only
+touches on its boundary is not enriched.
 Sliver rule (conditioning): a candidate is dropped when the diagonal of its
 enriched stiffness is below ``ENRICHMENT_DIAG_RATIO`` times the diagonal of
 its standard dofs (minimum over x and y).  For a node whose support the
@@ -38,6 +41,9 @@ from xfemslip.quadrature import cell_subtriangles, duffy_rule, triangle_rule
 logger = logging.getLogger(__name__)
 
 ENRICHMENT_DIAG_RATIO = 1.0e-4
+# A Heaviside enrichment whose shape function is below this on the whole
+# fracture (in units of the jump, 2 R N_a) carries no jump (see carries_jump).
+JUMP_TOL = 1.0e-9
 
 HEAVISIDE = 0  # candidate function codes: 0 = F = H R, 1..4 = branch B1..B4
 
@@ -135,12 +141,16 @@ def _cell_lines(fr, b, tol):
             and hi[k, 1] >= b[2]
         ):
             out.append((fr.points[k], fr.normal[k]))
-    diag = np.hypot(b[1] - b[0], b[3] - b[2])
-    centre = np.array([0.5 * (b[0] + b[1]), 0.5 * (b[2] + b[3])])
     for tip in fr.tips:
-        if np.linalg.norm(centre - tip.point) <= tip.ramp_length + diag:
-            out.append((tip.point, tip.direction))
-            out.append((tip.point - tip.ramp_length * tip.direction, tip.direction))
+        # the ramp's kink lines are infinite: they cross every cell of the strip
+        # -l <= psi <= 0, not only the cells near the tip
+        for point in (tip.point, tip.point - tip.ramp_length * tip.direction):
+            psi = (
+                np.array([[b[0], b[2]], [b[1], b[2]], [b[1], b[3]], [b[0], b[3]]])
+                - point
+            ) @ tip.direction
+            if psi.min() < -tol and psi.max() > tol:
+                out.append((point, tip.direction))
     return out
 
 
@@ -250,13 +260,41 @@ def _node_cells(mesh):
     return [cells_sorted[split[i] : split[i + 1]] for i in range(mesh.n_nodes)]
 
 
+def carries_jump(mesh, cand: Candidates, ip) -> np.ndarray:
+    """Whether each candidate's function jumps somewhere on its fracture (k,) bool.
+
+    A Heaviside candidate carries the jump 2 R N_a on the fracture; it carries
+    none when the fracture only touches its support's boundary (a fracture
+    along element edges, seen from a node off it), where N_a = 0.  Such an
+    enrichment is smooth, adds nothing to the crack, and can be linearly
+    dependent on its neighbours (the ramp), so it is never kept.  Branch
+    candidates are kept (B2..B4 carry no jump by design).
+    """
+    jump = np.zeros(cand.node.size)
+    if ip.n and cand.node.size:
+        N = mesh.shape_at(ip.cell, ip.xy)  # (n_ip, 4)
+        n_nodes = mesh.n_nodes
+        n_frac = int(max(ip.fracture.max(), cand.fracture.max())) + 1
+        key = ip.fracture[:, None] * n_nodes + mesh.cells[ip.cell]  # (n_ip, 4)
+        best = np.zeros(n_nodes * n_frac)
+        np.maximum.at(best, key.ravel(), (np.abs(2.0 * ip.ramp)[:, None] * N).ravel())
+        jump = best[cand.fracture * n_nodes + cand.node]
+    return (cand.func != HEAVISIDE) | (jump > JUMP_TOL)
+
+
 def select_enrichment(
-    mesh, cand: Candidates, ec: EnrichedCells, K_enr: np.ndarray, std_diag: np.ndarray
+    mesh,
+    cand: Candidates,
+    ec: EnrichedCells,
+    K_enr: np.ndarray,
+    std_diag: np.ndarray,
+    jumps: np.ndarray | None = None,
 ) -> DofMap:
-    """Apply the sliver rule and number the kept enriched dofs.
+    """Apply the jump and sliver rules and number the kept enriched dofs.
 
     K_enr : (nc, 8+2S, 8+2S) enriched-cell stiffness with every candidate slot.
     std_diag : (n_std,) diagonal of the standard-dof bulk stiffness.
+    jumps : (k,) bool from ``carries_jump`` (None: not applied).
     """
     n_std = 2 * mesh.n_nodes
     k = cand.node.size
@@ -273,6 +311,10 @@ def select_enrichment(
     ref = np.stack([std_diag[2 * cand.node], std_diag[2 * cand.node + 1]], axis=1)
     ratio = (diag / ref).min(axis=1) if k else np.zeros(0)
     keep = ratio >= ENRICHMENT_DIAG_RATIO
+    if jumps is not None:
+        keep &= jumps
+    if jumps is not None:
+        keep &= jumps
     cand_dof = -np.ones(k, np.int64)
     cand_dof[keep] = n_std + 2 * np.arange(np.count_nonzero(keep))
     if k and not keep.all():

@@ -87,8 +87,13 @@ class Fracture:
         return np.where(side >= 0.0, 1.0, -1.0) * dist[rows, j]
 
     def side(self, pts: np.ndarray) -> np.ndarray:
-        """H(phi) of eq. 12 at points (n, 2): +1 where phi >= 0, else -1."""
-        return np.where(self.signed_distance(pts) >= 0.0, 1.0, -1.0)
+        """H(phi) of eq. 12 at points (n, 2): +1 where phi >= 0, else -1.
+
+        Points within round-off of the fracture (|phi| <= 1e-12 of its length)
+        count as phi = 0, i.e. +1.
+        """
+        tol = 1e-12 * float(self.length.sum())
+        return np.where(self.signed_distance(pts) >= -tol, 1.0, -1.0)
 
     def ramp(self, pts: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Tip ramp R (n,) in [0, 1] and its gradient (n, 2) [1/m].
@@ -258,10 +263,7 @@ def build_fracture(mesh, spec, box) -> Fracture:
                 sign=1.0 if end == 1 else -1.0,
             )
         )
-    tip_mode = getattr(spec, "tip", None) or DEFAULT_TIP
-    radius = getattr(spec, "tip_radius", None)
-    if radius is None:
-        radius = TIP_RADIUS_CELLS * max((t.cell_size for t in tips), default=0.0)
+    tip_mode, radius = _tip_enrichment(spec, key, tips, length)
     frac = Fracture(
         index=spec.index,
         points=pts,
@@ -288,6 +290,54 @@ def build_fracture(mesh, spec, box) -> Fracture:
         len(np.unique(piece_cell)),
     )
     return frac
+
+
+def _tip_enrichment(spec, key, tips, length):
+    """Tip mode and branch radius of a fracture, within what its geometry allows.
+
+    B1 jumps along the whole straight ray behind its tip, so the supports of
+    branch-enriched nodes (radius + one cell diagonal from the tip) must stay
+    on the tip segment and short of the fracture's middle; otherwise the ray
+    would cut the body where there is no fracture (past a kink or past the
+    other tip).  A larger radius is reduced to that limit, and a fracture
+    whose tip cells do not fit at all falls back to the ramp; both are logged
+    as warnings.
+    """
+    mode = getattr(spec, "tip", None) or DEFAULT_TIP
+    given = getattr(spec, "tip_radius", None)
+    if mode != "branch" or not tips:
+        return mode, float(given or 0.0)
+    radius = (
+        given
+        if given is not None
+        else TIP_RADIUS_CELLS * max(t.cell_size for t in tips)
+    )
+    limit = np.inf
+    for tip in tips:
+        seg = length[0] if tip.end == 0 else length[-1]
+        diag = np.sqrt(2.0) * tip.cell_size
+        limit = min(limit, min(seg, 0.5 * float(length.sum())) - diag)
+        if limit < diag:
+            logger.warning(
+                '%s: tip = "branch" needs a straight tip segment of at least 2 cell '
+                "diagonals (%.3g m) on each side of a tip; this fracture is too short or "
+                'kinked near a tip, so it uses tip = "ramp"',
+                key,
+                2 * diag,
+            )
+            return "ramp", 0.0
+    if radius > limit:
+        level = logging.WARNING if given is not None else logging.INFO
+        logger.log(
+            level,
+            "%s: branch enrichment radius %.3g m reduced to %.3g m so that "
+            "the tip functions stay on the fracture's tip segments",
+            key,
+            radius,
+            limit,
+        )
+        radius = limit
+    return mode, float(radius)
 
 
 def _segments_cross(a0, a1, b0, b1):

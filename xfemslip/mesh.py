@@ -58,6 +58,15 @@ class Mesh:
     def cell_of(self, i: np.ndarray, j: np.ndarray) -> np.ndarray:
         return j * self.nx + i
 
+    def shape_at(self, cells: np.ndarray, xy: np.ndarray) -> np.ndarray:
+        """Q4 shape functions N (n, 4) at points xy (n, 2) of the given cells (n,)."""
+        b = self.bounds[cells]
+        xi = (2.0 * xy[:, 0] - b[:, 0] - b[:, 1]) / (b[:, 1] - b[:, 0])
+        eta = (2.0 * xy[:, 1] - b[:, 2] - b[:, 3]) / (b[:, 3] - b[:, 2])
+        xa = np.array([-1.0, 1.0, 1.0, -1.0])
+        ya = np.array([-1.0, -1.0, 1.0, 1.0])
+        return 0.25 * (1.0 + xi[:, None] * xa) * (1.0 + eta[:, None] * ya)
+
 
 def build_mesh(x: np.ndarray, y: np.ndarray) -> Mesh:
     """Mesh from strictly increasing node coordinates along x and y [m]."""

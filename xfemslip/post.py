@@ -18,15 +18,6 @@ from xfemslip.writers import FractureFields, VisMesh
 STATE_CODES = "0 open, 1 stick, 2 slip"
 
 
-def q4_shape_np(x, y, b):
-    """N (n, 4) at points (x, y) (n,) of cells with bounds b (n, 4)."""
-    xi = (2.0 * x - b[:, 0] - b[:, 1]) / (b[:, 1] - b[:, 0])
-    eta = (2.0 * y - b[:, 2] - b[:, 3]) / (b[:, 3] - b[:, 2])
-    xa = np.array([-1.0, 1.0, 1.0, -1.0])
-    ya = np.array([-1.0, -1.0, 1.0, 1.0])
-    return 0.25 * (1.0 + xi[:, None] * xa) * (1.0 + eta[:, None] * ya)
-
-
 def cell_strain(mesh, bulk, u) -> np.ndarray:
     """Element-average strain (M, 3) [exx, eyy, gxy]."""
     eps = np.zeros((mesh.n_cells, 3))
@@ -107,7 +98,7 @@ def vis_mesh(mesh, ec, bulk, u) -> VisMesh:
     cell = ec.cells[tri_owner]
     pts = ec.tris.reshape(-1, 2)
     owner_v = np.repeat(tri_owner, 3)
-    N = q4_shape_np(pts[:, 0], pts[:, 1], mesh.bounds[np.repeat(cell, 3)])  # (3nt, 4)
+    N = mesh.shape_at(np.repeat(cell, 3), pts)  # (3nt, 4)
     disp = np.einsum("va,vac->vc", N, U[mesh.cells[np.repeat(cell, 3)]])
     Fv = ec.tri_F.reshape(-1, ec.tri_F.shape[2])  # (3nt, S)
     dofs = bulk.enr_dofs[owner_v]  # (3nt, 8+2S)

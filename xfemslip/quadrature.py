@@ -15,6 +15,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from xfemslip.geometry import GEOMETRY_TOL
+
 # Dunavant (1985) degree-5 rule on the reference triangle: barycentric points, weights (sum 1).
 _A1, _B1 = 0.059715871789770, 0.470142064105115
 _A2, _B2 = 0.797426985353087, 0.101286507323456
@@ -105,10 +107,11 @@ def cell_subtriangles(bounds: np.ndarray, lines, tol: float, apexes=()) -> np.nd
 
 # Collapsed (Duffy) product rule for triangles with a 1/sqrt(r) gradient
 # singularity at vertex 0: x = v0 + u (v1 - v0 + v (v2 - v1)), dA = 2 A u du dv,
-# which cancels the 1/r of |grad B|^2 and leaves a smooth integrand.
-DUFFY_POINTS = 7
+# with u = s^2 so that both the 1/r of |grad B|^2 and the 1/sqrt(r) of
+# grad N . grad B become polynomials in (s, v): dA = 4 A s^3 ds dv.
+DUFFY_POINTS = 8
 _g, _gw = np.polynomial.legendre.leggauss(DUFFY_POINTS)
-_DU, _DV = np.meshgrid(0.5 * (_g + 1.0), 0.5 * (_g + 1.0), indexing="ij")
+_DS, _DV = np.meshgrid(0.5 * (_g + 1.0), 0.5 * (_g + 1.0), indexing="ij")
 _DW = np.outer(0.5 * _gw, 0.5 * _gw)
 
 
@@ -118,12 +121,13 @@ def duffy_rule(tris: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     e1 = v1 - v0
     e2 = v2 - v0
     area = 0.5 * np.abs(e1[:, 0] * e2[:, 1] - e1[:, 1] * e2[:, 0])
-    u = _DU.ravel()
+    sq = _DS.ravel()
+    u = sq * sq
     v = _DV.ravel()
     xy = v0[:, None, :] + u[None, :, None] * (
         (v1 - v0)[:, None, :] + v[None, :, None] * (v2 - v1)[:, None, :]
     )
-    w = 2.0 * area[:, None] * (u * _DW.ravel())[None, :]
+    w = 4.0 * area[:, None] * (sq**3 * _DW.ravel())[None, :]
     return xy.reshape(-1, 2), w.reshape(-1)
 
 
@@ -155,8 +159,13 @@ class InterfacePoints:
         return self.fracture.size
 
 
-def interface_points(fractures) -> InterfacePoints:
-    """Gauss points on every piece of every fracture, split at the ramp kinks."""
+def interface_points(fractures, min_cell: float | None = None) -> InterfacePoints:
+    """Gauss points on every piece of every fracture, split at the ramp kinks.
+
+    min_cell : smallest element size [m]; sub-pieces shorter than
+    GEOMETRY_TOL * min_cell (a kink falling on a piece's end) are skipped
+    (default: 1e-12 of the segment length).
+    """
     cols = {
         k: [] for k in ("fracture", "cell", "xy", "s", "weight", "normal", "tangent")
     }
@@ -172,7 +181,9 @@ def interface_points(fractures) -> InterfacePoints:
                     if ta < t < tb:
                         cuts.append(t)
             cuts = np.sort(cuts)
-            for a, b in zip(cuts[:-1], cuts[1:]):
+            tol = GEOMETRY_TOL * min_cell if min_cell else 1e-12 * fr.length[seg]
+            keep = np.diff(cuts) * fr.length[seg] > tol
+            for a, b in zip(cuts[:-1][keep], cuts[1:][keep]):
                 t = 0.5 * (a + b) + 0.5 * (b - a) * LINE_POINTS
                 cols["fracture"].append(np.full(t.size, fi))
                 cols["cell"].append(np.full(t.size, cell))

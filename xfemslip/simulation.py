@@ -16,7 +16,7 @@ import numpy as np
 
 from xfemslip import __version__
 from xfemslip.assembly import BulkSystem, assemble_bulk
-from xfemslip.boundary import dirichlet, traction_load
+from xfemslip.boundary import dirichlet, hold_enriched, traction_load
 from xfemslip.contact import ContactSet, build_contact
 from xfemslip.enrichment import EnrichedCells, build_enriched_cells, find_candidates
 from xfemslip.errors import ConvergenceError, OutputError, UsageError
@@ -68,12 +68,12 @@ def build_model(spec) -> Model:
     fractures = build_fractures(mesh, spec.fractures, box)
     cand = find_candidates(mesh, fractures)
     ec = build_enriched_cells(mesh, fractures, cand)
-    bulk = assemble_bulk(mesh, D, cand, ec)
-    ip = interface_points(fractures)
+    ip = interface_points(fractures, mesh.h_min)
+    bulk = assemble_bulk(mesh, D, cand, ec, ip)
     contact = build_contact(
         mesh, fractures, ip, ec, cand, bulk.dofmap, spec.loading.initial_stress
     )
-    bc = dirichlet(mesh, spec.boundary)
+    bc = hold_enriched(dirichlet(mesh, spec.boundary), cand, bulk.dofmap)
     F = traction_load(
         mesh, spec.boundary, spec.loading, ec, cand, bulk.dofmap, fractures
     )
@@ -112,7 +112,8 @@ def build_model(spec) -> Model:
 
 def floating_parts(mesh, fractures, ip, bc):
     """Fractures that cut the domain in two and leave one part without prescribed dofs."""
-    fixed_nodes = np.unique(bc.dofs // 2)
+    std = bc.dofs[bc.dofs < 2 * mesh.n_nodes]  # enrichment dofs are not nodes
+    fixed_nodes = np.unique(std // 2)
     out = []
     for fi, fr in enumerate(fractures):
         if fr.tips:

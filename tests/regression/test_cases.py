@@ -1,0 +1,267 @@
+"""Regression: every ``cases/*.toml`` run end to end against pinned scalars.
+
+Each case is run once (``run_case(load_case(case), out_dir)``, i.e.
+``xfemslip run CASE -o OUT_DIR``) into a temporary folder.  Its key scalars
+(``golden_scalars.key_scalars``: max |slip|, min slip, number of contact and of
+slipping points, Newton iterations per step, mean element sigma_yy -- standing
+in for the reaction, which is not in the output -- and the displacement of the
+top-centre node) are compared with ``golden/<stem>.json`` using the explicit
+tolerances of ``RTOL`` below.  The output is also checked against the contract
+of output-format.md (datasets, shapes, dtypes, attributes, /steps, result.pvd)
+and against two facts that hold whatever the numerics: the principal stresses
+are the eigenvalues of the stress, and the average stress theorem
+(mean sigma = far-field stress when every edge's traction is known).
+
+To regenerate the goldens after an *intended* change of the results (say why in
+the commit message)::
+
+    python tests/regression/regen.py                 # all cases
+    python tests/regression/regen.py liu_borja_plate # one case
+
+A new case in ``cases/`` without a golden fails here until regen.py is run.
+"""
+
+from __future__ import annotations
+
+import math
+import tomllib
+import xml.etree.ElementTree as ET
+from pathlib import Path
+
+import h5py
+import numpy as np
+import pytest
+from golden_scalars import case_files, golden_path, key_scalars, read_golden, run
+
+import xfemslip
+
+# Explicit tolerances: the solver stops at eta <= 1e-8, so results agree to far
+# better than 1e-6 between runs and platforms; counts and iterations are exact.
+RTOL = {
+    "max_abs_slip": 1e-6,
+    "min_slip": 1e-6,
+    "mean_stress_yy": 1e-6,
+    "top_centre_displacement": 1e-6,
+    "top_centre_point": 1e-12,
+}
+EXACT = ("n_contact_points", "n_slip_points", "iterations_per_step")
+
+CASES = case_files()
+IDS = [c.stem for c in CASES]
+
+FRACTURE_DATASETS = {  # name: (trailing shape, dtype kind)
+    "s": ((), "f"),
+    "points": ((2,), "f"),
+    "slip": ((), "f"),
+    "opening": ((), "f"),
+    "normal_traction": ((), "f"),
+    "shear_traction": ((), "f"),
+    "state": ((), "i"),
+}
+ROOT_ATTRS = (
+    "format_version",
+    "xfemslip_version",
+    "case_toml",
+    "converged",
+    "load_steps",
+    "newton_iterations",
+    "wall_time_s",
+)
+
+
+@pytest.fixture(scope="module")
+def runs(tmp_path_factory):
+    """Each case run once per module: stem -> (case path, out dir, summary)."""
+    done = {}
+
+    def get(case: Path):
+        if case.stem not in done:
+            out = tmp_path_factory.mktemp(case.stem) / "out"
+            done[case.stem] = (case, out, run(case, out))
+        return done[case.stem]
+
+    return get
+
+
+def test_cases_exist():
+    assert {"reservoir_depletion", "liu_borja_plate"} <= set(IDS)
+
+
+@pytest.mark.parametrize("case", CASES, ids=IDS)
+def test_key_scalars_match_golden(runs, case):
+    assert golden_path(case).is_file(), (
+        f"no golden for {case.name}: run python tests/regression/regen.py {case.stem}"
+    )
+    _, out, summary = runs(case)
+    got, want = key_scalars(out, summary), read_golden(case)
+    assert set(got) == set(want)
+    for key in EXACT:
+        assert got[key] == want[key], f"{key}: {got[key]} != golden {want[key]}"
+    for key, rtol in RTOL.items():
+        np.testing.assert_allclose(
+            got[key], want[key], rtol=rtol, atol=0, err_msg=f"{case.stem}: {key}"
+        )
+
+
+@pytest.mark.parametrize("case", CASES, ids=IDS)
+def test_output_contract(runs, case):
+    """result.h5 holds every dataset of output-format.md with its documented shape."""
+    _, out, summary = runs(case)
+    spec_text = case.read_text()
+    doc = tomllib.loads(spec_text)
+    steps = doc["loading"].get("steps", 1)
+    n_fractures = len(doc.get("fractures", []))
+    for name in ("result.h5", "result.vtu", "fractures.vtu"):
+        assert (out / name).is_file(), name
+    with h5py.File(out / "result.h5", "r") as f:
+        for key in ROOT_ATTRS:
+            assert key in f.attrs, key
+        assert int(f.attrs["format_version"]) == 1
+        assert f.attrs["xfemslip_version"] == xfemslip.__version__
+        assert f.attrs["case_toml"] == spec_text
+        assert bool(f.attrs["converged"]) is True
+        assert int(f.attrs["load_steps"]) == steps
+        assert int(f.attrs["newton_iterations"]) == summary.newton_iterations
+        assert summary.newton_iterations == sum(summary.iterations_per_step)
+        assert float(f.attrs["wall_time_s"]) > 0.0
+
+        points, cells = f["mesh/points"][()], f["mesh/cells"][()]
+        nx, ny = doc["mesh"]["elements"]
+        N, M = (nx + 1) * (ny + 1), nx * ny
+        assert points.shape == (N, 2) and points.dtype == np.float64
+        assert cells.shape == (M, 4) and cells.dtype == np.int64
+        assert cells.min() == 0 and cells.max() == N - 1
+        # counter-clockwise: positive shoelace area, summing to the domain area
+        x, y = points[cells, 0], points[cells, 1]
+        area = 0.5 * np.sum(
+            x * np.roll(y, -1, axis=1) - y * np.roll(x, -1, axis=1), axis=1
+        )
+        assert np.all(area > 0.0)
+        size = doc["domain"]["size"]
+        assert np.sum(area) == pytest.approx(size[0] * size[1], rel=1e-12)
+
+        shapes = {
+            "fields/displacement": (N, 2),
+            "fields/stress": (M, 3),
+            "fields/stress_zz": (M,),
+            "fields/principal_stress": (M, 2),
+        }
+        for name, shape in shapes.items():
+            assert f[name].shape == shape, name
+            assert f[name].dtype.kind == "f", name
+            assert np.all(np.isfinite(f[name][()])), name
+        stress = f["fields/stress"][()]
+        principal = f["fields/principal_stress"][()]
+        tensors = np.stack([stress[:, [0, 2]], stress[:, [2, 1]]], axis=1)
+        eig = np.linalg.eigvalsh(tensors)[:, ::-1]  # [s_max, s_min]
+        scale = np.max(np.abs(stress))
+        np.testing.assert_allclose(principal, eig, rtol=0, atol=1e-9 * scale)
+        szz = f["fields/stress_zz"][()]
+        if (
+            doc["material"]["model"] == "plane_strain"
+        ):  # eps_zz = 0: s_zz = nu (s_xx + s_yy)
+            nu = doc["material"]["nu"]
+            np.testing.assert_allclose(
+                szz, nu * (stress[:, 0] + stress[:, 1]), rtol=0, atol=1e-9 * scale
+            )
+        else:
+            assert np.all(szz == 0.0)
+
+        for i in range(n_fractures):
+            check_fracture_group(f[f"fractures/{i}"], doc["fractures"][i])
+        if steps > 1:
+            kept = sorted(f["steps"].keys())
+            assert kept == [f"{k:04d}" for k in range(1, steps + 1)]
+            for k in kept:
+                g = f[f"steps/{k}"]
+                assert g["fields/displacement"].shape == (N, 2)
+                for i in range(n_fractures):
+                    for name in FRACTURE_DATASETS:
+                        assert name in g[f"fractures/{i}"], (
+                            f"steps/{k}/fractures/{i}/{name}"
+                        )
+            # the root holds the final step
+            last = f[f"steps/{steps:04d}"]
+            np.testing.assert_array_equal(
+                last["fields/displacement"][()], f["fields/displacement"][()]
+            )
+            for i in range(n_fractures):
+                np.testing.assert_array_equal(
+                    last[f"fractures/{i}/slip"][()], f[f"fractures/{i}/slip"][()]
+                )
+    if steps > 1:
+        pvd = ET.parse(out / "result.pvd").getroot()
+        files = [d.get("file") for d in pvd.iter("DataSet")]
+        assert len(files) == steps
+        assert all((out / name).is_file() for name in files)
+
+
+def fracture_ends(frac: dict):
+    if "points" in frac:
+        return np.array(frac["points"][0], float), np.array(frac["points"][-1], float)
+    c = np.array(frac["center"], float)
+    a = math.radians(frac["angle"])
+    d = 0.5 * frac["length"] * np.array([math.cos(a), math.sin(a)])
+    return c - d, c + d
+
+
+def check_fracture_group(g, frac: dict):
+    """Datasets of one fracture: shapes, dtypes, and the points lie on the fracture
+    at arc length s from its first point (straight fractures)."""
+    K = g["s"].shape[0]
+    assert K > 0
+    for name, (trailing, kind) in FRACTURE_DATASETS.items():
+        assert g[name].shape == (K, *trailing), name
+        assert g[name].dtype.kind == kind, name
+    assert g["state"].dtype == np.int8
+    assert set(np.unique(g["state"][()])) <= {0, 1, 2}
+    s, pts = g["s"][()], g["points"][()]
+    assert np.all(np.diff(s) >= 0.0)  # strictly: test_arc_length_strictly_increasing
+    p0, p1 = fracture_ends(frac)
+    if "points" not in frac or len(frac["points"]) == 2:
+        t = (p1 - p0) / np.linalg.norm(p1 - p0)
+        rel = pts - p0
+        np.testing.assert_allclose(rel @ t, s, rtol=0, atol=1e-12)
+        np.testing.assert_allclose(rel @ np.array([-t[1], t[0]]), 0.0, atol=1e-12)
+        assert s[-1] < np.linalg.norm(p1 - p0)
+
+
+def test_reservoir_average_stress(runs):
+    """Average stress theorem: with the known tractions on top, left and right and
+    u_y = 0 on the bottom (whose reaction has no moment arm, y = 0), the
+    area-average of sigma equals the far-field stress, fracture or not."""
+    case = next(c for c in CASES if c.stem == "reservoir_depletion")
+    _, out, _ = runs(case)
+    s = tomllib.loads(case.read_text())["loading"]["stress"]
+    with h5py.File(out / "result.h5", "r") as f:
+        mean = f["fields/stress"][()].mean(axis=0)  # uniform mesh: equal areas
+    np.testing.assert_allclose(
+        mean, [s["xx"], s["yy"], s["xy"]], rtol=0, atol=1e-6 * 40e6
+    )
+
+
+def test_plate_fracture_slips_down_the_dip(runs):
+    """Top pushed down on a 45-degree crack (t pointing up-right, + side up-left):
+    the upper-left block moves down relative to the lower-right one, slip < 0
+    (output-format.md sign convention), along the whole crack."""
+    case = next(c for c in CASES if c.stem == "liu_borja_plate")
+    _, out, _ = runs(case)
+    with h5py.File(out / "result.h5", "r") as f:
+        slip = f["fractures/0/slip"][()]
+        state = f["fractures/0/state"][()]
+    assert np.all(slip < 0.0)
+    assert np.all(state == 2)
+
+
+@pytest.mark.parametrize("stem", ["reservoir_depletion", "liu_borja_plate"])
+def test_arc_length_strictly_increasing(runs, stem):
+    """output-format.md: s is "increasing" at each contact integration point; two
+    integration points at the same place are a degenerate piece (the reservoir
+    case: four points at s = 0.017157 m, where the fracture crosses the node
+    (0.3, 0.3) exactly at the end of the tip ramp)."""
+    _, out, _ = runs(next(c for c in CASES if c.stem == stem))
+    with h5py.File(out / "result.h5", "r") as f:
+        s = f["fractures/0/s"][()]
+    assert np.all(np.diff(s) > 0.0), (
+        f"repeated s values: {np.unique(s[1:][np.diff(s) == 0])}"
+    )
