@@ -54,7 +54,15 @@ class StepResult:
     u: np.ndarray
     contact: ContactResult
     iterations: int
-    residuals: list
+    residuals: list  # eta at every iteration
+    switches: list  # stick/slip/open switches at every iteration
+
+
+def _regime(state, pt):
+    """Branch of the contact law at each point: open, stick, slip forward (+t),
+    slip backward.  A switch between any two changes the tangent, so it is what
+    the log and the ConvergenceError count as a stick/slip switch."""
+    return np.where(state == SLIP, np.where(pt >= 0.0, SLIP, SLIP + 1), state)
 
 
 class NewtonSolver:
@@ -105,13 +113,16 @@ class NewtonSolver:
         u = u.copy()
         u[self.p.fixed] = lam * self.p.fixed_values
         pt_prev, gt_prev = c.pt_committed.copy(), c.gt_committed.copy()
-        prev_state = c.state_committed
+        prev_regime = _regime(c.state_committed, c.pt_committed)
         residuals = []
+        switches = []
         for it in range(self.max_it + 1):
             res = c.evaluate(u, self.mode, pt_prev, gt_prev)
             r, eta = self._residual(u, lam, res)
-            flips = int(np.count_nonzero(res.state != prev_state))
+            regime = _regime(res.state, res.pt)
+            flips = int(np.count_nonzero(regime != prev_regime))
             residuals.append(eta)
+            switches.append(flips)
             logger.info(
                 "step %d/%d iteration %d: eta = %.3e; contact points: %d slip, %d stick, "
                 "%d open; %d switched",
@@ -129,7 +140,9 @@ class NewtonSolver:
             if eta <= self.tol:
                 self._check_floating(res, k, it, eta)
                 c.commit(res)
-                self.completed.append(StepResult(k, lam, u.copy(), res, it, residuals))
+                self.completed.append(
+                    StepResult(k, lam, u.copy(), res, it, residuals, switches)
+                )
                 return u
             if it == self.max_it:
                 raise self._fail(
@@ -137,7 +150,7 @@ class NewtonSolver:
                 )
             du = self._solve(res, r, k, it, eta)
             u[self.free] -= du
-            pt_prev, gt_prev, prev_state = res.pt, res.gt, res.state
+            pt_prev, gt_prev, prev_regime = res.pt, res.gt, regime
         raise AssertionError("unreachable")
 
     def _check_floating(self, res, k, it, eta):
