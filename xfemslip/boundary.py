@@ -17,7 +17,6 @@ import numpy as np
 
 from xfemslip.enrichment import candidate_values
 from xfemslip.errors import GeometryError
-from xfemslip.kernels.shape import q4_shape
 from xfemslip.quadrature import LINE_POINTS, LINE_WEIGHTS
 
 logger = logging.getLogger(__name__)
@@ -230,16 +229,13 @@ def _enriched_edge_load(F, mesh, cell, e, p, q, t, ec, cand, dofmap, fractures):
                 if 0.0 < s < 1.0:
                     cuts.append(s)
     cuts = np.sort(cuts)
-    b = mesh.bounds[cell]
-    N = np.empty(4)
-    dN = np.empty((4, 2))
     length = np.linalg.norm(xq - xp)
     for a0, a1 in zip(cuts[:-1], cuts[1:]):
         mid = xp + 0.5 * (a0 + a1) * (xq - xp)
         for g, w in zip(LINE_POINTS, LINE_WEIGHTS):
             s = 0.5 * (a0 + a1) + 0.5 * (a1 - a0) * g
             x = xp + s * (xq - xp)
-            q4_shape(x[0], x[1], b[0], b[1], b[2], b[3], N, dN)
+            N = mesh.shape_at(np.array([cell]), x[None])[0]
             for slot, k in enumerate(ec.slot_cand[e]):
                 if k < 0 or dofmap.cand_dof[k] < 0:
                     continue

@@ -18,7 +18,6 @@ from xfemslip import kernels
 from xfemslip.assembly import coo_block, scatter_vector
 from xfemslip.branch import b1_jump
 from xfemslip.enrichment import HEAVISIDE
-from xfemslip.kernels.shape import q4_shape
 
 logger = logging.getLogger(__name__)
 
@@ -123,35 +122,37 @@ def _jump_operators(mesh, fractures, ip, ec, cand, dofmap):
     Heaviside slot: [[H R]] N_a = 2 R N_a (eq. 14); branch slot B1:
     [[B1]] N_a = 2 sqrt(r) (n_d . n) N_a; B2..B4 are continuous (no entry).
     """
+    n = ip.n
+    if n == 0 or ec.slot_cand.shape[1] == 0:
+        return np.zeros((n, 0)), np.zeros((n, 0), np.int64)
     pos = np.searchsorted(ec.cells, ip.cell)
-    rows = [[] for _ in range(ip.n)]
-    N = np.empty(4)
-    dN = np.empty((4, 2))
-    for i in range(ip.n):
-        e = pos[i]
-        b = mesh.bounds[ip.cell[i]]
-        q4_shape(ip.xy[i, 0], ip.xy[i, 1], b[0], b[1], b[2], b[3], N, dN)
-        for s, k in enumerate(ec.slot_cand[e]):
-            if k < 0 or cand.fracture[k] != ip.fracture[i] or dofmap.cand_dof[k] < 0:
-                continue
-            a = ec.slot_node[e, s]
-            if cand.func[k] == HEAVISIDE:
-                jump = 2.0 * ip.ramp[i]
-            elif cand.func[k] == 1:
-                tip = fractures[cand.fracture[k]].tips[cand.tip[k]]
-                jump = b1_jump(tip, ip.xy[i])[0]
-            else:
-                continue
-            rows[i].append((jump * N[a], dofmap.cand_dof[k]))
-    J = max((len(r) for r in rows), default=0)
-    coef = np.zeros((ip.n, J))
-    dofs = -np.ones((ip.n, 2 * J), np.int64)
-    for i, r in enumerate(rows):
-        for j, (c, d) in enumerate(r):
-            coef[i, j] = c
-            dofs[i, 2 * j] = d
-            dofs[i, 2 * j + 1] = d + 1
-    return coef, dofs
+    N = mesh.shape_at(ip.cell, ip.xy)  # (n, 4)
+    K = ec.slot_cand[pos]  # (n, S) candidate of each slot of the point's cell
+    Kc = np.maximum(K, 0)
+    func = cand.func[Kc]
+    valid = (
+        (K >= 0)
+        & (cand.fracture[Kc] == ip.fracture[:, None])
+        & (dofmap.cand_dof[Kc] >= 0)
+        & ((func == HEAVISIDE) | (func == 1))
+    )
+    jump = np.where(func == HEAVISIDE, 2.0 * ip.ramp[:, None], 0.0)
+    for fi, fr in enumerate(fractures):
+        for ti, tip in enumerate(fr.tips):
+            m = valid & (func == 1) & (cand.fracture[Kc] == fi) & (cand.tip[Kc] == ti)
+            rows = np.nonzero(m)[0]
+            jump[m] = b1_jump(tip, ip.xy[rows])
+    a = np.maximum(ec.slot_node[pos], 0)
+    coef_all = np.where(valid, jump * np.take_along_axis(N, a, axis=1), 0.0)
+    J = int(valid.sum(axis=1).max())
+    order = np.argsort(~valid, axis=1, kind="stable")[:, :J]  # valid slots first
+    kept = np.take_along_axis(valid, order, axis=1)
+    first = np.take_along_axis(dofmap.cand_dof[Kc], order, axis=1)
+    coef = np.where(kept, np.take_along_axis(coef_all, order, axis=1), 0.0)
+    dofs = np.empty((n, 2 * J), np.int64)
+    dofs[:, 0::2] = np.where(kept, first, -1)
+    dofs[:, 1::2] = np.where(kept, first + 1, -1)
+    return np.ascontiguousarray(coef), dofs
 
 
 def build_contact(mesh, fractures, ip, ec, cand, dofmap, initial_stress) -> ContactSet:
