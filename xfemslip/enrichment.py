@@ -154,11 +154,21 @@ def _cell_lines(fr, b, tol):
     return out
 
 
-def _node_side(fractures, mesh, tol):
-    """H at the nodes per fracture: a node on the fracture takes +1 (eq. 12)."""
-    return [
-        np.where(fr.signed_distance(mesh.nodes) >= -tol, 1.0, -1.0) for fr in fractures
-    ]
+def _candidate_node_values(fractures, mesh, cand, tol):
+    """F(x_a) of every candidate at its own node (the shift of eq. 11), (k,).
+
+    A node on the fracture takes H = +1 (eq. 12).
+    """
+    out = np.zeros(cand.node.size)
+    for fi, fr in enumerate(fractures):
+        for tip in np.unique(cand.tip[cand.fracture == fi]):
+            rows = np.nonzero((cand.fracture == fi) & (cand.tip == tip))[0]
+            pts = mesh.nodes[cand.node[rows]]
+            side = np.where(fr.signed_distance(pts) >= -tol, 1.0, -1.0)
+            F = _group_values(fractures, fi, int(tip), pts, side, tol)[0]
+            j = np.where(cand.func[rows] == HEAVISIDE, 0, cand.func[rows] - 1)
+            out[rows] = F[np.arange(rows.size), j]
+    return out
 
 
 def _cell_rule(mesh, c, fractures, frs, has_branch, tol):
@@ -176,7 +186,7 @@ def _cell_rule(mesh, c, fractures, frs, has_branch, tol):
 def build_enriched_cells(mesh, fractures, cand: Candidates) -> EnrichedCells:
     """Slots, sub-cell quadrature and enrichment values of every enriched cell."""
     tol = GEOMETRY_TOL * mesh.h_min
-    node_side = _node_side(fractures, mesh, tol)
+    cand_fnode = _candidate_node_values(fractures, mesh, cand, tol)
     slots_of = {}
     if cand.node.size:
         node_cells = _node_cells(mesh)
@@ -208,10 +218,7 @@ def build_enriched_cells(mesh, fractures, cand: Candidates) -> EnrichedCells:
             fi, tip = int(cand.fracture[k]), int(cand.tip[k])
             slot_cand[e, s] = k
             slot_node[e, s] = int(np.nonzero(mesh.cells[c] == node)[0][0])
-            side_n = node_side[fi][node : node + 1]
-            slot_fnode[e, s] = candidate_values(
-                fractures, cand, k, mesh.nodes[node : node + 1], side_n, tol
-            )[0][0]
+            slot_fnode[e, s] = cand_fnode[k]
             if (fi, tip) not in cache:
                 st = side_t[fi]
                 cache[fi, tip] = (
