@@ -6,10 +6,12 @@ its errors to messages and exit codes.  It does no numerics.
 Exit codes:
 
 - 0: success;
-- 1: the run failed (``ConvergenceError``, ``OutputError``, ``MeshError``,
-  ``GeometryError``, any other ``XfemslipError``);
-- 2: bad input (``CaseError``, ``xfemslip.errors.UsageError``, a missing case
-  file, bad command-line options);
+- 1: the run failed (``ConvergenceError``, ``OutputError``, any other
+  ``XfemslipError``);
+- 2: bad input (``CaseError``, ``GeometryError`` and ``MeshError`` -- input
+  that validates key by key but cannot be built, e.g. intersecting fractures --
+  ``xfemslip.errors.UsageError``, a missing case file, bad command-line
+  options);
 - 130: interrupted (Ctrl-C).
 
 A library error is reported as one line ``Error: <message>`` on stderr; the
@@ -31,7 +33,13 @@ from pathlib import Path
 import click
 
 from xfemslip import __version__
-from xfemslip.errors import CaseError, UsageError, XfemslipError
+from xfemslip.errors import (
+    CaseError,
+    GeometryError,
+    MeshError,
+    UsageError,
+    XfemslipError,
+)
 
 logger = logging.getLogger(__name__)
 
@@ -97,7 +105,7 @@ def _reported_errors(debug: bool) -> Iterator[None]:
         if debug:
             click.secho(traceback.format_exc().rstrip(), err=True, dim=True)
         click.echo(f"Error: {_one_line(err)}", err=True)
-        usage = isinstance(err, CaseError | UsageError)
+        usage = isinstance(err, CaseError | UsageError | GeometryError | MeshError)
         raise click.exceptions.Exit(EXIT_USAGE if usage else EXIT_FAILURE) from None
     except KeyboardInterrupt:
         if debug:
@@ -176,12 +184,15 @@ def run(
 def check(case: Path, debug: bool) -> None:
     """Validate CASE and print its settings in SI units.
 
-    Nothing is built or solved.
+    Besides the keys, the geometry is checked (fractures against the mesh,
+    boundary corners); nothing is assembled or solved.
     """
     with _reported_errors(debug):
         spec = _load(case)
         from xfemslip.case import describe
+        from xfemslip.simulation import check_geometry
 
+        check_geometry(spec)
         click.echo(describe(spec))
 
 

@@ -19,7 +19,7 @@ from xfemslip.assembly import BulkSystem, assemble_bulk
 from xfemslip.boundary import dirichlet, hold_enriched, traction_load
 from xfemslip.contact import ContactSet, build_contact
 from xfemslip.enrichment import EnrichedCells, build_enriched_cells, find_candidates
-from xfemslip.errors import ConvergenceError, OutputError, UsageError
+from xfemslip.errors import ConvergenceError, GeometryError, OutputError, UsageError
 from xfemslip.geometry import build_fractures
 from xfemslip.material import elasticity_matrix
 from xfemslip.mesh import Mesh, build_mesh
@@ -59,13 +59,31 @@ class RunSummary:
     n_dofs: int
 
 
+def _geometry(spec):
+    """Mesh and fractures; geometry errors name the case file."""
+    mesh = build_mesh(spec.mesh.x, spec.mesh.y)
+    box = np.array([mesh.x[0], mesh.x[-1], mesh.y[0], mesh.y[-1]])
+    try:
+        return mesh, build_fractures(mesh, spec.fractures, box)
+    except GeometryError as err:
+        raise GeometryError(f"{spec.path}: {err}") from None
+
+
+def check_geometry(spec) -> None:
+    """What ``xfemslip check`` adds to key validation: fractures against the
+    mesh and the prescribed values at boundary corners (GeometryError)."""
+    mesh, _ = _geometry(spec)
+    try:
+        dirichlet(mesh, spec.boundary)
+    except GeometryError as err:
+        raise GeometryError(f"{spec.path}: {err}") from None
+
+
 def build_model(spec) -> Model:
     """Build the discrete problem of a validated case."""
-    mesh = build_mesh(spec.mesh.x, spec.mesh.y)
+    mesh, fractures = _geometry(spec)
     mat = spec.material
     D = elasticity_matrix(mat.E, mat.nu, mat.model)
-    box = np.array([mesh.x[0], mesh.x[-1], mesh.y[0], mesh.y[-1]])
-    fractures = build_fractures(mesh, spec.fractures, box)
     cand = find_candidates(mesh, fractures)
     ec = build_enriched_cells(mesh, fractures, cand)
     ip = interface_points(fractures, mesh.h_min)
@@ -73,7 +91,10 @@ def build_model(spec) -> Model:
     contact = build_contact(
         mesh, fractures, ip, ec, cand, bulk.dofmap, spec.loading.initial_stress
     )
-    bc = hold_enriched(dirichlet(mesh, spec.boundary), cand, bulk.dofmap)
+    try:
+        bc = hold_enriched(dirichlet(mesh, spec.boundary), cand, bulk.dofmap)
+    except GeometryError as err:
+        raise GeometryError(f"{spec.path}: {err}") from None
     F = traction_load(
         mesh, spec.boundary, spec.loading, ec, cand, bulk.dofmap, fractures
     )

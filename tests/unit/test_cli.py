@@ -250,3 +250,58 @@ def test_run_programming_error_propagates(runner, fake, case_file):
     result = runner.invoke(cli, ["run", "-q", str(case_file)])
     assert isinstance(result.exception, ValueError)
     assert result.exit_code != 0
+
+
+# --- input that validates key by key but cannot be built: exit 2, no output ---
+
+_GEOMETRY_CASE = """
+[domain]
+size = [1.0, 1.0]
+[mesh]
+elements = [10, 10]
+[material]
+E = 5.0e9
+nu = 0.3
+{fractures}
+[boundary]
+bottom = {{ ux = 0.0, uy = 0.0 }}
+left = {{ ux = {left_ux} }}
+top = {{ uy = -0.001 }}
+"""
+_FRACTURE = """[[fractures]]
+points = [{points}]
+friction = 0.1
+kn = 5.0e12
+kt = 5.0e12
+"""
+
+
+@pytest.mark.parametrize(
+    ("fractures", "left_ux", "words"),
+    [
+        (
+            _FRACTURE.format(points="[0.2, 0.2], [0.8, 0.8]")
+            + _FRACTURE.format(points="[0.2, 0.8], [0.8, 0.2]"),
+            "0.0",
+            "fractures[0] and fractures[1] intersect",
+        ),
+        (
+            _FRACTURE.format(points="[0.2, 0.2], [0.8, 0.8]"),
+            "0.01",
+            "boundary.bottom and boundary.left prescribe different ux",
+        ),
+    ],
+    ids=["intersecting-fractures", "corner-conflict"],
+)
+@pytest.mark.parametrize("command", ["check", "run"])
+def test_geometry_errors_are_bad_input(tmp_path, command, fractures, left_ux, words):
+    path = tmp_path / "geo.toml"
+    path.write_text(_GEOMETRY_CASE.format(fractures=fractures, left_ux=left_ux))
+    out = tmp_path / "out"
+    args = [command, str(path)] + (["-o", str(out), "-q"] if command == "run" else [])
+    result = CliRunner().invoke(cli, args)
+    assert result.exit_code == 2, result.output
+    lines = [line for line in result.stderr.splitlines() if line.strip()]
+    assert len(lines) == 1 and lines[0].startswith("Error: ")
+    assert str(path) in lines[0] and words in lines[0]
+    assert not out.exists()
