@@ -17,35 +17,14 @@ import numpy as np
 import pytest
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
+from casegen import fracture_case
 
 from xfemslip import kernels
 from xfemslip.case import loads_case
 from xfemslip.enrichment import ENRICHMENT_DIAG_RATIO, HEAVISIDE, find_candidates
 from xfemslip.simulation import build_model
 
-
-def _case(points, tip="ramp", n=6, size=6.0):
-    return loads_case(f"""
-[domain]
-size = [{size!r}, {size!r}]
-[mesh]
-elements = [{n}, {n}]
-[material]
-E = 10.0e9
-nu = 0.3
-model = "plane_strain"
-[[fractures]]
-points = {points!r}
-friction = 0.5
-kn = 1.0e12
-kt = 1.0e12
-tip = "{tip}"
-[loading]
-stress = {{ xx = -20.0e6, yy = -40.0e6, xy = 0.0 }}
-[boundary]
-bottom = {{ ux = 0.0, uy = 0.0 }}
-top = "traction"
-""")
+_case = fracture_case
 
 
 _CACHE = {}

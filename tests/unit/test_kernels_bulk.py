@@ -12,8 +12,8 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from casegen import fracture_case
 
-from xfemslip.case import loads_case
 from xfemslip.enrichment import HEAVISIDE, find_candidates
 from xfemslip.kernels import enriched_cell_matrices, rectangle_stiffness
 from xfemslip.kernels.shape import q4_shape
@@ -26,28 +26,7 @@ XI = np.array([-1.0, 1.0, 1.0, -1.0])
 ETA = np.array([-1.0, -1.0, 1.0, 1.0])
 
 
-def _case(points, tip="ramp", n=6, size=6.0):
-    return loads_case(f"""
-[domain]
-size = [{size!r}, {size!r}]
-[mesh]
-elements = [{n}, {n}]
-[material]
-E = 10.0e9
-nu = 0.3
-model = "plane_strain"
-[[fractures]]
-points = {points!r}
-friction = 0.5
-kn = 1.0e12
-kt = 1.0e12
-tip = "{tip}"
-[loading]
-stress = {{ xx = -20.0e6, yy = -40.0e6, xy = 0.0 }}
-[boundary]
-bottom = {{ ux = 0.0, uy = 0.0 }}
-top = "traction"
-""")
+_case = fracture_case
 
 
 MODELS = {
