@@ -55,7 +55,7 @@ def dirichlet(mesh, boundary) -> Dirichlet:
                 f"boundary.{name}: values shape {v.shape} != {(nodes.size, 2)}"
             )
         scale = max(scale, float(np.nanmax(np.abs(v), initial=0.0)))
-        for node, row in zip(nodes, v):
+        for node, row in zip(nodes, v, strict=True):
             for c in range(2):
                 if np.isnan(row[c]):
                     continue
@@ -65,7 +65,8 @@ def dirichlet(mesh, boundary) -> Dirichlet:
                 ):
                     comp = "xy"[c]
                     raise GeometryError(
-                        f"boundary.{owner[dof]} and boundary.{name} prescribe different "
+                        f"boundary.{owner[dof]} and boundary.{name} prescribe "
+                        "different "
                         f"u{comp} at their common corner ({mesh.nodes[node, 0]:g}, "
                         f"{mesh.nodes[node, 1]:g}): {values[dof]:g} and {row[c]:g} m"
                     )
@@ -103,7 +104,11 @@ def hold_enriched(bc: Dirichlet, cand, dofmap) -> Dirichlet:
     by_node = {}
     for k in np.nonzero(kept)[0]:
         by_node.setdefault(int(cand.node[k]), []).append(int(dofmap.cand_dof[k]))
-    extra = [d + int(c) for n, c in zip(node, comp) for d in by_node.get(int(n), ())]
+    extra = [
+        d + int(c)
+        for n, c in zip(node, comp, strict=True)
+        for d in by_node.get(int(n), ())
+    ]
     if not extra:
         return bc
     dofs = np.concatenate([bc.dofs, np.array(extra, np.int64)])
@@ -113,7 +118,7 @@ def hold_enriched(bc: Dirichlet, cand, dofmap) -> Dirichlet:
 
 
 def _rigid_modes(mesh, dofs):
-    """Rows of the three rigid-body modes (ux, uy, rotation about the centre) at dofs."""
+    """Rigid-body modes (ux, uy, rotation about the centre) at dofs, (m, 3)."""
     centre = mesh.nodes.mean(axis=0)
     node, comp = dofs // 2, dofs % 2
     rel = mesh.nodes[node] - centre
@@ -184,7 +189,7 @@ def traction_load(mesh, boundary, loading, ec, cand, dofmap, fractures) -> np.nd
         t = (S @ np.array(OUTWARD[name])) * mask
         nodes = mesh.edge_nodes(name)
         cells = edge_cells(mesh, name)
-        for p, q, cell in zip(nodes[:-1], nodes[1:], cells):
+        for p, q, cell in zip(nodes[:-1], nodes[1:], cells, strict=True):
             length = np.linalg.norm(mesh.nodes[q] - mesh.nodes[p])
             F[2 * p : 2 * p + 2] += 0.5 * length * t
             F[2 * q : 2 * q + 2] += 0.5 * length * t
@@ -230,9 +235,9 @@ def _enriched_edge_load(F, mesh, cell, e, p, q, t, ec, cand, dofmap, fractures):
                     cuts.append(s)
     cuts = np.sort(cuts)
     length = np.linalg.norm(xq - xp)
-    for a0, a1 in zip(cuts[:-1], cuts[1:]):
+    for a0, a1 in zip(cuts[:-1], cuts[1:], strict=True):
         mid = xp + 0.5 * (a0 + a1) * (xq - xp)
-        for g, w in zip(LINE_POINTS, LINE_WEIGHTS):
+        for g, w in zip(LINE_POINTS, LINE_WEIGHTS, strict=True):
             s = 0.5 * (a0 + a1) + 0.5 * (a1 - a0) * g
             x = xp + s * (xq - xp)
             N = mesh.shape_at(np.array([cell]), x[None])[0]

@@ -130,17 +130,15 @@ def _group_values(fractures, fi, tip, pts, side, tol):
 
 def _cell_lines(fr, b, tol):
     """Kink lines of fracture fr that can cross the cell with bounds b."""
-    out = []
     lo = np.minimum(fr.points[:-1], fr.points[1:]) - tol
     hi = np.maximum(fr.points[:-1], fr.points[1:]) + tol
-    for k in range(fr.normal.shape[0]):
-        if (
-            lo[k, 0] <= b[1]
-            and hi[k, 0] >= b[0]
-            and lo[k, 1] <= b[3]
-            and hi[k, 1] >= b[2]
-        ):
-            out.append((fr.points[k], fr.normal[k]))
+    near = (
+        (lo[:, 0] <= b[1])
+        & (hi[:, 0] >= b[0])
+        & (lo[:, 1] <= b[3])
+        & (hi[:, 1] >= b[2])
+    )
+    out = [(fr.points[k], fr.normal[k]) for k in np.nonzero(near)[0]]
     for tip in fr.tips:
         # the ramp's kink lines are infinite: they cross every cell of the strip
         # -l <= psi <= 0, not only the cells near the tip
@@ -232,7 +230,7 @@ def build_enriched_cells(mesh, fractures, cand: Candidates) -> EnrichedCells:
             F[:, s], gF[:, s] = Fq[:, j], gq[:, j]
             Fv[:, :, s] = Fvert[:, j].reshape(-1, 3)
         for key, val in zip(
-            ("xy", "w", "F", "gF", "tris", "Fv"), (xy, w, F, gF, tris, Fv)
+            ("xy", "w", "F", "gF", "tris", "Fv"), (xy, w, F, gF, tris, Fv), strict=True
         ):
             parts[key].append(val)
         qp_off.append(qp_off[-1] + xy.shape[0])

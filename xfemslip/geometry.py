@@ -156,7 +156,7 @@ def clip_segment(p0, p1, boxes):
 def _clip_to_domain(points, box, tol, key):
     """Clip a polyline to the domain box; it must stay in one connected piece."""
     kept = []
-    for p0, p1 in zip(points[:-1], points[1:]):
+    for p0, p1 in zip(points[:-1], points[1:], strict=True):
         ta, tb = clip_segment(p0, p1, box[None, :])
         if tb[0] - ta[0] <= 0.0:
             kept.append(None)
@@ -195,9 +195,9 @@ def _on_boundary(p, box, tol):
 
 
 def _cell_pieces(mesh, points, tol):
-    """Pieces of each segment in each cell, deduplicated, in order along the polyline."""
+    """Pieces of each segment in each cell, deduplicated, in polyline order."""
     cells, segs, tas, tbs = [], [], [], []
-    for k, (p0, p1) in enumerate(zip(points[:-1], points[1:])):
+    for k, (p0, p1) in enumerate(zip(points[:-1], points[1:], strict=True)):
         lo, hi = np.minimum(p0, p1) - tol, np.maximum(p0, p1) + tol
         i0 = max(np.searchsorted(mesh.x, lo[0], side="right") - 1, 0)
         i1 = min(np.searchsorted(mesh.x, hi[0], side="left"), mesh.nx)
@@ -210,7 +210,7 @@ def _cell_pieces(mesh, points, tol):
         ok = (tb - ta) * seg_len > tol
         order = np.argsort(ta[ok], kind="stable")
         seen = set()
-        for c, a, b in zip(cand[ok][order], ta[ok][order], tb[ok][order]):
+        for c, a, b in zip(cand[ok][order], ta[ok][order], tb[ok][order], strict=True):
             key = (round(a * seg_len / tol), round(b * seg_len / tol))
             if key in seen:  # the same piece on the edge shared by two cells
                 continue
@@ -320,7 +320,8 @@ def _tip_enrichment(spec, key, tips, length):
         if limit < diag:
             logger.warning(
                 '%s: tip = "branch" needs a straight tip segment of at least 2 cell '
-                "diagonals (%.3g m) on each side of a tip; this fracture is too short or "
+                "diagonals (%.3g m) on each side of a tip; this fracture is too short "
+                "or "
                 'kinked near a tip, so it uses tip = "ramp"',
                 key,
                 2 * diag,
@@ -377,8 +378,10 @@ def build_fractures(mesh, specs, box) -> tuple[Fracture, ...]:
                 for j in range(len(pb) - 1):
                     if _segments_cross(pa[i], pa[i + 1], pb[j], pb[j + 1]):
                         raise GeometryError(
-                            f"fractures[{fracs[a].index}] and fractures[{fracs[b].index}] "
-                            "intersect: intersecting fractures (networks) are not supported "
+                            f"fractures[{fracs[a].index}] and "
+                            f"fractures[{fracs[b].index}] "
+                            "intersect: intersecting fractures (networks) are not "
+                            "supported "
                             "yet; move one so they do not touch"
                         )
     return fracs

@@ -75,7 +75,7 @@ def fracture_fields(ip, res, n_fractures) -> list[FractureFields]:
 
 
 def vis_mesh(mesh, ec, bulk, u) -> VisMesh:
-    """Bulk mesh with enriched cells split into sub-triangles carrying their own side."""
+    """Bulk mesh with enriched cells split into sub-triangles, each on its side."""
     n_std = 2 * mesh.n_nodes
     U = u[:n_std].reshape(-1, 2)
     is_enr = np.zeros(mesh.n_cells, bool)

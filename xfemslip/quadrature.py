@@ -17,7 +17,8 @@ import numpy as np
 
 from xfemslip.geometry import GEOMETRY_TOL
 
-# Dunavant (1985) degree-5 rule on the reference triangle: barycentric points, weights (sum 1).
+# Dunavant (1985) degree-5 rule on the reference triangle: barycentric points and
+# weights (summing to 1).
 _A1, _B1 = 0.059715871789770, 0.470142064105115
 _A2, _B2 = 0.797426985353087, 0.101286507323456
 TRI_BARY = np.array(
@@ -170,7 +171,9 @@ def interface_points(fractures, min_cell: float | None = None) -> InterfacePoint
         k: [] for k in ("fracture", "cell", "xy", "s", "weight", "normal", "tangent")
     }
     for fi, fr in enumerate(fractures):
-        for cell, seg, (ta, tb) in zip(fr.piece_cell, fr.piece_seg, fr.piece_t):
+        for cell, seg, (ta, tb) in zip(
+            fr.piece_cell, fr.piece_seg, fr.piece_t, strict=True
+        ):
             p0 = fr.points[seg]
             d = fr.points[seg + 1] - p0
             cuts = [ta, tb]
@@ -183,7 +186,7 @@ def interface_points(fractures, min_cell: float | None = None) -> InterfacePoint
             cuts = np.sort(cuts)
             tol = GEOMETRY_TOL * min_cell if min_cell else 1e-12 * fr.length[seg]
             keep = np.diff(cuts) * fr.length[seg] > tol
-            for a, b in zip(cuts[:-1][keep], cuts[1:][keep]):
+            for a, b in zip(cuts[:-1][keep], cuts[1:][keep], strict=True):
                 t = 0.5 * (a + b) + 0.5 * (b - a) * LINE_POINTS
                 cols["fracture"].append(np.full(t.size, fi))
                 cols["cell"].append(np.full(t.size, cell))

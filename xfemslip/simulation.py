@@ -1,4 +1,4 @@
-"""run_case: case spec -> mesh -> fractures -> enrichment -> quadrature -> Newton -> output.
+"""run_case: case -> mesh -> fractures -> enrichment -> quadrature -> Newton -> output.
 
 Testable without the CLI.  Output files follow ``output-format.md``; when a
 load step fails, the steps already converged are written (``converged =
@@ -132,7 +132,7 @@ def build_model(spec) -> Model:
 
 
 def floating_parts(mesh, fractures, ip, bc):
-    """Fractures that cut the domain in two and leave one part without prescribed dofs."""
+    """Fractures cutting the domain in two, one part without prescribed dofs."""
     std = bc.dofs[bc.dofs < 2 * mesh.n_nodes]  # enrichment dofs are not nodes
     fixed_nodes = np.unique(std // 2)
     out = []
@@ -263,7 +263,7 @@ def write_output(model: Model, results, out_dir: Path, *, converged, wall, itera
 
 def _write_vtu(model, results, fields, out_dir, series, vtu):
     entries = []
-    for r, f in zip(results, fields):
+    for r, f in zip(results, fields, strict=True):
         vis = vis_mesh(model.mesh, model.ec, model.bulk, r.u)
         cell_data = {
             "stress": f.stress,

@@ -124,7 +124,8 @@ class NewtonSolver:
             residuals.append(eta)
             switches.append(flips)
             logger.info(
-                "step %d/%d iteration %d: eta = %.3e; contact points: %d slip, %d stick, "
+                "step %d/%d iteration %d: eta = %.3e; contact points: %d slip, %d "
+                "stick, "
                 "%d open; %d switched",
                 k,
                 steps,
@@ -154,7 +155,7 @@ class NewtonSolver:
         raise AssertionError("unreachable")
 
     def _check_floating(self, res, k, it, eta):
-        """A block held only by a fracture on which no point sticks slides without bound."""
+        """A block held only by a fracture with no sticking point slides unbounded."""
         for index, mask in self.p.floating or []:
             if mask.any() and not np.any(res.state[mask] == STICK):
                 raise self._fail(
@@ -162,10 +163,14 @@ class NewtonSolver:
                     it,
                     eta,
                     0,
-                    f"fractures[{index}] cuts the domain in two and one part has no prescribed "
-                    "displacement, so only the fracture holds it; no point of the fracture "
-                    "sticks, so that part slides without bound (no static equilibrium). "
-                    "Prescribe a displacement on that part (e.g. on its edge) or raise the "
+                    f"fractures[{index}] cuts the domain in two and one part has no "
+                    "prescribed "
+                    "displacement, so only the fracture holds it; no point of the "
+                    "fracture "
+                    "sticks, so that part slides without bound (no static "
+                    "equilibrium). "
+                    "Prescribe a displacement on that part (e.g. on its edge) or raise "
+                    "the "
                     "friction or cohesion",
                 )
 
@@ -191,8 +196,10 @@ class NewtonSolver:
 
     def _fail(self, k, it, eta, flips, why):
         return ConvergenceError(
-            f"load step {k} did not converge: {why}; iteration {it}, residual eta = {eta:.3e} "
-            f"(tolerance {self.tol:.1e}), {flips} stick/slip switches in the last iteration; "
+            f"load step {k} did not converge: {why}; iteration {it}, residual eta = "
+            f"{eta:.3e} "
+            f"(tolerance {self.tol:.1e}), {flips} stick/slip switches in the last "
+            "iteration; "
             f"{len(self.completed)} converged step(s) kept",
             step=k,
             iteration=it,
