@@ -62,7 +62,11 @@ def split_polygon(poly: np.ndarray, point: np.ndarray, normal: np.ndarray, tol: 
             x = p + dp / (dp - dq) * (q - p)
             pos.append(x)
             neg.append(x)
-    return [np.array(pos), np.array(neg)]
+    # a line within tol of a corner can leave a degenerate piece (3 coincident
+    # points): keep only pieces with area
+    pieces = [np.array(v) for v in (pos, neg) if len(v) >= 3]
+    pieces = [v for v in pieces if polygon_area(v) > tol * tol]
+    return pieces or [poly]
 
 
 def polygon_area(poly: np.ndarray) -> float:
