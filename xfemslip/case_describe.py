@@ -1,0 +1,146 @@
+"""``describe``: the resolved SI summary of a case printed by ``xfemslip check``.
+
+Private helper of :mod:`xfemslip.case`, which stays the ONLY entry point for
+validating user input (house style: case.py is the only place user input is
+validated); import the public names from ``xfemslip.case``, not from here.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+
+from xfemslip.case_specs import (
+    EDGES,
+    CaseSpec,
+    EdgeSpec,
+    FractureSpec,
+    LoadingSpec,
+    MaterialSpec,
+    MeshSpec,
+    SolverSpec,
+)
+from xfemslip.case_tables import _fmt
+
+
+def _with_unit(value: Any, unit: str) -> str:
+    """``5e+09 Pa``; no unit for dimensionless ("-") or unitless ("") values."""
+    text = _fmt(value) if isinstance(value, int | float) else str(value)
+    return f"{text} {unit}" if unit not in ("", "-") else text
+
+
+def _describe_axis(coords: np.ndarray, label: str) -> str:
+    """Element sizes along one axis: uniform or graded (min .. max)."""
+    h = np.diff(coords)
+    unit = MeshSpec.UNITS[label]
+    if np.ptp(h) <= 1e-9 * h.max():
+        return f"d{label} = {_with_unit(float(h[0]), unit)} (uniform)"
+    return (
+        f"d{label} = {_fmt(float(h.min()))} .. {_with_unit(float(h.max()), unit)} "
+        "(graded)"
+    )
+
+
+def _describe_fracture(spec: FractureSpec) -> list[str]:
+    """Points, length, segment angles and contact parameters of one fracture."""
+    p = spec.points
+    seg = np.diff(p, axis=0)
+    angles = np.degrees(np.arctan2(seg[:, 1], seg[:, 0]))
+    units = FractureSpec.UNITS
+    points = " -> ".join(f"({_fmt(float(x))}, {_fmt(float(y))})" for x, y in p)
+    params = ", ".join(
+        f"{k} = {_with_unit(getattr(spec, k), units[k])}"
+        for k in ("friction", "cohesion", "kn", "kt")
+    )
+    tip = spec.tip + (
+        f", radius {_with_unit(spec.tip_radius, units['tip_radius'])}"
+        if spec.tip_radius is not None
+        else (", radius 4 tip-cell sizes (automatic)" if spec.tip == "branch" else "")
+    )
+    return [
+        f"  [{spec.index}] points [{units['points']}]: {points}",
+        f"      length {_with_unit(float(np.hypot(*seg.T).sum()), units['points'])}, "
+        f"angle {', '.join(_fmt(float(a)) for a in angles)} deg",
+        f"      {params}",
+        f"      tip: {tip}",
+    ]
+
+
+def _describe_edge(name: str, edge: EdgeSpec) -> str:
+    """One edge's boundary condition."""
+    if edge.kind == "traction":
+        return f"  {name}: traction = loading.stress . n"
+    if edge.kind == "free":
+        note = " (not given in [boundary])" if edge.source == "default" else ""
+        return f"  {name}: free (zero traction){note}"
+    parts = []
+    for c, label in enumerate(("ux", "uy")):
+        column = edge.values[:, c]
+        if np.isnan(column).all():
+            extra = " (traction = loading.stress . n)" if edge.traction else ""
+            parts.append(f"{label} free{extra}")
+        elif np.ptp(column) == 0.0:
+            parts.append(
+                f"{label} = {_with_unit(float(column[0]), EdgeSpec.UNITS['values'])}"
+            )
+        else:
+            parts.append(
+                f"{label} = {_fmt(float(column.min()))} .. "
+                f"{_with_unit(float(column.max()), EdgeSpec.UNITS['values'])}"
+            )
+    return (
+        f"  {name}: displacement {', '.join(parts)} at {len(edge.values)} nodes "
+        f"[{edge.source}]"
+    )
+
+
+def _describe_stress(stress: tuple[float, float, float] | None) -> str:
+    """``(xx, yy, xy) = (...) Pa`` or none."""
+    if stress is None:
+        return "none"
+    values = ", ".join(_fmt(v) for v in stress)
+    return f"(xx, yy, xy) = ({values}) {LoadingSpec.UNITS['stress']}"
+
+
+def describe(spec: CaseSpec) -> str:
+    """Human-readable summary of a resolved case (SI units, tension positive).
+
+    Printed by ``xfemslip check``: domain, mesh (element sizes, graded or not),
+    material, fractures, loading, every edge's condition (edges not given in the
+    file are reported as free), solver options (from SOLVER_OPTIONS) and output.
+    """
+    from xfemslip.case import SOLVER_OPTIONS  # lazy: case.py imports this module
+
+    (x0, y0), (w, h) = spec.origin, spec.size
+    nx, ny = spec.mesh.x.size - 1, spec.mesh.y.size - 1
+    m = spec.material
+    lines = [
+        f"case {spec.name!r} ({spec.path})",
+        f"domain: [{_fmt(x0)}, {_fmt(x0 + w)}] x [{_fmt(y0)}, {_fmt(y0 + h)}] m "
+        f"(size {_fmt(w)} x {_fmt(h)} m)",
+        f"mesh: {nx} x {ny} Q4 elements, {(nx + 1) * (ny + 1)} nodes; "
+        f"{_describe_axis(spec.mesh.x, 'x')}; {_describe_axis(spec.mesh.y, 'y')}",
+        f"material: E = {_with_unit(m.E, MaterialSpec.UNITS['E'])}, nu = {_fmt(m.nu)}, "
+        f"{m.model}",
+        f"fractures: {len(spec.fractures)}",
+    ]
+    for fracture in spec.fractures:
+        lines += _describe_fracture(fracture)
+    steps = spec.loading.steps
+    lines += [
+        f"loading: stress {_describe_stress(spec.loading.stress)}; "
+        f"initial_stress {_describe_stress(spec.loading.initial_stress)}; "
+        f"{steps} step{'' if steps == 1 else 's'}",
+        "boundary:",
+    ]
+    lines += [_describe_edge(e, getattr(spec.boundary, e)) for e in EDGES]
+    lines.append("solver:")
+    for option in SOLVER_OPTIONS:
+        value = getattr(spec.solver, option.name)
+        lines.append(
+            f"  {option.name} = {_with_unit(value, SolverSpec.UNITS[option.name])}"
+            f"  ({option.doc})"
+        )
+    lines.append(f"output: {spec.output.directory} ({', '.join(spec.output.formats)})")
+    return "\n".join(lines)

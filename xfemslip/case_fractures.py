@@ -1,0 +1,191 @@
+"""``[[fractures]]`` -> ``FractureSpec`` tuple: polyline (``points`` or
+``center``/``length``/``angle``), contact parameters and tip treatment.
+
+Private helper of :mod:`xfemslip.case`, which stays the ONLY entry point for
+validating user input (house style: case.py is the only place user input is
+validated); import the public names from ``xfemslip.case``, not from here.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from xfemslip.case_grid import _Grid
+from xfemslip.case_polyline import _check_polyline
+from xfemslip.case_specs import FractureSpec
+from xfemslip.case_tables import (
+    _NON_NEGATIVE,
+    _POSITIVE,
+    _check_number,
+    _check_vector,
+    _exact,
+    _frozen,
+    _show,
+    _Table,
+)
+
+FRACTURE_KEYS = (
+    "center",
+    "length",
+    "angle",
+    "points",
+    "friction",
+    "cohesion",
+    "kn",
+    "kt",
+    "tip",
+)
+TIP_KINDS = ("branch", "ramp")
+TIP_KEYS = ("kind", "radius")
+
+
+def _cos_sin_degrees(angle: float) -> tuple[float, float]:
+    """cos and sin of ``angle`` [deg], exact at multiples of 45 degrees.
+
+    math.cos(math.pi / 2) is 6e-17, not 0, and cos/sin(pi/4) differ in the last
+    bit: reducing to [0, 45] and rotating by quarter turns keeps vertical,
+    horizontal and diagonal fractures exactly on their lines.
+    """
+    turns, rest = divmod(angle, 90.0)  # rest in [0, 90)
+    if rest == 45.0:
+        c = s = math.sqrt(0.5)
+    elif rest < 45.0:
+        c, s = math.cos(math.radians(rest)), math.sin(math.radians(rest))
+    else:  # 90 - rest is exact here (Sterbenz)
+        s, c = math.cos(math.radians(90.0 - rest)), math.sin(math.radians(90.0 - rest))
+    for _ in range(int(turns) % 4):
+        c, s = -s, c  # rotate by +90 degrees
+    return c + 0.0, s + 0.0  # + 0.0 turns -0.0 into 0.0
+
+
+def _read_points(table: _Table) -> np.ndarray | None:
+    """``points``: an array of >= 2 points, each two finite numbers [m]."""
+    value = table.data["points"]
+    key = table.key("points")
+    if not isinstance(value, list) or len(value) < 2:
+        table.error(
+            "points", f"expected an array of >= 2 points [x, y], got {_show(value)}"
+        )
+        return None
+
+    def check(v, k):
+        return _check_number(v, k, table.problems)
+
+    points = [
+        _check_vector(p, f"{key}[{i}]", table.problems, 2, check)
+        for i, p in enumerate(value)
+    ]
+    return (
+        None if any(p is None for p in points) else np.array(points, dtype=np.float64)
+    )
+
+
+def _fracture_points(table: _Table) -> np.ndarray | None:
+    """Polyline vertices from ``points`` or from ``center``/``length``/``angle``."""
+    given = [k for k in ("center", "length", "angle") if table.has(k)]
+    if given and table.has("points"):
+        table.error(
+            None,
+            "give either points or center, length and angle, not both "
+            f"(got points and {', '.join(given)})",
+        )
+        return None
+    if table.has("points"):
+        return _read_points(table)
+    if not given:
+        table.error(
+            "points",
+            "required key missing: give points = [[x0, y0], "
+            "[x1, y1], ...] or center, length and angle",
+        )
+        return None
+    hint = f" ({', '.join(given)} given: center, length and angle go together)"
+    center = table.numbers("center", 2, hint=hint)
+    length = table.number("length", rule=_POSITIVE, hint=hint)
+    angle = table.number("angle", hint=hint)
+    if center is None or length is None or angle is None:
+        return None
+    c, s = _cos_sin_degrees(angle)
+    with np.errstate(over="ignore", invalid="ignore"):
+        half = 0.5 * length * np.array([c, s])
+        points = np.array([np.asarray(center) - half, np.asarray(center) + half])
+    if not np.isfinite(points).all():
+        table.error(
+            "length",
+            f"center -/+ length/2 (cos angle, sin angle) overflows, "
+            f"got length {_exact(length)}",
+        )
+        return None
+    return points
+
+
+def _read_fracture(
+    table: _Table, index: int, grid: _Grid | None
+) -> FractureSpec | None:
+    """One [[fractures]] entry."""
+    start = len(table.problems)
+    points = _fracture_points(table)
+    friction = table.number("friction", rule=_NON_NEGATIVE)
+    cohesion = table.number("cohesion", 0.0, rule=_NON_NEGATIVE)
+    kn = table.number("kn", rule=_POSITIVE)
+    kt = table.number("kt", rule=_POSITIVE)
+    tip, radius = _read_tip(table)
+    if points is not None:
+        _check_polyline(table, points, grid)
+    if len(table.problems) > start:
+        return None
+    return FractureSpec(
+        index=index,
+        points=_frozen(points),
+        friction=friction,
+        cohesion=cohesion,
+        kn=kn,
+        kt=kt,
+        tip=tip,
+        tip_radius=radius,
+    )
+
+
+def _read_tip(table: _Table) -> tuple[str, float | None]:
+    """``tip = "branch"`` / ``"ramp"``, or ``tip = { kind = .., radius = .. }``.
+
+    branch: near-tip branch functions on the nodes within ``radius`` (m) of each
+    tip (default: 4 tip-cell sizes); ramp: the jump falls linearly to zero
+    across the tip cell.  Default "branch".
+    """
+    if not table.has("tip"):
+        return "branch", None
+    value = table.data["tip"]
+    if isinstance(value, dict):
+        sub = _Table(value, table.key("tip"), table.problems, TIP_KEYS)
+        kind = sub.choice("kind", TIP_KINDS, "branch")
+        radius = sub.number("radius", None, rule=_POSITIVE)
+        if radius is not None and kind == "ramp":
+            sub.error("radius", 'only used with kind = "branch"')
+        return kind, radius
+    return table.choice("tip", TIP_KINDS), None
+
+
+def _read_fractures(
+    root: _Table, grid: _Grid | None
+) -> tuple[FractureSpec, ...] | None:
+    """``[[fractures]]``: zero or more fracture tables."""
+    value = root.data.get("fractures", [])
+    if not isinstance(value, list):
+        root.error(
+            "fractures",
+            f"expected an array of tables [[fractures]], got "
+            f"{_show(value)} (write [[fractures]], not [fractures])",
+        )
+        return None
+    specs = []
+    for i, item in enumerate(value):
+        if not isinstance(item, dict):
+            root.error(f"fractures[{i}]", f"expected a table, got {_show(item)}")
+            specs.append(None)
+            continue
+        table = _Table(item, f"fractures[{i}]", root.problems, FRACTURE_KEYS)
+        specs.append(_read_fracture(table, i, grid))
+    return None if any(s is None for s in specs) else tuple(specs)
