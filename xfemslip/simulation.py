@@ -106,6 +106,9 @@ def build_model(spec) -> Model:
         contact=contact,
         n_dofs=bulk.dofmap.n_dofs,
         floating=floating_parts(mesh, fractures, ip, bc),
+        penalty_ratio=max((max(f.kn, f.kt) for f in fractures), default=0.0)
+        * mesh.h_min
+        / mat.E,
     )
     logger.info(
         "model: %d x %d cells, %d fracture(s), %d dofs (%d nodes enriched with %d "

@@ -30,6 +30,11 @@ from xfemslip.errors import ConvergenceError
 
 logger = logging.getLogger(__name__)
 
+# kn*h/E above this is named in the message of a Newton failure as a likely cause.
+PENALTY_RATIO_HIGH = 1.0e5
+# Step halvings tried by the line search before keeping the best trial.
+LINE_SEARCH_CUTS = 6
+
 TANGENTS = {"consistent": kernels.TANGENT_CONSISTENT, "secant": kernels.TANGENT_SECANT}
 
 
@@ -45,6 +50,8 @@ class Problem:
     # fracture that cuts the domain in two with one part left without any
     # prescribed displacement: that part is held by the fracture alone.
     floating: list = None
+    # largest penalty stiffness relative to the bulk, max(kn, kt) * h_min / E [-]
+    penalty_ratio: float = 0.0
 
 
 @dataclass
@@ -143,9 +150,9 @@ class NewtonSolver:
         prev_regime = _regime(c.state_committed, c.pt_committed)
         residuals = []
         switches = []
+        res = c.evaluate(u, self.mode, pt_prev, gt_prev)
+        r, eta = self._residual(u, lam, res)
         for it in range(self.max_it + 1):
-            res = c.evaluate(u, self.mode, pt_prev, gt_prev)
-            r, eta = self._residual(u, lam, res)
             regime = _regime(res.state, res.pt)
             flips = int(np.count_nonzero(regime != prev_regime))
             residuals.append(eta)
@@ -174,12 +181,55 @@ class NewtonSolver:
                 return u
             if it == self.max_it:
                 raise self._fail(
-                    k, it, eta, flips, f"no convergence in {self.max_it} iterations"
+                    k, it, eta, flips, self._no_convergence_reason(switches)
                 )
             du = self._solve(res, r, k, it, eta)
-            u[self.free] -= du
             pt_prev, gt_prev, prev_regime = res.pt, res.gt, regime
+            u, res, r, eta = self._line_search(u, du, lam, eta, pt_prev, gt_prev)
         raise AssertionError("unreachable")
+
+    def _line_search(self, u, du, lam, eta0, pt_prev, gt_prev):
+        """Backtracking on eta along the Newton direction (Armijo on the norm).
+
+        The full step is tried first and kept whenever it lowers eta, so
+        Newton's quadratic convergence is untouched near the solution.  With a
+        very stiff penalty the full step can overshoot the contact states
+        (open <-> slip ping-pong); halving the step up to LINE_SEARCH_CUTS
+        times restores a decrease.  If none decreases, the best trial is kept.
+        """
+        c = self.p.contact
+        best = None
+        alpha = 1.0
+        for _ in range(LINE_SEARCH_CUTS + 1):
+            trial = u.copy()
+            trial[self.free] -= alpha * du
+            res = c.evaluate(trial, self.mode, pt_prev, gt_prev)
+            r, eta = self._residual(trial, lam, res)
+            if best is None or eta < best[3]:
+                best = (trial, res, r, eta)
+            if eta <= (1.0 - 1.0e-4 * alpha) * eta0:
+                break
+            alpha *= 0.5
+        if alpha < 1.0:
+            logger.info(
+                "line search: step length %.3g (eta %.3e -> %.3e)", alpha, eta0, best[3]
+            )
+        return best
+
+    def _no_convergence_reason(self, switches):
+        """Why Newton stopped, and what to change."""
+        why = f"no convergence in {self.max_it} iterations"
+        if sum(1 for n in switches[-5:] if n > 0) >= 4:
+            why += "; the contact states keep switching between iterations (ping-pong)"
+            ratio = self.p.penalty_ratio
+            if ratio > PENALTY_RATIO_HIGH:
+                why += (
+                    f", and the penalty is very stiff (kn*h/E up to {ratio:.1e}; "
+                    f"10 to 1e4 is usual): lower kn/kt, or use more load steps"
+                )
+            else:
+                why += "; use more load steps or raise [solver] max_iterations"
+        return why
 
     def _check_floating(self, res, k, it, eta):
         """A block held only by a fracture with no sticking point slides unbounded."""

@@ -62,7 +62,15 @@ LIMIT = 0.03  # allowed relative L2 slip error at h = a/16 (n = 64)
 
 
 def run_inclined(
-    folder: Path, *, psi, friction, cohesion=0.0, plane="plane_strain", n=64, steps=1
+    folder: Path,
+    *,
+    psi,
+    friction,
+    cohesion=0.0,
+    plane="plane_strain",
+    n=64,
+    steps=1,
+    penalty=PENALTY,
 ):
     """Write the case and the four boundary CSV files into folder, run, read the result.
 
@@ -85,7 +93,7 @@ def run_inclined(
     t = (math.cos(math.radians(psi)), math.sin(math.radians(psi)))
     p0 = (CENTER[0] - A * t[0], CENTER[1] - A * t[1])
     p1 = (CENTER[0] + A * t[0], CENTER[1] + A * t[1])
-    kn = PENALTY * E / (2 * HALF / n)
+    kn = penalty * E / (2 * HALF / n)
     text = f"""name = "inclined-crack"
 
 [domain]
@@ -224,3 +232,23 @@ def test_slip_error_converges(tmp_path):
     assert errors[1] <= LIMIT
     assert errors[0] > errors[1] > errors[2], f"errors {errors} do not decrease"
     assert order >= 0.8, f"errors {errors}, observed order {order:.2f}"
+
+
+def test_stiff_penalty_converges_with_the_line_search(tmp_path):
+    """kn h / E = 1e6: the full Newton step overshoots the contact states and
+    ping-pongs between open and slip (no convergence in 30 iterations before
+    the line search; 28 iterations with it).  The slip is as accurate as with a
+    moderate penalty: measured 0.61 % (0.59 % at kn h / E = 100).
+
+    Known limitation (issue 3, traction stabilisation): at this stiffness the
+    contact tractions oscillate so much that about 30 % of the points report
+    OPEN although the crack is under 30 MPa of compression; so only the slip
+    is checked here, not the states.
+    """
+    s, slip, _, exact = run_inclined(
+        tmp_path, psi=30.0, friction=0.1, n=64, penalty=1.0e6
+    )
+    err = cf.relative_l2(s, slip, exact)
+    assert err < 0.01, f"relative L2 slip error {100 * err:.2f}%"
+    inner = np.abs(s - A) < 0.8 * A
+    assert np.all(np.sign(slip[inner]) == np.sign(exact[inner]))
