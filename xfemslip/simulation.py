@@ -259,12 +259,35 @@ def write_output(model: Model, results, out_dir: Path, *, converged, wall, itera
         attrs=attrs,
         load_steps=spec.loading.steps,
     )
-    if "vtu" not in spec.output.formats or not fields:
-        return
-    _write_vtu(model, results, fields, out_dir, spec.loading.steps > 1, vtu)
+    written = {out_dir / "result.h5"}
+    if "vtu" in spec.output.formats and fields:
+        written |= _write_vtu(
+            model, results, fields, out_dir, spec.loading.steps > 1, vtu
+        )
+    _remove_stale(out_dir, written)
 
 
-def _write_vtu(model, results, fields, out_dir, series, vtu):
+def _remove_stale(out_dir: Path, written: set) -> None:
+    """Remove output files of an earlier run (--overwrite) that this run did not
+    write, e.g. result.pvd and steps/ after a rerun with one load step, so the
+    folder never mixes two runs."""
+    old = [out_dir / name for name in OUTPUT_FILES]
+    steps = out_dir / "steps"
+    if steps.is_dir():
+        old += sorted(steps.glob("result_*.vtu")) + sorted(
+            steps.glob("fractures_*.vtu")
+        )
+    for path in old:
+        if path.exists() and path not in written:
+            path.unlink()
+            logger.info("removed %s of an earlier run", path)
+    if steps.is_dir() and not any(steps.iterdir()):
+        steps.rmdir()
+
+
+def _write_vtu(model, results, fields, out_dir, series, vtu) -> set:
+    """Write the VTU (and PVD) files; returns the paths written."""
+    written = set()
     entries = []
     for r, f in zip(results, fields, strict=True):
         vis = vis_mesh(model.mesh, model.ec, model.bulk, r.u)
@@ -279,12 +302,19 @@ def _write_vtu(model, results, fields, out_dir, series, vtu):
             name = f"steps/result_{r.step:04d}.vtu"
             (out_dir / "steps").mkdir(exist_ok=True)
             vtu.write_bulk(out_dir / name, vis, cell_data)
+            written.add(out_dir / name)
             if fr:
-                vtu.write_fractures(out_dir / f"steps/fractures_{r.step:04d}.vtu", fr)
+                frac_name = out_dir / f"steps/fractures_{r.step:04d}.vtu"
+                vtu.write_fractures(frac_name, fr)
+                written.add(frac_name)
             entries.append((r.load_factor, name))
         if is_last:
             vtu.write_bulk(out_dir / "result.vtu", vis, cell_data)
+            written.add(out_dir / "result.vtu")
             if fr:
                 vtu.write_fractures(out_dir / "fractures.vtu", fr)
+                written.add(out_dir / "fractures.vtu")
     if series:
         vtu.write_pvd(out_dir / "result.pvd", entries)
+        written.add(out_dir / "result.pvd")
+    return written

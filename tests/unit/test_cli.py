@@ -305,3 +305,43 @@ def test_geometry_errors_are_bad_input(tmp_path, command, fractures, left_ux, wo
     assert len(lines) == 1 and lines[0].startswith("Error: ")
     assert str(path) in lines[0] and words in lines[0]
     assert not out.exists()
+
+
+def test_overwrite_leaves_no_file_of_the_earlier_run(tmp_path):
+    """5 load steps (pvd + steps/), then 1 step without VTU into the same folder
+    with --overwrite: only result.h5 of the new run is left."""
+    case = tmp_path / "c.toml"
+    text = """
+[domain]
+size = [1.0, 1.0]
+[mesh]
+elements = [6, 6]
+[material]
+E = 1.0e9
+nu = 0.25
+[[fractures]]
+points = [[0.2, 0.3], [0.8, 0.7]]
+friction = 0.3
+kn = 1.0e12
+kt = 1.0e12
+[loading]
+steps = {steps}
+[boundary]
+bottom = {{ ux = 0.0, uy = 0.0 }}
+top = {{ uy = -0.001 }}
+[output]
+formats = {formats}
+"""
+    out = tmp_path / "out"
+    case.write_text(text.format(steps=5, formats='["h5", "vtu"]'))
+    first = CliRunner().invoke(cli, ["run", "-q", str(case), "-o", str(out)])
+    assert first.exit_code == 0, first.output
+    assert (out / "result.pvd").exists() and (out / "steps").is_dir()
+    case.write_text(text.format(steps=1, formats='["h5"]'))
+    again = CliRunner().invoke(cli, ["run", "-q", str(case), "-o", str(out)])
+    assert again.exit_code == 2  # refused without --overwrite
+    second = CliRunner().invoke(
+        cli, ["run", "-q", "--overwrite", str(case), "-o", str(out)]
+    )
+    assert second.exit_code == 0, second.output
+    assert sorted(p.name for p in out.iterdir()) == ["result.h5"]
