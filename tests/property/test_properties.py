@@ -54,7 +54,8 @@ def half_plane_area(bounds, point, normal):
 
     knots = [x0, x1]
     for y in (y0, y1):  # where the line crosses the top and bottom
-        x = point[0] - ny * (y - point[1]) / nx if nx != 0.0 else None
+        # a (nearly) horizontal line crosses neither the top nor the bottom
+        x = point[0] - ny * (y - point[1]) / nx if abs(nx) > 1e-12 * abs(ny) else None
         if x is not None and x0 < x < x1:
             knots.append(x)
     knots = np.sort(knots)
