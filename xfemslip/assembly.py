@@ -93,8 +93,9 @@ def assemble_bulk(mesh, D, cand: Candidates, ec: EnrichedCells, ip=None) -> Bulk
         enr_dofs[:, 8 + 2 * s] = np.where(base >= 0, base, -1)
         enr_dofs[:, 9 + 2 * s] = np.where(base >= 0, base + 1, -1)
 
-    rows = [np.repeat(std_dofs, 8, axis=1).ravel(), _pairs(enr_dofs)[0]]
-    cols = [np.tile(std_dofs, (1, 8)).ravel(), _pairs(enr_dofs)[1]]
+    enr_rows, enr_cols = _pairs(enr_dofs)
+    rows = [np.repeat(std_dofs, 8, axis=1).ravel(), enr_rows]
+    cols = [np.tile(std_dofs, (1, 8)).ravel(), enr_cols]
     vals = [K_u[which].ravel(), K_e.ravel()]
     rows, cols, vals = (np.concatenate(v) for v in (rows, cols, vals))
     keep = (rows >= 0) & (cols >= 0)

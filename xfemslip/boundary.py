@@ -227,7 +227,7 @@ def _enriched_edge_load(F, mesh, cell, e, p, q, t, ec, cand, dofmap, fractures):
     xp, xq = mesh.nodes[p], mesh.nodes[q]
     cuts = [0.0, 1.0]
     for fr in fractures:  # split where the edge crosses a kink line of F
-        for point, normal in _lines(fr):
+        for point, normal in fr.kink_lines():
             den = (xq - xp) @ normal
             if den != 0.0:
                 s = ((point - xp) @ normal) / den
@@ -251,7 +251,3 @@ def _enriched_edge_load(F, mesh, cell, e, p, q, t, ec, cand, dofmap, fractures):
                 phi = N[ec.slot_node[e, slot]] * (Fx - ec.slot_fnode[e, slot])
                 d = dofmap.cand_dof[k]
                 F[d : d + 2] += 0.5 * (a1 - a0) * length * w * phi * t
-
-
-def _lines(fr):
-    return fr.kink_lines()

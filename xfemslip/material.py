@@ -1,8 +1,6 @@
-"""Linear elastic constants (paper eqs. 24-25) and contact parameters."""
+"""Linear elastic constants (paper eqs. 24-25)."""
 
 from __future__ import annotations
-
-from typing import NamedTuple
 
 import numpy as np
 
@@ -28,10 +26,3 @@ def elasticity_matrix(
             ]
         )
     raise ValueError(f"unknown model {model!r}")
-
-
-class FrictionParams(NamedTuple):
-    friction_coefficient: float  # f [-]
-    normal_penalty: float  # k_N [Pa/m]
-    tangential_penalty: float  # k_T [Pa/m]
-    cohesion: float = 0.0  # c_f [Pa]

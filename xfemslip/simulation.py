@@ -7,6 +7,7 @@ False``) before the ConvergenceError is passed on.
 
 from __future__ import annotations
 
+import contextlib
 import logging
 import time
 from dataclasses import dataclass
@@ -59,24 +60,29 @@ class RunSummary:
     n_dofs: int
 
 
-def _geometry(spec):
-    """Mesh and fractures; geometry errors name the case file."""
-    mesh = build_mesh(spec.mesh.x, spec.mesh.y)
-    box = np.array([mesh.x[0], mesh.x[-1], mesh.y[0], mesh.y[-1]])
+@contextlib.contextmanager
+def _naming_the_file(spec):
+    """Geometry errors found while building name the case file."""
     try:
-        return mesh, build_fractures(mesh, spec.fractures, box)
+        yield
     except GeometryError as err:
         raise GeometryError(f"{spec.path}: {err}") from None
+
+
+def _geometry(spec):
+    """Mesh and fractures."""
+    mesh = build_mesh(spec.mesh.x, spec.mesh.y)
+    box = np.array([mesh.x[0], mesh.x[-1], mesh.y[0], mesh.y[-1]])
+    with _naming_the_file(spec):
+        return mesh, build_fractures(mesh, spec.fractures, box)
 
 
 def check_geometry(spec) -> None:
     """What ``xfemslip check`` adds to key validation: fractures against the
     mesh and the prescribed values at boundary corners (GeometryError)."""
     mesh, _ = _geometry(spec)
-    try:
+    with _naming_the_file(spec):
         dirichlet(mesh, spec.boundary)
-    except GeometryError as err:
-        raise GeometryError(f"{spec.path}: {err}") from None
 
 
 def build_model(spec) -> Model:
@@ -91,10 +97,8 @@ def build_model(spec) -> Model:
     contact = build_contact(
         mesh, fractures, ip, ec, cand, bulk.dofmap, spec.loading.initial_stress
     )
-    try:
+    with _naming_the_file(spec):
         bc = hold_enriched(dirichlet(mesh, spec.boundary), cand, bulk.dofmap)
-    except GeometryError as err:
-        raise GeometryError(f"{spec.path}: {err}") from None
     F = traction_load(
         mesh, spec.boundary, spec.loading, ec, cand, bulk.dofmap, fractures
     )
