@@ -42,7 +42,7 @@ from __future__ import annotations
 import math
 from pathlib import Path
 
-import closed_form as cf
+from xfemslip import closed_form as cf
 import numpy as np
 import pytest
 from harness import SLIP, STICK, box_edges, read_result, write_edge_csv

@@ -20,7 +20,7 @@ from __future__ import annotations
 import tomllib
 from pathlib import Path
 
-import closed_form as cf
+from xfemslip import closed_form as cf
 import numpy as np
 import pytest
 import tomli_w

@@ -1,8 +1,8 @@
-"""Closed-form references for the verification tests (independent of xfemslip).
+"""Closed-form references: the frictional straight crack and the slip window.
 
-Copied, with small additions, from the project's acceptance-check helpers
-(``shared/checks/analytic.py``), so that the tests do not import from outside
-the repository.  Sources:
+Pure numpy, independent of the XFEM code (nothing here imports the solver), so
+that ``xfemslip verify``, the screening tools and the tests can compare the
+simulator against it.  Sources:
 
 - straight crack of half-length a in an infinite elastic plane under a uniform
   remote stress, Coulomb friction f and cohesion c on its faces: the slip is
@@ -119,6 +119,16 @@ def displacement(
     ux_l = ((kappa + 1.0) / 2.0 * Zhat.imag + yl * Z.real) / (2.0 * G)
     uy_l = (-(kappa - 1.0) / 2.0 * Zhat.real - yl * Z.imag) / (2.0 * G)
     return u + np.outer(ux_l, t) + np.outer(uy_l, n)
+
+
+def k_ii(stress, psi_deg, a, friction, cohesion=0.0):
+    """Mode-II stress intensity factor K_II = Delta tau sqrt(pi a) [Pa sqrt(m)].
+
+    Signed like Delta tau (positive when the + face moves along +t).  The same
+    at both tips of the straight crack (Phan et al. 2003; Tada, Paris & Irwin,
+    "The stress analysis of cracks handbook", 3rd ed., section 5.1).
+    """
+    return driving_shear(stress, psi_deg, friction, cohesion) * math.sqrt(math.pi * a)
 
 
 def principal(stress):
