@@ -64,11 +64,11 @@ def fracture_fields(ip, res, n_fractures) -> list[FractureFields]:
             FractureFields(
                 s=ip.s[m].copy(),
                 points=ip.xy[m].copy(),
-                slip=res.gt[m].copy(),
-                opening=res.gn[m].copy(),
-                normal_traction=res.pn[m].copy(),
-                shear_traction=res.pt[m].copy(),
-                state=res.state[m].astype(np.int8),
+                slip=res.point_gt[m].copy(),
+                opening=res.point_gn[m].copy(),
+                normal_traction=res.point_pn[m].copy(),
+                shear_traction=res.point_pt[m].copy(),
+                state=res.point_state[m].astype(np.int8),
             )
         )
     return out

@@ -109,7 +109,7 @@ def build_model(spec) -> Model:
         fixed_values=bc.values,
         contact=contact,
         n_dofs=bulk.dofmap.n_dofs,
-        floating=floating_parts(mesh, fractures, ip, bc),
+        floating=floating_parts(mesh, fractures, contact, bc),
         penalty_ratio=max((max(f.kn, f.kt) for f in fractures), default=0.0)
         * mesh.h_min
         / mat.E,
@@ -138,7 +138,7 @@ def build_model(spec) -> Model:
     )
 
 
-def floating_parts(mesh, fractures, ip, bc):
+def floating_parts(mesh, fractures, contact, bc):
     """Fractures cutting the domain in two, one part without prescribed dofs."""
     std = bc.dofs[bc.dofs < 2 * mesh.n_nodes]  # enrichment dofs are not nodes
     fixed_nodes = np.unique(std // 2)
@@ -148,7 +148,7 @@ def floating_parts(mesh, fractures, ip, bc):
             continue
         side = fr.side(mesh.nodes[fixed_nodes]) if fixed_nodes.size else np.zeros(0)
         if not (np.any(side > 0) and np.any(side < 0)):
-            out.append((fr.index, ip.fracture == fi))
+            out.append((fr.index, contact.fracture == fi))
     return out
 
 
