@@ -58,6 +58,7 @@ from xfemslip.case_grid import (
     _read_grid,
 )
 from xfemslip.case_specs import (
+    CONTACT_PATCH_CELLS,
     EDGES,
     BoundarySpec,
     CaseSpec,
@@ -156,6 +157,15 @@ SOLVER_OPTIONS: tuple[Option, ...] = (
         "consistent",
         "contact tangent: 'consistent' (Newton) or 'secant' (paper eq. 28)",
         ("consistent", "secant"),
+    ),
+    Option(
+        "contact_patch",
+        float,
+        CONTACT_PATCH_CELLS,
+        "length of a contact patch in cell sizes: the contact law acts on the jump "
+        "averaged over each patch, which removes the traction oscillation of "
+        "pointwise penalty XFEM; 0 = pointwise (every Gauss point on its own)",
+        Range(0.0, 100.0),
     ),
 )
 

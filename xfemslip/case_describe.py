@@ -12,6 +12,7 @@ from typing import Any
 import numpy as np
 
 from xfemslip.case_specs import (
+    AUTO_PENALTY,
     EDGES,
     CaseSpec,
     EdgeSpec,
@@ -51,12 +52,18 @@ def _describe_fracture(spec: FractureSpec) -> list[str]:
     points = " -> ".join(f"({_fmt(float(x))}, {_fmt(float(y))})" for x, y in p)
     params = ", ".join(
         f"{k} = {_with_unit(getattr(spec, k), units[k])}"
+        if getattr(spec, k) is not None
+        else f"{k} = {_fmt(AUTO_PENALTY)} E/h (automatic)"
         for k in ("friction", "cohesion", "kn", "kt")
     )
     tip = spec.tip + (
         f", radius {_with_unit(spec.tip_radius, units['tip_radius'])}"
         if spec.tip_radius is not None
-        else (", radius 4 tip-cell sizes (automatic)" if spec.tip == "branch" else "")
+        else (
+            ", radius 0.1 x length within 4-8 tip-cell sizes (automatic)"
+            if spec.tip == "branch"
+            else ""
+        )
     )
     return [
         f"  [{spec.index}] points [{units['points']}]: {points}",

@@ -129,8 +129,8 @@ def _read_fracture(
     points = _fracture_points(table)
     friction = table.number("friction", rule=_NON_NEGATIVE)
     cohesion = table.number("cohesion", 0.0, rule=_NON_NEGATIVE)
-    kn = table.number("kn", rule=_POSITIVE)
-    kt = table.number("kt", rule=_POSITIVE)
+    kn = table.number("kn", None, rule=_POSITIVE)
+    kt = table.number("kt", None, rule=_POSITIVE)
     tip, radius = _read_tip(table)
     if points is not None:
         _check_polyline(table, points, grid)

@@ -17,17 +17,12 @@ import numpy as np
 from xfemslip import kernels
 from xfemslip.assembly import coo_block, scatter_vector
 from xfemslip.branch import b1_jump
+from xfemslip.case_specs import AUTO_PENALTY, CONTACT_PATCH_CELLS
 from xfemslip.enrichment import HEAVISIDE
 
 logger = logging.getLogger(__name__)
 
 OPEN, STICK, SLIP = kernels.OPEN, kernels.STICK, kernels.SLIP
-
-# Length of a contact patch in local cell sizes (see ContactSet).  Measured on
-# the inclined crack (h = a/20): the normal traction's max deviation from its
-# mean is 23% pointwise, 1.2% with 1-cell patches, 0.3% with 1.5-cell patches,
-# the slip error unchanged (benchmarks/RESULTS.md).
-PATCH_CELLS = 1.5
 
 
 @dataclass
@@ -66,7 +61,7 @@ class ContactSet:
     about one jump dof per node) and the tractions oscillate from point to point
     (the LBB problem of XFEM contact; Bechet, Moes & Wohlmuth 2009, IJNME 78).
     One traction per patch of about one cell length removes it.  With
-    ``projection = "pointwise"`` every interface point is its own patch.
+    ``[solver] contact_patch = 0`` every interface point is its own patch.
     """
 
     dofs: np.ndarray  # (m, 2J) int64
@@ -289,20 +284,26 @@ def _jump_operators(mesh, fractures, ip, ec, cand, dofmap):
     return np.ascontiguousarray(coef), dofs
 
 
+def _or_nan(value):
+    return np.nan if value is None else value
+
+
 def build_contact(
-    mesh, fractures, ip, ec, cand, dofmap, initial_stress, patch_cells=None
+    mesh, fractures, ip, ec, cand, dofmap, initial_stress, E=None, patch_cells=None
 ) -> ContactSet:
     """Interface operators from the interface points and the enriched cells.
 
     initial_stress : (xx, yy, xy) or None; the faces start closed and stuck
     with traction sigma0 . n (the committed plastic slip is set so that the
     stick traction at zero jump is the in-situ shear traction).
+    E : Young's modulus [Pa], for the automatic penalty of fractures without
+    kn / kt (AUTO_PENALTY * E / h, h = sqrt of the area of the patch's cells).
     patch_cells : length of a contact patch in local cell sizes (0: pointwise;
-    None: PATCH_CELLS).
+    None: CONTACT_PATCH_CELLS).
     """
     coef, dofs = _jump_operators(mesh, fractures, ip, ec, cand, dofmap)
     if patch_cells is None:
-        patch_cells = PATCH_CELLS
+        patch_cells = CONTACT_PATCH_CELLS
     patch = contact_patches(mesh, fractures, ip, patch_cells)
     p_coef, p_dofs, W = _patch_operators(patch, ip.weight, coef, dofs)
     n = W.size
@@ -312,9 +313,22 @@ def build_contact(
     normal = np.ascontiguousarray(ip.normal[first])
     tangent = np.ascontiguousarray(ip.tangent[first])
     par = {
-        name: np.array([getattr(fractures[f], name) for f in frac], dtype=float)
+        name: np.array(
+            [_or_nan(getattr(fractures[f], name)) for f in frac],
+            dtype=float,
+        )
         for name in ("kn", "kt", "friction", "cohesion")
     }
+    if n:
+        b = mesh.bounds[ip.cell]
+        size = np.sqrt((b[:, 1] - b[:, 0]) * (b[:, 3] - b[:, 2]))
+        h = np.bincount(patch, weights=ip.weight * size) / W  # mean over the patch
+        for name in ("kn", "kt"):
+            auto = np.isnan(par[name])
+            if auto.any():
+                if E is None:
+                    raise ValueError("automatic penalty needs E")
+                par[name][auto] = AUTO_PENALTY * E / h[auto]
     if n == 0:
         par = {name: np.zeros(0) for name in ("kn", "kt", "friction", "cohesion")}
     pn0 = np.zeros(n)

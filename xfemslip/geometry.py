@@ -66,8 +66,8 @@ class Fracture:
     piece_t: np.ndarray  # (p, 2) float64: segment parameters [ta, tb] of each piece
     friction: float
     cohesion: float
-    kn: float
-    kt: float
+    kn: float | None  # [Pa/m]; None = automatic (contact.build_contact)
+    kt: float | None
     tip_mode: str = "branch"  # "branch" | "ramp" (enrichment.py)
     tip_radius: float = 0.0  # branch enrichment radius around each tip [m]
 

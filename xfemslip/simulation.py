@@ -95,7 +95,15 @@ def build_model(spec) -> Model:
     ip = interface_points(fractures, mesh.h_min)
     bulk = assemble_bulk(mesh, D, cand, ec, ip)
     contact = build_contact(
-        mesh, fractures, ip, ec, cand, bulk.dofmap, spec.loading.initial_stress
+        mesh,
+        fractures,
+        ip,
+        ec,
+        cand,
+        bulk.dofmap,
+        spec.loading.initial_stress,
+        mat.E,
+        spec.solver.contact_patch,
     )
     with _naming_the_file(spec):
         bc = hold_enriched(dirichlet(mesh, spec.boundary), cand, bulk.dofmap)
@@ -110,7 +118,7 @@ def build_model(spec) -> Model:
         contact=contact,
         n_dofs=bulk.dofmap.n_dofs,
         floating=floating_parts(mesh, fractures, contact, bc),
-        penalty_ratio=max((max(f.kn, f.kt) for f in fractures), default=0.0)
+        penalty_ratio=float(np.max(np.maximum(contact.kn, contact.kt), initial=0.0))
         * mesh.h_min
         / mat.E,
     )
@@ -252,6 +260,7 @@ def write_output(model: Model, results, out_dir: Path, *, converged, wall, itera
         "newton_iterations_per_step": np.array(iterations, dtype=np.int64),
         "wall_time_s": float(wall),
         "tangent": spec.solver.tangent,
+        "contact_patch_cells": float(spec.solver.contact_patch),
         "n_dofs": int(model.problem.n_dofs),
         "status_codes": STATE_CODES,
     }

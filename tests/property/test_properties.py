@@ -220,7 +220,8 @@ max_iterations = 40
     order = np.argsort(ip.s[keep])
     c = result.contact
     return {
-        k: getattr(c, "point_" + k)[keep][order] for k in ("gn", "gt", "pn", "pt", "state")
+        k: getattr(c, "point_" + k)[keep][order]
+        for k in ("gn", "gt", "pn", "pt", "state")
     } | {"s": ip.s[keep][order]}
 
 

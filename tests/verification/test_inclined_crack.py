@@ -10,8 +10,9 @@ the only error left is the discretisation (and the penalty kn = kt = 100 E/h).
 The slip along the crack is compared with Phan et al. (2003)'s closed form
 ``closed_form.slip_profile`` in the relative L2 norm along the arc length.
 
-Measured relative L2 slip errors (branch tips, the default; h = 2 m / n, so
-n = 64 is h = a/16):
+Measured relative L2 slip errors (branch tips, the default; contact patches of
+1.5 cells, the default; h = 2 m / n, so n = 64 is h = a/16; the table was
+measured with pointwise contact, which gives the same slip to +-0.01 %):
 
 ===============================================  ======  ======  =======
 psi, f, c, plane                                 n = 32  n = 64  n = 128
@@ -27,8 +28,9 @@ psi, f, c, plane                                 n = 32  n = 64  n = 128
 150 deg, f = 0 (frictionless), plane stress              0.52 %
 ===============================================  ======  ======  =======
 
-(n = 256: 0.17 %.)  Pairwise observed orders 0.77 (32 -> 64) and 0.91
-(64 -> 128); the least-squares order over the three meshes is 0.84, see
+With the geometric branch radius (0.1 x length, within 4-8 tip cells) the
+psi = 30 row is 0.99 / 0.59 / 0.19 % and the least-squares order over the
+three meshes 1.20 (it was 0.84 with a fixed 4-cell radius), see
 ``test_slip_error_converges``.  The 3 % limit of the brief is the acceptance
 limit; the measured errors are far below it, so only a regression that makes
 the error about five times worse is caught by the fast tests -- the
@@ -42,11 +44,11 @@ from __future__ import annotations
 import math
 from pathlib import Path
 
-from xfemslip import closed_form as cf
 import numpy as np
 import pytest
 from harness import SLIP, STICK, box_edges, read_result, write_edge_csv
 
+from xfemslip import closed_form as cf
 from xfemslip.case import load_case
 from xfemslip.simulation import run_case
 
@@ -71,6 +73,7 @@ def run_inclined(
     n=64,
     steps=1,
     penalty=PENALTY,
+    patch=None,
 ):
     """Write the case and the four boundary CSV files into folder, run, read the result.
 
@@ -127,11 +130,14 @@ right = {{ file = "right.csv" }}
 [output]
 formats = ["h5"]
 """
+    if patch is not None:
+        text += f"\n[solver]\ncontact_patch = {patch!r}\n"
     case = folder / "case.toml"
     case.write_text(text)
     run_case(load_case(case), folder / "out")
     fr = read_result(folder / "out" / "result.h5").fr
     exact = cf.slip_profile(fr["s"], A, E, NU, plane, STRESS, psi, friction, cohesion)
+    run_inclined.fracture = fr  # the whole fracture record, for traction checks
     return fr["s"], fr["slip"], fr["state"], exact
 
 
@@ -214,12 +220,13 @@ def test_slip_matches_closed_form_more(tmp_path, psi, friction, cohesion, plane)
 
 @pytest.mark.slow
 def test_slip_error_converges(tmp_path):
-    """Observed order of the L2 slip error over n = 32, 64, 128 is >= 0.8.
+    """Observed order of the L2 slip error over n = 32, 64, 128 is >= 1 (issue 3).
 
     The order is the least-squares slope of log(error) against log(h) over the
-    three meshes (measured 0.84; pairwise 0.77 and 0.91, errors 1.01 %,
-    0.59 %, 0.31 %).  Order about 1 is what a first-order penalty/bilinear
-    discretisation of a sqrt-shaped slip gives in the L2 norm.
+    three meshes: measured 1.20, errors 0.99 %, 0.59 %, 0.19 %.  It was 0.84
+    (1.01 / 0.59 / 0.31 %) when the branch radius was a fixed 4 tip cells: a
+    radius that shrinks with h leaves the near-tip error at a fixed share
+    (Laborde et al. 2005), hence the geometric radius of geometry.py.
     """
     ns = np.array([32, 64, 128])
     errors = []
@@ -231,24 +238,51 @@ def test_slip_error_converges(tmp_path):
     order = np.polyfit(np.log(2.0 / ns), np.log(errors), 1)[0]  # error ~ h^order
     assert errors[1] <= LIMIT
     assert errors[0] > errors[1] > errors[2], f"errors {errors} do not decrease"
-    assert order >= 0.8, f"errors {errors}, observed order {order:.2f}"
+    assert order >= 1.0, f"errors {errors}, observed order {order:.2f}"
 
 
 def test_stiff_penalty_converges_with_the_line_search(tmp_path):
-    """kn h / E = 1e6: the full Newton step overshoots the contact states and
-    ping-pongs between open and slip (no convergence in 30 iterations before
-    the line search; 28 iterations with it).  The slip is as accurate as with a
-    moderate penalty: measured 0.61 % (0.59 % at kn h / E = 100).
+    """kn h / E = 1e6: the slip is as accurate as with a moderate penalty
+    (measured 0.60 %; 0.59 % at kn h / E = 100) and every point slides.
 
-    Known limitation (issue 3, traction stabilisation): at this stiffness the
-    contact tractions oscillate so much that about 30 % of the points report
-    OPEN although the crack is under 30 MPa of compression; so only the slip
-    is checked here, not the states.
+    With the pointwise penalty this case ping-ponged between open and slip (28
+    iterations with the line search) and about 30 % of the points reported
+    OPEN under 30 MPa of compression; on contact patches it takes 2.
     """
-    s, slip, _, exact = run_inclined(
+    s, slip, state, exact = run_inclined(
         tmp_path, psi=30.0, friction=0.1, n=64, penalty=1.0e6
     )
     err = cf.relative_l2(s, slip, exact)
     assert err < 0.01, f"relative L2 slip error {100 * err:.2f}%"
     inner = np.abs(s - A) < 0.8 * A
     assert np.all(np.sign(slip[inner]) == np.sign(exact[inner]))
+    assert np.all(state == SLIP)
+
+
+def _oscillation(s, traction):
+    """max |t_N - mean| / |mean| over the inner 90 % of the crack."""
+    inner = np.abs(s - A) < 0.9 * A
+    t = traction[inner]
+    return float(np.max(np.abs(t - t.mean())) / abs(t.mean()))
+
+
+@pytest.mark.parametrize(
+    "psi, friction", [(30.0, 0.1), (80.0, 0.3)], ids=["slipping", "stuck"]
+)
+def test_normal_traction_is_uniform_on_contact_patches(tmp_path, psi, friction):
+    """The closed form's normal traction is uniform, n.sigma.n, along the crack.
+
+    Pointwise penalty XFEM oscillates from Gauss point to Gauss point (the LBB
+    problem of contact on an enriched interface): measured max deviation over
+    mean 16.7 % (slipping) and 3.0 % (stuck) at n = 64.  On 1.5-cell contact
+    patches (the default): 0.15 % and 0.23 %, and the mean is n.sigma.n.
+    """
+    t_n, _ = cf.crack_tractions(STRESS, psi)
+    s, *_ = run_inclined(tmp_path / "patch", psi=psi, friction=friction)
+    patch = run_inclined.fracture["normal_traction"]
+    s0, *_ = run_inclined(tmp_path / "point", psi=psi, friction=friction, patch=0.0)
+    point = run_inclined.fracture["normal_traction"]
+    assert _oscillation(s, patch) <= 0.01
+    assert _oscillation(s0, point) >= 5 * _oscillation(s, patch)  # before/after
+    inner = np.abs(s - A) < 0.9 * A
+    assert np.mean(patch[inner]) == pytest.approx(t_n, rel=0.005)

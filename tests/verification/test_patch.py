@@ -39,10 +39,11 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from xfemslip import closed_form as cf
 import numpy as np
 import pytest
 from harness import STICK, box_edges, case_text, run_text, write_edge_csv
+
+from xfemslip import closed_form as cf
 
 pytestmark = pytest.mark.verification
 

@@ -21,12 +21,12 @@ from __future__ import annotations
 import tomllib
 from pathlib import Path
 
-from xfemslip import closed_form as cf
 import numpy as np
 import pytest
 import tomli_w
 from harness import SLIP, read_result
 
+from xfemslip import closed_form as cf
 from xfemslip.case import load_case
 from xfemslip.simulation import run_case
 
