@@ -72,8 +72,10 @@ def sweep(sweep_file, output, jobs, scheduler, force, verbose, debug) -> None:
         if not sweep_file.is_file():
             raise UsageError(f"{sweep_file}: no such file")
         from xfemslip.sweep import load_sweep
-        from xfemslip.sweep_run import format_table, run_sweep
+        from xfemslip.sweep_run import format_table, require_dask, run_sweep
 
+        if scheduler:
+            require_dask()
         spec = load_sweep(sweep_file)
         folder = output or spec.directory
         n_jobs = jobs or os.cpu_count() or 1

@@ -46,8 +46,10 @@ def effective_stress(stress, pore_pressure: float) -> tuple[float, float, float]
 def plane_stresses(stress, theta_deg) -> tuple[np.ndarray, np.ndarray]:
     """(sigma_n, tau) [Pa] on planes at theta [deg] (arrays; see module doc)."""
     xx, yy, xy = (float(v) for v in stress)
-    th = np.radians(np.asarray(theta_deg, dtype=float))
-    c, s = np.cos(th), np.sin(th)
+    theta = np.asarray(theta_deg, dtype=float)
+    c, s = np.cos(np.radians(theta)), np.sin(np.radians(theta))
+    quarter = np.mod(theta, 90.0) == 0.0  # cos(pi/2) is 6e-17, not 0
+    c, s = np.where(quarter, np.round(c), c), np.where(quarter, np.round(s), s)
     sigma_n = xx * s * s + yy * c * c - 2.0 * xy * s * c
     tau = (yy - xx) * s * c + xy * (c * c - s * s)
     return sigma_n, tau

@@ -233,14 +233,21 @@ def _run_local(tasks: list[CaseTask], jobs: int) -> Iterable[tuple]:
             raise
 
 
-def _client(scheduler: str):
-    """A dask.distributed Client of the scheduler at ``scheduler``."""
+def require_dask() -> None:
+    """UsageError (exit 2) when dask.distributed cannot be imported."""
     try:
-        from distributed import Client
+        import distributed  # noqa: F401
     except ImportError:
         raise UsageError(
             "--scheduler needs dask.distributed: pip install 'xfemslip[dask]'"
         ) from None
+
+
+def _client(scheduler: str):
+    """A dask.distributed Client of the scheduler at ``scheduler``."""
+    require_dask()
+    from distributed import Client
+
     try:
         return Client(scheduler, timeout="10s")
     except (OSError, TimeoutError, ValueError) as exc:
