@@ -425,6 +425,7 @@ def test_rerun_after_editing_the_base_runs_again(tmp_path, base):
     assert run_sweep(load_sweep(path), out, force=True)[0].status == "ok"
 
 
+@pytest.mark.slow  # two spawned interpreters load numba: ~7 s
 def test_cli_sweep_two_processes(tmp_path, base, runner, monkeypatch):
     # spawned workers import xfemslip from the same tree as this process
     monkeypatch.setenv("PYTHONPATH", str(Path(__file__).resolve().parents[2]))

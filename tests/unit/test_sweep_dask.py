@@ -34,6 +34,7 @@ def sweep_file(tmp_path: Path) -> Path:
     return path
 
 
+@pytest.mark.slow  # a scheduler and two worker processes: ~12 s
 def test_sweep_on_a_local_dask_cluster(sweep_file, tmp_path, runner, monkeypatch):
     from distributed import LocalCluster
 
