@@ -158,8 +158,15 @@ def _default_figure_dir(results: list[Path]) -> Path:
     default=None,
     help="Displacement magnification of the deformed mesh [default: auto].",
 )
+@click.option(
+    "--dpi",
+    type=click.FloatRange(min=10.0),
+    default=110.0,
+    show_default=True,
+    help="Resolution of the PNG files.",
+)
 @_debug_option
-def plot(results, output, kinds, formats, labels, scale, debug) -> None:
+def plot(results, output, kinds, formats, labels, scale, dpi, debug) -> None:
     """Draw the paper's figures of one or several RESULTS (result.h5 files or
     their folders); several results are drawn side by side or overlaid."""
     with _reported_errors(debug):
@@ -173,6 +180,7 @@ def plot(results, output, kinds, formats, labels, scale, debug) -> None:
             formats=formats or ("png", "pdf"),
             labels=labels or None,
             scale=scale,
+            dpi=dpi,
         )
         for path in written:
             click.echo(str(path))
@@ -251,6 +259,13 @@ def plot_run(out_dir: Path) -> None:
     default=None,
     help="Also draw the Mohr diagram into this folder.",
 )
+@click.option(
+    "--format",
+    "formats",
+    multiple=True,
+    type=click.Choice(("png", "pdf")),
+    help="Format of the --plot files (repeatable) [default: png and pdf].",
+)
 @_debug_option
 def screen(
     case,
@@ -262,6 +277,7 @@ def screen(
     step,
     csv_path,
     plot_dir,
+    formats,
     debug,
 ) -> None:
     """Closed-form slip screening of every orientation (and of the fractures of
@@ -302,6 +318,7 @@ def screen(
                 f0,
                 c0,
                 [(s.label, s.theta, s.friction, s.cohesion) for s in screened],
+                formats or ("png", "pdf"),
             ):
                 click.echo(str(path), err=True)
 

@@ -32,7 +32,7 @@ from matplotlib.tri import Triangulation
 
 from xfemslip.errors import OutputError, UsageError
 from xfemslip.plot_data import ResultData, read_result
-from xfemslip.plot_mohr import draw_mohr
+from xfemslip.plot_mohr import add_legend, draw_mohr, mohr_figsize
 
 logger = logging.getLogger(__name__)
 
@@ -104,9 +104,7 @@ def figure_displacement(results: Sequence[ResultData]) -> Figure:
         for i, (comp, word) in enumerate(((0, "horizontal"), (1, "vertical"))):
             ax = axes[i, j]
             cs = ax.tricontourf(tri, u[:, comp], levels=20, cmap="viridis")
-            fig.colorbar(
-                cs, ax=ax, label=f"$u_{'xy'[comp]}$ [m]", format="%.2e", shrink=0.8
-            )
+            fig.colorbar(cs, ax=ax, label=f"$u_{'xy'[comp]}$ [m]", shrink=0.8)
             _frame(ax, data, f"{data.label}\n{word} displacement $u_{'xy'[comp]}$ [m]")
     return fig
 
@@ -133,10 +131,9 @@ def figure_principal(results: Sequence[ResultData]) -> Figure:
             )
             ax = axes[i, j]
             ax.add_collection(coll)
+            ax.margins(0.0)
             ax.autoscale_view()
-            fig.colorbar(
-                coll, ax=ax, label="[Pa], tension positive", format="%.2e", shrink=0.8
-            )
+            fig.colorbar(coll, ax=ax, label="[Pa], tension positive", shrink=0.8)
             _frame(ax, data, f"{data.label}\n{title}")
     return fig
 
@@ -237,22 +234,35 @@ def figure_slip(results: Sequence[ResultData]) -> Figure:
     return fig
 
 
+def _point_labels(results: Sequence[ResultData]) -> dict:
+    """Label of each (result, fracture) point on the Mohr circle; results whose
+    points coincide (same stress and angle) share one label, on the first."""
+    labels, first = {}, {}
+    for k, data in enumerate(results):
+        for f in data.fractures:
+            if len(results) == 1:
+                labels[k, f.index] = f"fracture {f.index}, $\\theta$ = {f.theta:g} deg"
+                continue
+            key = (data.stress_state, round(f.theta % 180.0, 9))
+            if key in first:
+                labels[k, f.index] = ""
+                labels[first[key]] += f", {data.label}"
+            else:
+                first[key] = (k, f.index)
+                labels[k, f.index] = data.label
+    return labels
+
+
 def figure_mohr(results: Sequence[ResultData]) -> Figure:
     """The Mohr-Coulomb diagram of every result's stress and fractures; a
     circle per distinct stress state, a failure line per distinct (f, c)."""
-    fig = Figure(figsize=(8.0, 3.9), layout="constrained")
+    fig = Figure(figsize=mohr_figsize(results[0].stress_state), layout="constrained")
     ax = fig.subplots()
     circles, criteria = set(), set()
+    labels = _point_labels(results)
     for k, data in enumerate(results):
         fractures = [
-            (
-                data.label
-                if len(results) > 1
-                else f"fracture {f.index}, $\\theta$ = {f.theta:g} deg",
-                f.theta,
-                f.friction,
-                f.cohesion,
-            )
+            (labels[k, f.index], f.theta, f.friction, f.cohesion)
             for f in data.fractures
         ]
         keys = {(data.stress_state, f, c) for _, _, f, c in fractures}
@@ -266,6 +276,11 @@ def figure_mohr(results: Sequence[ResultData]) -> Figure:
             first=k == 0,
             circle=data.stress_state not in circles,
             criterion=not keys <= criteria,
+            inset_lines=[
+                (f.theta, f"C{j % 10}")
+                for j, other in enumerate(results)
+                for f in other.fractures
+            ],
         )
         circles.add(data.stress_state)
         criteria |= keys
@@ -275,6 +290,7 @@ def figure_mohr(results: Sequence[ResultData]) -> Figure:
         "tension positive)",
         fontsize=9,
     )
+    add_legend(fig)
     return fig
 
 
@@ -283,13 +299,13 @@ def figure_mohr(results: Sequence[ResultData]) -> Figure:
 # --------------------------------------------------------------------------- #
 
 
-def _save(fig: Figure, out_dir: Path, name: str, formats) -> list[Path]:
+def _save(fig: Figure, out_dir: Path, name: str, formats, dpi=DPI) -> list[Path]:
     """Write ``<out_dir>/<name>.<fmt>`` for each format."""
     paths = []
     for fmt in formats:
         path = out_dir / f"{name}.{fmt}"
         try:
-            fig.savefig(path, dpi=DPI, bbox_inches="tight")
+            fig.savefig(path, dpi=dpi, bbox_inches="tight")
         except OSError as exc:
             raise OutputError(f"cannot write {path}: {exc.strerror or exc}") from None
         paths.append(path)
@@ -316,7 +332,7 @@ def plot_screen(
     ``fractures`` = [(label, theta [deg], f, c)]."""
     out_dir = Path(out_dir)
     _make_dir(out_dir)
-    fig = Figure(figsize=(8.0, 3.9), layout="constrained")
+    fig = Figure(figsize=mohr_figsize(stress, pore_pressure), layout="constrained")
     ax = fig.subplots()
     if not fractures:
         fractures = [("", 0.0, friction, cohesion)]
@@ -331,6 +347,7 @@ def plot_screen(
         "tension positive)",
         fontsize=9,
     )
+    add_legend(fig)
     return _save(fig, out_dir, "mohr", formats)
 
 
@@ -342,8 +359,13 @@ def plot_results(
     formats: Sequence[str] = FORMATS,
     labels: Sequence[str] | None = None,
     scale: float | None = None,
+    dpi: float = DPI,
 ) -> list[Path]:
-    """Read the results and write the figures; returns the files written."""
+    """Read the results and write the figures; returns the files written.
+
+    ``kinds`` from KINDS, ``formats`` "png" / "pdf", ``labels`` one per result
+    (default: the folder name), ``scale`` the deformed mesh's magnification
+    (default :func:`auto_scale`), ``dpi`` of the PNG files."""
     if labels and len(labels) != len(paths):
         raise UsageError(f"got {len(labels)} labels for {len(paths)} results")
     results = [
@@ -363,5 +385,5 @@ def plot_results(
         if kind in ("slip", "mohr") and not any(r.fractures for r in results):
             logger.info("no fracture: %s figure skipped", kind)
             continue
-        written += _save(makers[kind](), out_dir, kind, formats)
+        written += _save(makers[kind](), out_dir, kind, formats, dpi)
     return written

@@ -37,19 +37,23 @@ def draw_mohr(
     first: bool = True,
     circle: bool = True,
     criterion: bool = True,
+    inset_lines=None,
 ) -> None:
     """Draw the circle of ``stress`` (+ p), the failure line of each distinct
     (f, c) of ``fractures`` = [(label, theta [deg], f, c)], the slip band, the
     fractures' points and the ``contact`` tractions [(p_N (K,), p_T (K,))].
 
-    ``first``: also label the axes and draw the inset; ``circle`` and
-    ``criterion`` switch off parts already drawn for an earlier result.
+    ``first``: also label the axes and draw the inset, with the fracture
+    lines ``inset_lines`` = [(theta [deg], colour)] (default: ``fractures``
+    in ``color``); ``circle`` and
+    ``criterion`` switch off parts already drawn for an earlier result.  The
+    caller adds the legend (:func:`add_legend`) once everything is drawn.
     """
     eff = effective_stress(stress, pore_pressure)
     band0 = slip_band(eff, 0.0)
     s1, s3, dir1 = band0.sigma1, band0.sigma3, band0.dir1
     centre, radius = -(s1 + s3) / 2.0, (s1 - s3) / 2.0
-    x_left = -1.08 * max(s1, 1.0)
+    x_left = mohr_limits(stress, pore_pressure)[0]
     if circle:
         xs, ys = _circle_point(centre, radius, np.linspace(0.0, 90.0, 181))
         ax.plot(
@@ -91,11 +95,15 @@ def draw_mohr(
                 f"from $\\sigma_1'$ (f = {f:g}; most critical "
                 f"$45 - \\phi/2$ = {45 - phi / 2:.1f} deg)",
             )
+        else:
+            ax.plot([], [], " ", label=f"f = {f:g}: no orientation slips")
     for label, theta, _, _ in fractures:
         beta = angle_to_sigma1(theta, dir1)
         px, py = _circle_point(centre, radius, beta)
         ax.plot([centre, px], [0.0, py], color=color, lw=0.6)
         ax.plot(px, py, "o", color=color, mec="k", ms=7, zorder=5)
+        if not label:  # annotated with an earlier result at the same point
+            continue
         ax.annotate(
             f"{label} ($\\beta$ = {beta:.1f} deg)",
             (px, py),
@@ -120,15 +128,34 @@ def draw_mohr(
         ax.axhline(0.0, color="k", lw=0.5)
         ax.axvline(0.0, color="k", lw=0.5)
         ax.set_aspect("equal")
-        ax.set_xlim(x_left, 0.25 * max(s1, 1.0))
-        ax.set_ylim(0.0, max(radius * 1.75, 0.3 * s1))
+        ax.set_xlim(*mohr_limits(stress, pore_pressure)[:2])
+        ax.set_ylim(*mohr_limits(stress, pore_pressure)[2:])
         ax.ticklabel_format(style="sci", scilimits=(-3, 3))
         f0, c0 = (fractures[0][2], fractures[0][3]) if fractures else (0.0, 0.0)
-        _inset(ax, slip_band(eff, f0, c0), fractures, color)
-    ax.legend(fontsize=6.5, loc="upper left")
+        if inset_lines is None:
+            inset_lines = [(theta, color) for _, theta, _, _ in fractures]
+        _inset(ax, slip_band(eff, f0, c0), inset_lines)
 
 
-def _inset(ax, band, fractures, color: str) -> None:
+def mohr_limits(stress, pore_pressure: float = 0.0) -> tuple[float, ...]:
+    """(x0, x1, y0, y1) of the diagram [Pa]: the circle, zero and room above."""
+    band = slip_band(effective_stress(stress, pore_pressure), 0.0)
+    s1, radius = max(band.sigma1, 1.0), (band.sigma1 - band.sigma3) / 2.0
+    return -1.08 * s1, 0.25 * s1, 0.0, max(1.5 * radius, 0.3 * s1)
+
+
+def mohr_figsize(stress, pore_pressure: float = 0.0, width: float = 8.0):
+    """Figure size that fits the equal-aspect diagram, its title and legend."""
+    x0, x1, y0, y1 = mohr_limits(stress, pore_pressure)
+    return width, (width - 0.8) * (y1 - y0) / (x1 - x0) + 2.0
+
+
+def add_legend(fig) -> None:
+    """One legend below the diagram for everything drawn on it."""
+    fig.legend(loc="outside lower center", ncol=2, fontsize=7)
+
+
+def _inset(ax, band, lines) -> None:
     """Plane orientations that slip, drawn in the x-y plane (sigma_1' arrows)."""
     ins = ax.inset_axes([0.78, 0.40, 0.21, 0.50])
     ins.set_aspect("equal")
@@ -158,7 +185,7 @@ def _inset(ax, band, fractures, color: str) -> None:
         "$\\sigma_1'$",
         fontsize=7,
     )
-    for _, theta, _, _ in fractures:
+    for theta, color in lines:
         t = math.radians(theta)
         ins.plot(
             [-math.cos(t), math.cos(t)],

@@ -52,7 +52,7 @@ def plane_stresses(stress, theta_deg) -> tuple[np.ndarray, np.ndarray]:
     c, s = np.where(quarter, np.round(c), c), np.where(quarter, np.round(s), s)
     sigma_n = xx * s * s + yy * c * c - 2.0 * xy * s * c
     tau = (yy - xx) * s * c + xy * (c * c - s * s)
-    return sigma_n, tau
+    return sigma_n + 0.0, tau + 0.0  # + 0.0: no -0.0 in the printout
 
 
 def slip_tendency(sigma_n_eff, tau) -> np.ndarray:
@@ -244,13 +244,23 @@ def _fracture_text(fractures: list[FractureScreen]) -> str:
     """The per-fracture lines, with the pore-pressure change to slip."""
     lines = []
     for fs in fractures:
-        state = "SLIPS" if fs.margin <= 0.0 else "stable"
+        if fs.margin <= 0.0:
+            change = (
+                f"SLIPS already; a pore-pressure drop of {-fs.dp_slip:.6g} Pa "
+                "would stop it"
+                if math.isfinite(fs.dp_slip)
+                else "SLIPS at any pore pressure (f = 0)"
+            )
+        else:
+            change = (
+                f"stable; slips at a pore-pressure change dp = "
+                f"{fs.dp_critical:.6g} Pa (Coulomb {fs.dp_slip:.6g}, opening "
+                f"{fs.dp_open:.6g})"
+            )
         lines.append(
             f"{fs.label}: theta = {fs.theta:.2f} deg (beta = {fs.beta:.2f} deg), "
             f"f = {fs.friction:g}, c = {fs.cohesion:g}: sigma_n' = "
             f"{fs.sigma_n_eff:.6g}, tau = {fs.tau:.6g}, T_s = "
-            f"{fs.slip_tendency:.4f}, margin = {fs.margin:.6g} -> {state}; "
-            f"slips at a pore-pressure change dp = {fs.dp_critical:.6g} Pa "
-            f"(Coulomb {fs.dp_slip:.6g}, opening {fs.dp_open:.6g})"
+            f"{fs.slip_tendency:.4f}, margin = {fs.margin:.6g} -> {change}"
         )
     return "\n".join(lines)

@@ -147,7 +147,7 @@ def test_cli_screen_case(runner, tmp_path):
     text = result.stdout
     assert "slip band: beta = 5.83..78.46 deg from sigma1" in text
     assert "fractures[0]: theta = 45.00 deg (beta = 45.00 deg)" in text
-    assert "margin = -7e+06 -> SLIPS" in text
+    assert "margin = -7e+06 -> SLIPS already; a pore-pressure drop of 7e+07 Pa" in text
     assert (out / "mohr.png").stat().st_size > 10_000
     assert (out / "mohr.pdf").read_bytes()[:4] == b"%PDF"
     rows = csv_path.read_text().splitlines()
@@ -165,7 +165,10 @@ def test_cli_screen_options(runner):
     assert result.exit_code == 0, result.stderr
     assert "slip band: no orientation slips" in result.stdout
     assert "angle 45: theta = 45.00 deg" in result.stdout
-    assert "dp = 3.33333e+06 Pa" in result.stdout
+    assert "margin = 2e+06 -> stable; slips at a pore-pressure change dp = " in (
+        result.stdout
+    )
+    assert "dp = 3.33333e+06 Pa (Coulomb 3.33333e+06, opening 2e+07)" in result.stdout
 
 
 def test_cli_screen_needs_a_stress_and_a_friction(runner):
