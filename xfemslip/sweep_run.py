@@ -218,7 +218,8 @@ def _outcome(task: CaseTask, future) -> tuple:
 
 def _run_local(tasks: list[CaseTask], jobs: int) -> Iterable[tuple]:
     """Results in completion order: in this process, or a spawn process pool."""
-    if jobs == 1:
+    jobs = min(jobs, len(tasks))  # no idle workers to start
+    if jobs <= 1:
         for task in tasks:
             yield run_task(task)
         return
