@@ -152,6 +152,9 @@ def cli() -> None:
 )
 @click.option("-v", "--verbose", is_flag=True, help="Log debug messages.")
 @click.option("-q", "--quiet", is_flag=True, help="Log warnings and errors only.")
+@click.option(
+    "--plot", is_flag=True, help="Also draw the figures into <output>/figures."
+)
 @_debug_option
 def run(
     case: Path,
@@ -159,6 +162,7 @@ def run(
     overwrite: bool,
     verbose: bool,
     quiet: bool,
+    plot: bool,
     debug: bool,
 ) -> None:
     """Run the case file CASE and write its results."""
@@ -176,6 +180,10 @@ def run(
         )
         if not summary.converged:
             raise click.exceptions.Exit(EXIT_FAILURE)
+        if plot:  # matplotlib is imported only here
+            from xfemslip.cli_studies import plot_run
+
+            plot_run(summary.out_dir)
 
 
 @cli.command()
@@ -219,6 +227,15 @@ def _dist_version(name: str) -> str:
         return importlib.metadata.version(name)
     except importlib.metadata.PackageNotFoundError:
         return "not installed"
+
+
+# sweep | plot | screen: their code is in cli_studies, which imports the helpers
+# above (so this import stays below them).
+from xfemslip.cli_studies import plot, screen, sweep  # noqa: E402
+
+cli.add_command(sweep)
+cli.add_command(plot)
+cli.add_command(screen)
 
 
 def main() -> None:

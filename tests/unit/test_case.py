@@ -938,12 +938,18 @@ def test_tip_string_and_table_forms(tmp_path):
     ("line", "key", "words"),
     [
         ('tip = "brnch"', "fractures[0].tip", "did you mean 'branch'"),
-        ("tip = { kind = \"branch\", radius = -1.0 }", "fractures[0].tip.radius", "> 0"),
-        ("tip = { kind = \"ramp\", radius = 0.1 }", "fractures[0].tip.radius", "only used"),
-        ("tip = { knd = \"ramp\" }", "fractures[0].tip.knd", "did you mean 'kind'"),
+        ('tip = { kind = "branch", radius = -1.0 }', "fractures[0].tip.radius", "> 0"),
+        (
+            'tip = { kind = "ramp", radius = 0.1 }',
+            "fractures[0].tip.radius",
+            "only used",
+        ),
+        ('tip = { knd = "ramp" }', "fractures[0].tip.knd", "did you mean 'kind'"),
     ],
 )
 def test_tip_errors(tmp_path, line, key, words):
     with pytest.raises(CaseError) as info:
         load_case(_tip_case(tmp_path, line))
-    assert any(k == key and words in m for k, m in info.value.problems), info.value.problems
+    assert any(k == key and words in m for k, m in info.value.problems), (
+        info.value.problems
+    )

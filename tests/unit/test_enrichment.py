@@ -130,7 +130,7 @@ def test_too_short_for_branch_falls_back_to_ramp(caplog):
     with caplog.at_level("WARNING", logger="xfemslip.geometry"):
         m = build_model(_case(pts, "branch", n, size))
     assert m.fractures[0].tip_mode == "ramp"
-    assert any("uses tip = \"ramp\"" in r.getMessage() for r in caplog.records)
+    assert any('uses tip = "ramp"' in r.getMessage() for r in caplog.records)
     assert np.all(find_candidates(m.mesh, m.fractures).func == HEAVISIDE)
 
 

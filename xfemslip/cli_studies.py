@@ -1,0 +1,376 @@
+"""Commands ``xfemslip sweep | plot | screen`` (registered in :mod:`xfemslip.cli`).
+
+Like ``cli.py`` these only parse arguments, print and map errors to exit codes
+(through ``cli._reported_errors``); the work is in :mod:`xfemslip.sweep`,
+:mod:`xfemslip.sweep_run`, :mod:`xfemslip.plot` and :mod:`xfemslip.screen`.
+matplotlib is imported only when a figure is drawn, Dask only with
+``--scheduler``.
+"""
+
+from __future__ import annotations
+
+import csv
+import os
+from pathlib import Path
+
+import click
+
+from xfemslip.cli import (
+    EXIT_FAILURE,
+    _configure_logging,
+    _debug_option,
+    _load,
+    _reported_errors,
+)
+from xfemslip.errors import UsageError
+
+KINDS = ("displacement", "principal_stress", "deformed_mesh", "slip", "mohr")
+
+
+# --------------------------------------------------------------------------- #
+# sweep
+# --------------------------------------------------------------------------- #
+
+
+@click.command()
+@click.argument("sweep_file", metavar="SWEEP", type=click.Path(path_type=Path))
+@click.option(
+    "-o",
+    "--output",
+    type=click.Path(file_okay=False, path_type=Path),
+    default=None,
+    help="Sweep folder [default: output.directory of the sweep, else "
+    "out/sweeps/<name>].",
+)
+@click.option(
+    "-j",
+    "--jobs",
+    type=click.IntRange(min=1),
+    default=None,
+    help="Local worker processes [default: the number of CPUs]; 1 runs the "
+    "cases in this process.",
+)
+@click.option(
+    "--scheduler",
+    metavar="ADDRESS",
+    default=None,
+    help="Run on an existing Dask cluster (e.g. tcp://host:8786) instead of "
+    "local processes; needs `pip install xfemslip[dask]`.",
+)
+@click.option("--force", is_flag=True, help="Rerun cases that already have a result.")
+@click.option("-v", "--verbose", is_flag=True, help="Log every case's messages.")
+@_debug_option
+def sweep(sweep_file, output, jobs, scheduler, force, verbose, debug) -> None:
+    """Run the cases of the sweep file SWEEP (base case + varied parameters).
+
+    Each case writes into <folder>/<case id>/; cases with a converged result
+    of the same case text are skipped.  A table of the results is printed
+    and written to <folder>/summary.csv.  Exit 1 if a case failed.
+    """
+    with _reported_errors(debug):
+        _configure_logging(verbose, not verbose)
+        if not sweep_file.is_file():
+            raise UsageError(f"{sweep_file}: no such file")
+        from xfemslip.sweep import load_sweep
+        from xfemslip.sweep_run import format_table, require_dask, run_sweep
+
+        if scheduler:
+            require_dask()
+        spec = load_sweep(sweep_file)
+        folder = output or spec.directory
+        n_jobs = jobs or os.cpu_count() or 1
+        where = f"Dask at {scheduler}" if scheduler else f"{n_jobs} local process(es)"
+        click.echo(
+            f"{spec.name}: {len(spec.cases)} case(s) -> {folder} ({where})", err=True
+        )
+        with click.progressbar(
+            length=len(spec.cases),
+            label=spec.name,
+            file=click.get_text_stream("stderr"),
+        ) as bar:
+            rows = run_sweep(
+                spec,
+                folder,
+                jobs=n_jobs,
+                scheduler=scheduler,
+                force=force,
+                progress=lambda row: bar.update(1),
+            )
+        click.echo(format_table(spec.keys, rows))
+        failed = [r for r in rows if r.status == "failed"]
+        skipped = sum(r.status == "skipped" for r in rows)
+        click.echo(
+            f"summary: {folder / 'summary.csv'} ({len(rows) - len(failed)} "
+            f"done, {skipped} of them skipped as already done, "
+            f"{len(failed)} failed)",
+            err=True,
+        )
+        if failed:
+            raise click.exceptions.Exit(EXIT_FAILURE)
+
+
+# --------------------------------------------------------------------------- #
+# plot
+# --------------------------------------------------------------------------- #
+
+
+def _default_figure_dir(results: list[Path]) -> Path:
+    """One result: <its folder>/figures; several: <their common folder>/figures."""
+    folders = [(p if p.is_dir() else p.parent).resolve() for p in results]
+    if len(folders) == 1:
+        return folders[0] / "figures"
+    return Path(os.path.commonpath(folders)) / "figures"
+
+
+@click.command()
+@click.argument("results", nargs=-1, required=True, type=click.Path(path_type=Path))
+@click.option(
+    "-o",
+    "--output",
+    type=click.Path(file_okay=False, path_type=Path),
+    default=None,
+    help="Folder for the figures [default: <result folder>/figures, or the "
+    "results' common folder /figures].",
+)
+@click.option(
+    "--figure",
+    "kinds",
+    multiple=True,
+    type=click.Choice(KINDS),
+    help="Draw only this figure (repeatable) [default: all].",
+)
+@click.option(
+    "--format",
+    "formats",
+    multiple=True,
+    type=click.Choice(("png", "pdf")),
+    help="File format (repeatable) [default: png and pdf].",
+)
+@click.option(
+    "--label",
+    "labels",
+    multiple=True,
+    help="Legend label of each result, in order (repeatable).",
+)
+@click.option(
+    "--scale",
+    type=click.FloatRange(min=0.0, min_open=True),
+    default=None,
+    help="Displacement magnification of the deformed mesh [default: auto].",
+)
+@click.option(
+    "--dpi",
+    type=click.FloatRange(min=10.0),
+    default=110.0,
+    show_default=True,
+    help="Resolution of the PNG files.",
+)
+@_debug_option
+def plot(results, output, kinds, formats, labels, scale, dpi, debug) -> None:
+    """Draw the paper's figures of one or several RESULTS (result.h5 files or
+    their folders); several results are drawn side by side or overlaid."""
+    with _reported_errors(debug):
+        from xfemslip.plot import plot_results
+
+        out_dir = output or _default_figure_dir(list(results))
+        written = plot_results(
+            list(results),
+            out_dir,
+            kinds=kinds or KINDS,
+            formats=formats or ("png", "pdf"),
+            labels=labels or None,
+            scale=scale,
+            dpi=dpi,
+        )
+        for path in written:
+            click.echo(str(path))
+
+
+def plot_run(out_dir: Path) -> None:
+    """``xfemslip run --plot``: every figure of the run into <out_dir>/figures."""
+    from xfemslip.plot import plot_results
+
+    for path in plot_results([out_dir / "result.h5"], out_dir / "figures"):
+        click.echo(str(path))
+
+
+# --------------------------------------------------------------------------- #
+# screen
+# --------------------------------------------------------------------------- #
+
+
+@click.command()
+@click.argument("case", required=False, type=click.Path(path_type=Path))
+@click.option(
+    "--stress",
+    nargs=3,
+    type=float,
+    default=None,
+    metavar="XX YY XY",
+    help="Total far-field stress [Pa], tension positive "
+    "[default: loading.stress of CASE].",
+)
+@click.option(
+    "-p",
+    "--pore-pressure",
+    type=float,
+    default=0.0,
+    show_default=True,
+    help="Pore pressure p [Pa]; effective stress = stress + p I.",
+)
+@click.option(
+    "--friction",
+    type=click.FloatRange(min=0.0),
+    default=None,
+    help="Friction coefficient f [default: the first fracture's].",
+)
+@click.option(
+    "--cohesion",
+    type=click.FloatRange(min=0.0),
+    default=None,
+    help="Cohesion c [Pa] [default: the first fracture's, else 0].",
+)
+@click.option(
+    "--angle",
+    "angles",
+    multiple=True,
+    type=float,
+    help="A fracture angle to screen [deg, CCW from +x] (repeatable) "
+    "[default: the fractures of CASE].",
+)
+@click.option(
+    "--step",
+    type=click.FloatRange(min=0.1, max=90.0),
+    default=5.0,
+    show_default=True,
+    help="Angle step of the orientation table [deg].",
+)
+@click.option(
+    "--csv",
+    "csv_path",
+    type=click.Path(dir_okay=False, path_type=Path),
+    default=None,
+    help="Also write the orientation table as CSV.",
+)
+@click.option(
+    "--plot",
+    "plot_dir",
+    type=click.Path(file_okay=False, path_type=Path),
+    default=None,
+    help="Also draw the Mohr diagram into this folder.",
+)
+@click.option(
+    "--format",
+    "formats",
+    multiple=True,
+    type=click.Choice(("png", "pdf")),
+    help="Format of the --plot files (repeatable) [default: png and pdf].",
+)
+@_debug_option
+def screen(
+    case,
+    stress,
+    pore_pressure,
+    friction,
+    cohesion,
+    angles,
+    step,
+    csv_path,
+    plot_dir,
+    formats,
+    debug,
+) -> None:
+    """Closed-form slip screening of every orientation (and of the fractures of
+    CASE): slip tendency, Coulomb margin, the band that slips and the
+    pore-pressure change at which each fracture slips.  Stresses in Pa,
+    tension positive."""
+    with _reported_errors(debug):
+        from xfemslip import screen as scr
+
+        stress, fractures = _screen_inputs(case, stress, friction, cohesion, angles)
+        f0 = friction if friction is not None else fractures[0][2]
+        c0 = cohesion if cohesion is not None else fractures[0][3]
+        screened = [
+            scr.screen_fracture(
+                label,
+                theta,
+                stress,
+                pore_pressure,
+                f if friction is None else friction,
+                c if cohesion is None else cohesion,
+            )
+            for label, theta, f, c in fractures
+            if label
+        ]
+        click.echo(scr.format_report(stress, pore_pressure, f0, c0, step, screened))
+        if csv_path is not None:
+            _write_screen_csv(
+                csv_path,
+                scr.orientation_table(stress, pore_pressure, f0, c0, _angles(step)),
+            )
+        if plot_dir is not None:
+            from xfemslip.plot import plot_screen
+
+            for path in plot_screen(
+                plot_dir,
+                stress,
+                pore_pressure,
+                f0,
+                c0,
+                [(s.label, s.theta, s.friction, s.cohesion) for s in screened],
+                formats or ("png", "pdf"),
+            ):
+                click.echo(str(path), err=True)
+
+
+def _angles(step: float):
+    import numpy as np
+
+    return np.arange(0.0, 180.0, step)
+
+
+def _screen_inputs(case, stress, friction, cohesion, angles):
+    """(stress, [(label, theta, f, c)]) from CASE and the options; a
+    fracture-less entry (label "") carries the defaults of f and c."""
+    spec = _load(case) if case is not None else None
+    if stress is None:
+        if spec is None or spec.loading.stress is None:
+            raise UsageError(
+                "screen needs --stress XX YY XY or a CASE with loading.stress"
+            )
+        stress = spec.loading.stress
+    if angles:
+        fractures = [(f"angle {a:g}", a, friction, cohesion) for a in angles]
+    elif spec is not None and spec.fractures:
+        from xfemslip.screen import case_fractures
+
+        fractures = case_fractures(spec)
+    else:
+        fractures = [("", 0.0, friction, cohesion)]
+    f0 = friction if friction is not None else fractures[0][2]
+    if f0 is None:
+        raise UsageError("screen needs --friction (or a CASE with a fracture)")
+    c0 = cohesion if cohesion is not None else (fractures[0][3] or 0.0)
+    fractures = [
+        (lab, th, f0 if f is None else f, c0 if c is None else c)
+        for lab, th, f, c in fractures
+    ]
+    return tuple(float(v) for v in stress), fractures
+
+
+def _write_screen_csv(path: Path, table: dict) -> None:
+    from xfemslip.writers.atomic import atomic_path
+
+    names = list(table)
+    with atomic_path(path) as tmp, open(tmp, "w", newline="", encoding="utf-8") as fh:
+        writer = csv.writer(fh)
+        writer.writerow(names)
+        for i in range(len(table[names[0]])):
+            writer.writerow(
+                [
+                    f"{table[n][i]:.9g}"
+                    if n != "slips"
+                    else str(bool(table[n][i])).lower()
+                    for n in names
+                ]
+            )

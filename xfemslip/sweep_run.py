@@ -1,0 +1,367 @@
+"""Running a sweep: local processes or a Dask cluster, reruns, the summary.
+
+Each case of a :class:`~xfemslip.sweep.SweepSpec` runs in its own folder
+``<sweep directory>/<case id>/`` (``case.toml``, ``result.h5``, VTU files).
+
+- ``jobs = 1``: in this process, one case after the other.
+- ``jobs = N > 1``: a ``ProcessPoolExecutor`` of N workers started with
+  ``spawn`` (a fresh interpreter: no forked Numba or BLAS state).
+- ``scheduler = ADDRESS``: the cases are submitted to an existing
+  ``dask.distributed`` scheduler.  The workers need xfemslip installed and the
+  sweep folder on a file system they share with this machine.
+
+A case whose ``result.h5`` exists, says ``converged = true`` and holds the same
+case text is skipped (results are written atomically, so an existing file is
+complete); any other case runs (again).  A failed case is reported in its row
+and the others go on.  ``summary.csv`` has one row per case: the parameters,
+max |slip| [m], slipping length [m], share of contact points in slip,
+converged, Newton iterations, wall time [s], status and error.
+"""
+
+from __future__ import annotations
+
+import csv
+import logging
+import math
+import traceback
+from collections.abc import Callable, Iterable
+from concurrent.futures import ProcessPoolExecutor, as_completed
+from dataclasses import dataclass, field
+from multiprocessing import get_context
+from pathlib import Path
+
+import h5py
+import numpy as np
+
+from xfemslip.errors import OutputError, UsageError, XfemslipError
+from xfemslip.writers.atomic import atomic_path
+
+logger = logging.getLogger(__name__)
+
+SLIP_CODE = 2  # output-format.md: 0 open, 1 stick, 2 slip
+METRICS = (
+    "converged",
+    "max_abs_slip_m",
+    "slip_length_m",
+    "slip_share",
+    "newton_iterations",
+    "wall_time_s",
+)
+SUMMARY = "summary.csv"
+
+
+@dataclass(frozen=True)
+class CaseTask:
+    """What a worker needs to run one case (picklable, no spec objects)."""
+
+    case_id: str
+    text: str  # case TOML
+    path: str  # the path the case is loaded as (CSV files relative to it)
+    out_dir: str
+
+
+@dataclass
+class CaseRow:
+    """One line of the summary."""
+
+    case_id: str
+    params: tuple = ()
+    status: str = "ok"  # ok | skipped | failed
+    metrics: dict = field(default_factory=dict)
+    error: str = ""
+
+
+# --------------------------------------------------------------------------- #
+# Metrics of one result
+# --------------------------------------------------------------------------- #
+
+
+def arc_extent(points: np.ndarray, box: tuple) -> tuple[float, float]:
+    """Arc-length range [s_lo, s_hi] of a polyline inside box (x0, x1, y0, y1)."""
+    from xfemslip.geometry import clip_segment
+
+    points = np.asarray(points, dtype=float)
+    seg = np.linalg.norm(np.diff(points, axis=0), axis=1)
+    start = np.concatenate([[0.0], np.cumsum(seg)[:-1]])
+    lo, hi = math.inf, -math.inf
+    for k in range(len(seg)):
+        ta, tb = clip_segment(points[k], points[k + 1], np.asarray([box], float))
+        if tb[0] > ta[0]:
+            lo = min(lo, start[k] + ta[0] * seg[k])
+            hi = max(hi, start[k] + tb[0] * seg[k])
+    return lo, hi
+
+
+def slipping_length(s, state, s_lo: float, s_hi: float) -> float:
+    """Length [m] of fracture in slip: each point stands for the stretch between
+    the midpoints to its neighbours (the ends reach s_lo and s_hi)."""
+    s = np.asarray(s, dtype=float)
+    if s.size == 0:
+        return 0.0
+    mid = 0.5 * (s[1:] + s[:-1])
+    edges = np.concatenate([[min(s_lo, s[0])], mid, [max(s_hi, s[-1])]])
+    return float(np.sum(np.diff(edges)[np.asarray(state) == SLIP_CODE]))
+
+
+def result_metrics(h5_path: Path, spec) -> dict:
+    """The summary metrics of ``result.h5`` (read back, so a skipped case
+    reports what its run wrote)."""
+    box = (
+        spec.origin[0],
+        spec.origin[0] + spec.size[0],
+        spec.origin[1],
+        spec.origin[1] + spec.size[1],
+    )
+    slip_max, length, n_slip, n_points = 0.0, 0.0, 0, 0
+    with h5py.File(h5_path, "r") as f:
+        attrs = dict(f.attrs)
+        for i, fracture in enumerate(spec.fractures):
+            group = f.get(f"fractures/{i}")
+            if group is None:
+                continue
+            s, slip, state = (group[k][()] for k in ("s", "slip", "state"))
+            if slip.size:
+                slip_max = max(slip_max, float(np.max(np.abs(slip))))
+            length += slipping_length(s, state, *arc_extent(fracture.points, box))
+            n_slip += int(np.sum(state == SLIP_CODE))
+            n_points += int(state.size)
+    return {
+        "converged": bool(attrs.get("converged", False)),
+        "max_abs_slip_m": slip_max,
+        "slip_length_m": length,
+        "slip_share": n_slip / n_points if n_points else 0.0,
+        "newton_iterations": int(attrs.get("newton_iterations", 0)),
+        "wall_time_s": float(attrs.get("wall_time_s", math.nan)),
+    }
+
+
+def is_done(out_dir: Path, text: str) -> bool:
+    """Whether ``out_dir/result.h5`` is a converged result of this case text."""
+    path = Path(out_dir) / "result.h5"
+    if not path.is_file():
+        return False
+    try:
+        with h5py.File(path, "r") as f:
+            return bool(f.attrs.get("converged", False)) and (
+                f.attrs.get("case_toml") == text
+            )
+    except OSError:  # unreadable: run it again
+        return False
+
+
+# --------------------------------------------------------------------------- #
+# One case (runs in a worker)
+# --------------------------------------------------------------------------- #
+
+
+def run_task(task: CaseTask) -> tuple[str, str, dict, str]:
+    """Run one case; never raises.  Returns (case_id, status, metrics, error).
+
+    A library error (no convergence, unwritable output) is the case's error
+    message; any other exception is a bug and its traceback is the message.
+    """
+    from xfemslip.case import loads_case
+    from xfemslip.simulation import run_case
+
+    out_dir = Path(task.out_dir)
+    spec = None
+    try:
+        spec = loads_case(task.text, Path(task.path))
+        run_case(spec, out_dir, overwrite=True)
+        return task.case_id, "ok", result_metrics(out_dir / "result.h5", spec), ""
+    except XfemslipError as err:
+        error = " ".join(str(err).split())
+    except Exception:  # a bug: keep the other cases, show where it happened
+        error = " | ".join(traceback.format_exc().strip().splitlines()[-3:])
+    metrics = {}
+    if spec is not None and (out_dir / "result.h5").is_file():
+        try:
+            metrics = result_metrics(out_dir / "result.h5", spec)
+        except OSError:
+            metrics = {}
+    return task.case_id, "failed", metrics, error
+
+
+# --------------------------------------------------------------------------- #
+# The sweep
+# --------------------------------------------------------------------------- #
+
+
+def _prepare(sweep, directory: Path, force: bool) -> tuple[list, list[CaseRow]]:
+    """Write each case.toml; (tasks to run, rows of the skipped cases)."""
+    tasks, skipped = [], []
+    for case in sweep.cases:
+        out_dir = directory / case.case_id
+        if not force and is_done(out_dir, case.text):
+            row = CaseRow(case.case_id, case.params, "skipped")
+            row.metrics = result_metrics(out_dir / "result.h5", case.spec)
+            skipped.append(row)
+            continue
+        try:
+            out_dir.mkdir(parents=True, exist_ok=True)
+            header = f"# generated by xfemslip sweep from {sweep.path}\n"
+            (out_dir / "case.toml").write_text(header + case.text, encoding="utf-8")
+        except OSError as exc:
+            raise OutputError(f"cannot write {out_dir}: {exc.strerror}") from None
+        tasks.append(CaseTask(case.case_id, case.text, str(case.path), str(out_dir)))
+    return tasks, skipped
+
+
+def _outcome(task: CaseTask, future) -> tuple:
+    """A finished future's result; a lost worker (killed, out of memory) or a
+    pickling problem is that case's failure, not the sweep's."""
+    try:
+        return future.result()
+    except Exception as exc:  # noqa: BLE001 -- reported in the case's row
+        return task.case_id, "failed", {}, f"worker error: {type(exc).__name__}: {exc}"
+
+
+def _run_local(tasks: list[CaseTask], jobs: int) -> Iterable[tuple]:
+    """Results in completion order: in this process, or a spawn process pool."""
+    jobs = min(jobs, len(tasks))  # no idle workers to start
+    if jobs <= 1:
+        for task in tasks:
+            yield run_task(task)
+        return
+    context = get_context("spawn")  # no forked Numba/BLAS state in the workers
+    with ProcessPoolExecutor(max_workers=jobs, mp_context=context) as pool:
+        futures = {pool.submit(run_task, task): task for task in tasks}
+        try:
+            for future in as_completed(futures):
+                yield _outcome(futures[future], future)
+        except BaseException:
+            pool.shutdown(wait=False, cancel_futures=True)
+            raise
+
+
+def require_dask() -> None:
+    """UsageError (exit 2) when dask.distributed cannot be imported."""
+    try:
+        import distributed  # noqa: F401
+    except ImportError:
+        raise UsageError(
+            "--scheduler needs dask.distributed: pip install 'xfemslip[dask]'"
+        ) from None
+
+
+def _client(scheduler: str):
+    """A dask.distributed Client of the scheduler at ``scheduler``."""
+    require_dask()
+    from distributed import Client
+
+    try:
+        return Client(scheduler, timeout="10s")
+    except (OSError, TimeoutError, ValueError) as exc:
+        raise UsageError(
+            f"--scheduler {scheduler}: cannot connect to a Dask scheduler: "
+            f"{' '.join(str(exc).split())}"
+        ) from None
+
+
+def _run_dask(tasks: list[CaseTask], client) -> Iterable[tuple]:
+    """Results in completion order from a dask.distributed ``client``."""
+    from distributed import as_completed as dask_completed
+
+    # pure=False: a rerun of the same task must run, not hit a cached result
+    futures = client.map(run_task, tasks, pure=False)
+    owner = {future.key: task for future, task in zip(futures, tasks, strict=True)}
+    try:
+        for future in dask_completed(futures):
+            yield _outcome(owner[future.key], future)
+    finally:
+        client.cancel(futures)
+
+
+def run_sweep(
+    sweep,
+    directory: Path | None = None,
+    *,
+    jobs: int = 1,
+    scheduler: str | None = None,
+    force: bool = False,
+    progress: Callable[[CaseRow], None] | None = None,
+) -> list[CaseRow]:
+    """Run every case of ``sweep`` not already done; write ``summary.csv``.
+
+    Returns the rows in case order.  ``progress(row)`` is called once per
+    case: first for the skipped ones, then as each case finishes.
+    """
+    if jobs < 1:
+        raise UsageError(f"--jobs must be >= 1, got {jobs}")
+    directory = Path(directory) if directory is not None else sweep.directory
+    # connect first: a wrong address must not leave case folders behind
+    client = _client(scheduler) if scheduler else None
+    try:
+        rows = _run_all(sweep, directory, jobs, client, force, progress)
+    finally:
+        if client is not None:
+            client.close()
+    order = {case.case_id: case.index for case in sweep.cases}
+    rows.sort(key=lambda r: order[r.case_id])
+    write_summary(directory / SUMMARY, sweep.keys, rows)
+    return rows
+
+
+def _run_all(sweep, directory, jobs, client, force, progress) -> list[CaseRow]:
+    """Prepare the folders, run what is not done; the rows in completion order."""
+    tasks, rows = _prepare(sweep, directory, force)
+    for row in rows if progress is not None else ():
+        progress(row)
+    params = {case.case_id: case.params for case in sweep.cases}
+    results = _run_dask(tasks, client) if client else _run_local(tasks, jobs)
+    for case_id, status, metrics, error in results if tasks else ():
+        row = CaseRow(case_id, params[case_id], status, metrics, error)
+        if status == "failed":
+            logger.warning("case %s failed: %s", case_id, error)
+        rows.append(row)
+        if progress is not None:
+            progress(row)
+    return rows
+
+
+# --------------------------------------------------------------------------- #
+# Summary
+# --------------------------------------------------------------------------- #
+
+
+def _cell(value) -> str:
+    """One summary value as text."""
+    if isinstance(value, bool):
+        return "true" if value else "false"
+    if isinstance(value, float):
+        return f"{value:.6g}"
+    return str(value)
+
+
+def summary_table(keys, rows: list[CaseRow]) -> tuple[list[str], list[list[str]]]:
+    """Header and text cells of the summary (CSV and printout alike)."""
+    header = ["case", *keys, *METRICS, "status", "error"]
+    body = []
+    for row in rows:
+        values = dict(row.params)
+        cells = [row.case_id, *(_cell(values[k]) for k in keys)]
+        cells += [_cell(row.metrics[m]) if m in row.metrics else "" for m in METRICS]
+        body.append([*cells, row.status, row.error])
+    return header, body
+
+
+def write_summary(path: Path, keys, rows: list[CaseRow]) -> None:
+    """``summary.csv``, written atomically."""
+    header, body = summary_table(keys, rows)
+    with atomic_path(path) as tmp, open(tmp, "w", newline="", encoding="utf-8") as fh:
+        writer = csv.writer(fh)
+        writer.writerow(header)
+        writer.writerows(body)
+
+
+def format_table(keys, rows: list[CaseRow]) -> str:
+    """The summary as an aligned text table (the error column last, unpadded)."""
+    header, body = summary_table(keys, rows)
+    header = header[1:-1]  # the case id is long; the parameters say it all
+    body = [[*cells[1:-1], cells[-1]] for cells in body]
+    widths = [max(len(r[i]) for r in [header, *body]) for i in range(len(header))]
+    lines = ["  ".join(h.ljust(w) for h, w in zip(header, widths, strict=True))]
+    for cells in body:
+        text = "  ".join(c.ljust(w) for c, w in zip(cells[:-1], widths, strict=True))
+        lines.append(f"{text}  {cells[-1]}".rstrip())
+    return "\n".join(lines)
