@@ -101,7 +101,7 @@ PROBLEMS = (
     Problem("inclined-30", 30.0),
     Problem("inclined-60", 60.0),
     Problem("cohesion-30", 30.0, friction=0.1, cohesion=2.0e6),
-    Problem("friction0.3-30", 30.0, friction=0.3),
+    Problem("friction0.2-30", 30.0, friction=0.2),
     Problem("stress-30", 30.0, plane="plane_stress"),
     Problem("frictionless-30", 30.0, friction=0.0),
     Problem("stick-80", 80.0, friction=0.3, kind="stick"),

@@ -20,6 +20,16 @@ def rows(errors, kii=0.001, problem="inclined-30"):
     ]
 
 
+def test_every_problem_is_of_its_kind():
+    # a "slip" problem must have a driving shear (else its errors are 0/0), a
+    # "stick" problem none; the window sweep spans both sides of both edges
+    for p in V.PROBLEMS:
+        assert (p.driving_shear() != 0.0) == (p.kind == "slip"), p.name
+    assert set(V.QUICK_PROBLEMS) <= {p.name for p in V.PROBLEMS}
+    (lo, hi), _ = V.window_edges()
+    assert lo == pytest.approx(21.42, abs=0.01) and hi == pytest.approx(51.88, abs=0.01)
+
+
 def test_observed_order_of_a_first_order_sequence():
     rs = rows({10: 0.04, 20: 0.02, 40: 0.01})
     V.observed_orders(rs)
