@@ -127,11 +127,12 @@ def study_penalty(work: Path, runs: int, log) -> list[dict]:
 # ---------------------------------------------------------------- OGS problem
 
 OGS = dict(L=20.0, a=1.0, theta=45.0, E=5e9, nu=0.3, k=5e12, f=0.1)
+GROWTH = 1.2  # size ratio of neighbouring cells outside the crack's square
 
 
 def graded_lines(h: float, offset: float, core: float, half: float) -> np.ndarray:
     """Node lines: spacing h on [-core, core] (shifted by offset), then growing
-    by 1.2 per cell to +/- half."""
+    by GROWTH per cell to +/- half."""
     k0 = math.ceil((-core - offset) / h)
     k1 = math.floor((core - offset) / h)
     inner = offset + h * np.arange(k0, k1 + 1)
@@ -139,11 +140,11 @@ def graded_lines(h: float, offset: float, core: float, half: float) -> np.ndarra
     def grow(start, sign):
         pts, step, x = [], h, start
         while abs(x) < half:
-            step *= 1.2
+            step *= GROWTH
             x = x + sign * step
             pts.append(x)
         pts[-1] = sign * half
-        if len(pts) > 1 and abs(pts[-1] - pts[-2]) < 0.5 * step / 1.2:
+        if len(pts) > 1 and abs(pts[-1] - pts[-2]) < 0.5 * step / GROWTH:
             pts.pop(-2)  # merge a sliver last cell into its neighbour
         return pts
 
@@ -370,6 +371,7 @@ def pareto_plot(tips, ogs, path: Path, ogs_peer=None) -> None:
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
+    import matplotlib.ticker
 
     fig, ax = plt.subplots(figsize=(7, 5))
     for k, tip in enumerate(dict.fromkeys(r["tip"] for r in tips)):

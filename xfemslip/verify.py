@@ -571,6 +571,7 @@ def write_plot(report: Report, path: Path) -> None:
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
+    import matplotlib.ticker
 
     fig, (ax1, ax2) = plt.subplots(1, 2, figsize=(11, 4.5))
     by = {}
@@ -597,6 +598,7 @@ def write_plot(report: Report, path: Path) -> None:
         )
         ax1.loglog(h_all, e_ref * (h_all / h_all.max()), "k:", label="order 1")
     for ax in (ax1, ax2):
+        ax.xaxis.set_minor_formatter(matplotlib.ticker.NullFormatter())
         ax.axhline(SLIP_TARGET, color="grey", lw=0.8)
         ax.grid(True, which="both", alpha=0.3)
         ax.set_ylabel("relative error")
