@@ -217,9 +217,8 @@ def info() -> None:
 @click.option("--quick", is_flag=True, help="CI-sized: fewer problems and meshes.")
 @click.option(
     "--tip",
-    type=click.Choice(["branch", "ramp"]),
     default=None,
-    help="Crack-tip treatment [default: the case-format default].",
+    help="Crack-tip treatment, e.g. branch or ramp [default: the case default].",
 )
 @click.option(
     "--plot",

@@ -619,10 +619,13 @@ def main(*, quick=False, tip=None, plot=None, csv_path=None) -> bool:
     """``xfemslip verify``: run, print the table; True when every target is met."""
     import click
 
-    if plot is not None and Path(plot).suffix.lower() not in (".png", ".pdf"):
-        from xfemslip.errors import UsageError
+    from xfemslip.case_fractures import TIP_KINDS
+    from xfemslip.errors import UsageError
 
+    if plot is not None and Path(plot).suffix.lower() not in (".png", ".pdf"):
         raise UsageError(f"--plot {plot}: expected a .png or .pdf file name")
+    if tip is not None and tip not in TIP_KINDS:
+        raise UsageError(f"--tip {tip}: expected one of {', '.join(TIP_KINDS)}")
     start = time.perf_counter()
 
     def progress(msg):

@@ -90,6 +90,12 @@ def test_plot_name_must_be_png_or_pdf(tmp_path):
     assert not (tmp_path / "p.txt").exists()
 
 
+def test_unknown_tip_is_refused():
+    res = CliRunner().invoke(cli, ["verify", "--quick", "--tip", "sharp"])
+    assert res.exit_code == 2
+    assert "--tip sharp: expected one of branch, ramp" in res.output
+
+
 @pytest.mark.slow
 def test_verify_quick_end_to_end(tmp_path):
     png, table = tmp_path / "v.png", tmp_path / "v.csv"
