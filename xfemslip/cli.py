@@ -231,14 +231,22 @@ def info() -> None:
     type=click.Path(dir_okay=False, path_type=Path),
     help="Write the table as CSV.",
 )
+@click.option(
+    "--penalty",
+    default="100",
+    show_default=True,
+    help="kn h / E of the problems, or auto: leave kn, kt to the case default.",
+)
 @_debug_option
-def verify(quick, tip, plot, csv_path, debug) -> None:
+def verify(quick, tip, plot, csv_path, penalty, debug) -> None:
     """Run the verification problems against closed forms; exit 1 if a target
     is missed (see README, Verification)."""
     with _reported_errors(debug):
         from xfemslip.verify import main as verify_main
 
-        if not verify_main(quick=quick, tip=tip, plot=plot, csv_path=csv_path):
+        if not verify_main(
+            quick=quick, tip=tip, plot=plot, csv_path=csv_path, penalty=penalty
+        ):
             raise click.exceptions.Exit(EXIT_FAILURE)
 
 

@@ -53,6 +53,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from xfemslip.closed_form import kolosov
+from xfemslip.post import fracture_fields
 
 # Gauss rule on intact cells of the domain (the auxiliary field is smooth there,
 # away from the tip; 4 x 4 is exact for degree 7 per direction)
@@ -295,10 +296,12 @@ def _face_term(model, contact, fi, tip, q_nodes, r_out, r_in, mu, kappa, tractio
     """Crack-face part of I, + int p . [[u^aux_,1]] q ds, (2,)."""
     fr = model.fractures[fi]
     ip = model.ip
+    # the tractions result.h5 reports, per interface point, ordered by s
+    ff = fracture_fields(ip, contact, len(model.fractures))[fi]
     m = np.nonzero(ip.fracture == fi)[0]
-    m = m[np.argsort(ip.s[m], kind="stable")]
-    s_ip = ip.s[m]
-    pn, pt = contact.pn[m], contact.pt[m]
+    m = m[np.argsort(ip.s[m], kind="stable")]  # the same order
+    s_ip = ff.s
+    pn, pt = ff.normal_traction, ff.shear_traction
     s0 = model.spec.loading.initial_stress
     if s0 is not None:  # in-situ face traction: subtract it (see module doc)
         S0 = _tensor(np.asarray(s0, float)[None, :])[0]

@@ -41,6 +41,7 @@ import numpy as np
 from xfemslip import closed_form as cf
 from xfemslip.case import load_case
 from xfemslip.jintegral import stress_intensity_factors
+from xfemslip.post import fracture_fields
 from xfemslip.simulation import build_model
 from xfemslip.solver import NewtonSolver
 
@@ -109,14 +110,21 @@ PROBLEMS = (
 QUICK_PROBLEMS = ("inclined-30", "stress-30", "frictionless-30", "stick-80")
 
 
-def case_text(n: int, prob: Problem, tip: str | None, penalty: float) -> str:
-    """TOML of the problem on an n x n mesh of the box (edges from CSV files)."""
+def case_text(n: int, prob: Problem, tip: str | None, penalty: float | None) -> str:
+    """TOML of the problem on an n x n mesh of the box (edges from CSV files).
+
+    penalty : kn h / E (= kt h / E), or None to leave kn and kt out.
+    """
     a = HALF_LENGTH
     p = math.radians(prob.psi)
     t = (math.cos(p), math.sin(p))
     p0 = (CENTER[0] - a * t[0], CENTER[1] - a * t[1])
     p1 = (CENTER[0] + a * t[0], CENTER[1] + a * t[1])
-    kn = penalty * E / (2 * HALF_BOX / n)
+    if penalty is None:  # the case format's default (automatic, if it has one)
+        penalty_lines = ""
+    else:
+        kn = penalty * E / (2 * HALF_BOX / n)
+        penalty_lines = f"kn = {kn!r}\nkt = {kn!r}\n"
     tip_line = f'tip = "{tip}"\n' if tip else ""
     return f"""name = "verify-{prob.name}-{n}"
 
@@ -136,9 +144,7 @@ model = "{prob.plane}"
 points = [[{p0[0]!r}, {p0[1]!r}], [{p1[0]!r}, {p1[1]!r}]]
 friction = {prob.friction!r}
 cohesion = {prob.cohesion!r}
-kn = {kn!r}
-kt = {kn!r}
-{tip_line}
+{penalty_lines}{tip_line}
 [loading]
 steps = 1
 
@@ -225,16 +231,15 @@ def solve_case(path: Path) -> Solved:
 
 
 def fracture_arrays(solved: Solved) -> dict:
-    """s, slip, p_N, state of fracture 0, ordered by arc length."""
-    ip = solved.model.ip
-    m = np.nonzero(ip.fracture == 0)[0]
-    m = m[np.argsort(ip.s[m], kind="stable")]
-    c = solved.contact
+    """s, slip, p_N, state of fracture 0, ordered by arc length (the fields
+    that ``result.h5`` reports, from post.fracture_fields)."""
+    model = solved.model
+    ff = fracture_fields(model.ip, solved.contact, len(model.fractures))[0]
     return {
-        "s": ip.s[m],
-        "slip": c.gt[m],
-        "pn": c.pn[m],
-        "state": c.state[m],
+        "s": ff.s,
+        "slip": ff.slip,
+        "pn": ff.normal_traction,
+        "state": ff.state,
     }
 
 
@@ -306,7 +311,11 @@ def _profile_kw(prob: Problem) -> dict:
 
 
 def run_problem(
-    prob: Problem, a_over_h: int, tip: str | None, penalty: float, workdir: Path
+    prob: Problem,
+    a_over_h: int,
+    tip: str | None,
+    penalty: float | None,
+    workdir: Path,
 ) -> Row:
     """Write, solve and measure one problem on the mesh h = a / a_over_h."""
     n = int(round(2 * HALF_BOX * a_over_h / HALF_LENGTH))
@@ -615,7 +624,7 @@ def write_plot(report: Report, path: Path) -> None:
     plt.close(fig)
 
 
-def main(*, quick=False, tip=None, plot=None, csv_path=None) -> bool:
+def main(*, quick=False, tip=None, plot=None, csv_path=None, penalty="100") -> bool:
     """``xfemslip verify``: run, print the table; True when every target is met."""
     import click
 
@@ -626,12 +635,23 @@ def main(*, quick=False, tip=None, plot=None, csv_path=None) -> bool:
         raise UsageError(f"--plot {plot}: expected a .png or .pdf file name")
     if tip is not None and tip not in TIP_KINDS:
         raise UsageError(f"--tip {tip}: expected one of {', '.join(TIP_KINDS)}")
+    if penalty == "auto":
+        ratio = None
+    else:
+        try:
+            ratio = float(penalty)
+        except ValueError:
+            ratio = -1.0
+        if not ratio > 0.0:
+            raise UsageError(
+                f"--penalty {penalty}: expected a positive number (kn h / E) or auto"
+            )
     start = time.perf_counter()
 
     def progress(msg):
         click.echo(f"[{time.perf_counter() - start:6.1f} s] {msg}", err=True)
 
-    report = run_verification(quick=quick, tip=tip, progress=progress)
+    report = run_verification(quick=quick, tip=tip, penalty=ratio, progress=progress)
     click.echo(format_table(report))
     if csv_path is not None:
         write_csv(report, Path(csv_path))

@@ -69,8 +69,15 @@ def test_williams_fields_are_consistent(plane, mode):
 
 
 class _Tractions:
+    """A contact result with given tractions at every interface point (the
+    fields post.fracture_fields reads, under both of their names)."""
+
     def __init__(self, pn, pt):
-        self.pn, self.pt = pn, pt
+        zero = np.zeros_like(pn)
+        self.pn, self.pt, self.gn, self.gt = pn, pt, zero, zero
+        self.state = np.zeros(pn.size, np.int8)
+        self.point_pn, self.point_pt, self.point_gn, self.point_gt = pn, pt, zero, zero
+        self.point_state = self.state
 
 
 @pytest.fixture(scope="module")

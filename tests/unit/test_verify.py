@@ -96,6 +96,20 @@ def test_unknown_tip_is_refused():
     assert "--tip sharp: expected one of branch, ramp" in res.output
 
 
+def test_bad_penalty_is_refused():
+    res = CliRunner().invoke(cli, ["verify", "--quick", "--penalty", "-3"])
+    assert res.exit_code == 2
+    assert "expected a positive number (kn h / E) or auto" in res.output
+
+
+def test_auto_penalty_leaves_kn_kt_out():
+    text = V.case_text(40, V.PROBLEMS[0], None, None)
+    assert "kn =" not in text and "kt =" not in text
+    text = V.case_text(40, V.PROBLEMS[0], "ramp", 100.0)
+    # kn = 100 E / h with h = 2 m / 40
+    assert f"kn = {100.0 * V.E / 0.05!r}" in text and 'tip = "ramp"' in text
+
+
 @pytest.mark.slow
 def test_verify_quick_end_to_end(tmp_path):
     png, table = tmp_path / "v.png", tmp_path / "v.csv"
