@@ -453,11 +453,13 @@ def check_targets(rows: list[Row], window: list[WindowPoint]) -> list[str]:
     for name in dict.fromkeys(r.problem for r in rows):
         if name in probs and probs[name].kind != "slip":
             continue
+        meshes = {r.a_over_h for r in rows if r.problem == name}
+        if not {10, 40} <= meshes:
+            continue  # the target is for a/10 .. a/40 (not run with --quick)
         order = order_between(rows, name, 10, 40)
-        if math.isfinite(order) and order < ORDER_TARGET:
-            hi = max(r.a_over_h for r in rows if r.problem == name)
+        if order < ORDER_TARGET:
             fails.append(
-                f"{name}: observed order {order:.2f} between a/10 and a/{min(hi, 40)} "
+                f"{name}: observed order {order:.2f} between a/10 and a/40 "
                 f"< {ORDER_TARGET:g}"
             )
     fails += [
@@ -544,6 +546,8 @@ def format_table(report: Report) -> str:
             for w in report.window
         ]
     lines.append("")
+    if not any(r.a_over_h == 40 for r in report.rows):
+        lines.append("observed-order target not checked: it needs h = a/40 (full run)")
     if report.failures:
         lines.append("targets missed:")
         lines += [f"  - {f}" for f in report.failures]

@@ -48,6 +48,9 @@ def test_targets_met_and_missed():
     assert "slip L2 error 1.50 % > 1 %" in text
     assert "K_II error 3.00 % > 2 %" in text
     assert "observed order 0.37 between a/10 and a/40" in text
+    # without a/40 (--quick) the order target is not checked
+    quick = rows({10: 0.02, 20: 0.015})
+    assert not any("order" in f for f in V.check_targets(quick, []))
 
 
 def test_window_misclassification_counts_only_beyond_two_degrees():
