@@ -10,6 +10,7 @@ import pytest
 from click.testing import CliRunner
 
 from xfemslip import verify as V
+from xfemslip import verify_output as VO
 from xfemslip.cli import cli
 
 
@@ -78,10 +79,10 @@ def test_table_lists_every_row_and_the_verdict():
     rs = rows({10: 0.016, 20: 0.008})
     V.observed_orders(rs)
     report = V.Report(rows=rs, window=[], failures=[], tip=None)
-    text = V.format_table(report)
+    text = VO.format_table(report)
     assert "inclined-30" in text and "a/20" in text and "all targets met" in text
     report.failures = ["x: y"]
-    assert "targets missed:\n  - x: y" in V.format_table(report)
+    assert "targets missed:\n  - x: y" in VO.format_table(report)
 
 
 def test_plot_name_must_be_png_or_pdf(tmp_path):
