@@ -1,4 +1,4 @@
-"""Command-line interface: ``xfemslip run | check | info``.
+"""Command-line interface: ``xfemslip run | check | info | verify``.
 
 This module parses arguments, configures logging, calls the library and maps
 its errors to messages and exit codes.  It does no numerics.
@@ -219,6 +219,43 @@ def info() -> None:
     width = max(len(name) for name, _ in rows)
     for name, value in rows:
         click.echo(f"{name:<{width}}  {value}")
+
+
+@cli.command()
+@click.option("--quick", is_flag=True, help="CI-sized: fewer problems and meshes.")
+@click.option(
+    "--tip",
+    default=None,
+    help="Crack-tip treatment, e.g. branch or ramp [default: the case default].",
+)
+@click.option(
+    "--plot",
+    type=click.Path(dir_okay=False, path_type=Path),
+    help="Write error vs h and error vs wall time (.png or .pdf).",
+)
+@click.option(
+    "--csv",
+    "csv_path",
+    type=click.Path(dir_okay=False, path_type=Path),
+    help="Write the table as CSV.",
+)
+@click.option(
+    "--penalty",
+    default="100",
+    show_default=True,
+    help="kn h / E of the problems, or auto: leave kn, kt to the case default.",
+)
+@_debug_option
+def verify(quick, tip, plot, csv_path, penalty, debug) -> None:
+    """Run the verification problems against closed forms; exit 1 if a target
+    is missed (see README, Verification)."""
+    with _reported_errors(debug):
+        from xfemslip.verify import main as verify_main
+
+        if not verify_main(
+            quick=quick, tip=tip, plot=plot, csv_path=csv_path, penalty=penalty
+        ):
+            raise click.exceptions.Exit(EXIT_FAILURE)
 
 
 def _dist_version(name: str) -> str:

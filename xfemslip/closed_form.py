@@ -121,6 +121,54 @@ def displacement(
     return u + np.outer(ux_l, t) + np.outer(uy_l, n)
 
 
+def _local_frame(points, center, psi_deg):
+    """Crack-frame coordinates (x_l, y_l) and the unit vectors t, n."""
+    pts = np.asarray(points, dtype=float) - np.asarray(center, dtype=float)
+    p = math.radians(psi_deg)
+    t = np.array([math.cos(p), math.sin(p)])
+    n = np.array([-math.sin(p), math.cos(p)])
+    return pts @ t, pts @ n, t, n
+
+
+def stress_field(points, center, a, stress, psi_deg, friction, cohesion=0.0):
+    """Exact stress (N, 3) [sxx, syy, sxy] [Pa] of the cracked infinite plane.
+
+    Remote stress plus the Westergaard mode-II perturbation of the slipping
+    crack, Z = Delta tau (z / sqrt(z^2 - a^2) - 1), Z' = -Delta tau a^2 /
+    (z^2 - a^2)^(3/2), in the crack frame (Westergaard 1939; Anderson,
+    "Fracture mechanics", 3rd ed., appendix 2.3):
+
+        s_xx = 2 Im Z + y Re Z',  s_yy = -y Re Z',  s_xy = Re Z - y Im Z'.
+
+    The same in plane strain and plane stress (the in-plane stresses of a
+    traction problem do not depend on the elastic constants).  On the faces
+    (y = 0, |x| < a) the shear is t_T - Delta tau, the friction bound.
+    """
+    xl, yl, t, n = _local_frame(points, center, psi_deg)
+    base = stress_matrix(stress)
+    out = np.tile(np.array([base[0, 0], base[1, 1], base[0, 1]]), (xl.size, 1))
+    dtau = driving_shear(stress, psi_deg, friction, cohesion)
+    if dtau == 0.0:
+        return out
+    z = xl + 1j * yl
+    root = np.sqrt(z - a) * np.sqrt(z + a)
+    Z = dtau * (z / root - 1.0)
+    dZ = -dtau * a * a / root**3
+    sxx = 2.0 * Z.imag + yl * dZ.real
+    syy = -yl * dZ.real
+    sxy = Z.real - yl * dZ.imag
+    # rotate the crack-frame perturbation to x, y: s = R^T s_l R, R rows (t, n)
+    R = np.array([t, n])
+    local = np.empty((xl.size, 2, 2))
+    local[:, 0, 0], local[:, 1, 1] = sxx, syy
+    local[:, 0, 1] = local[:, 1, 0] = sxy
+    glob = np.einsum("ki,nkl,lj->nij", R, local, R)
+    out[:, 0] += glob[:, 0, 0]
+    out[:, 1] += glob[:, 1, 1]
+    out[:, 2] += glob[:, 0, 1]
+    return out
+
+
 def k_ii(stress, psi_deg, a, friction, cohesion=0.0):
     """Mode-II stress intensity factor K_II = Delta tau sqrt(pi a) [Pa sqrt(m)].
 
