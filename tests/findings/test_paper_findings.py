@@ -125,10 +125,11 @@ def test_slip_shrinks_as_friction_grows_and_vanishes_at_06(studies):
 
 @pytest.mark.slow
 def test_finer_angle_sweep_peaks_at_45_minus_phi_over_2(tmp_path):
-    """Angles 0..90 by 3 degrees: slip exactly inside the closed-form window
-    (away from its edges by more than 3 degrees, the documented limit of the
-    contact tractions near the tips), and the largest slip within 3 degrees
-    of the critical orientation 90 - (45 - phi/2) = 47.9 degrees from +x."""
+    """Angles 0..90 by 3 degrees: every point slips inside the closed-form
+    window and none outside (away from its edges by more than 0.5 degrees,
+    the margin of the slip-window sweep test), and the largest slip within
+    3 degrees of the critical orientation 90 - (45 - phi/2) = 47.9 degrees
+    from +x."""
     base = (ROOT / "cases" / "reservoir_depletion.toml").as_posix()
     sweep = tmp_path / "angles.toml"
     sweep.write_text(
@@ -141,8 +142,9 @@ def test_finer_angle_sweep_peaks_at_45_minus_phi_over_2(tmp_path):
     lo, hi = slip_window(s1, s3, 0.1)
     for angle, metrics in slips.items():
         beta = angle_to_sigma1(angle, dir1)
-        if min(abs(beta - lo), abs(beta - hi)) > 3.0:
-            assert (metrics["slip_share"] > 0.0) == (lo < beta < hi), angle
+        if min(abs(beta - lo), abs(beta - hi)) > 0.5:
+            expected = 1.0 if lo < beta < hi else 0.0
+            assert metrics["slip_share"] == expected, angle
     peak = max(slips, key=lambda a: slips[a]["max_abs_slip_m"])
     critical = 90.0 - (45.0 - math.degrees(math.atan(0.1)) / 2.0)
     assert abs(peak - critical) <= 3.0
