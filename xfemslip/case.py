@@ -157,6 +157,14 @@ SOLVER_OPTIONS: tuple[Option, ...] = (
         "contact tangent: 'consistent' (Newton) or 'secant' (paper eq. 28)",
         ("consistent", "secant"),
     ),
+    Option(
+        "max_step_cuts",
+        int,
+        5,
+        "bisections of a load step that does not converge (0: none); the "
+        "smallest sub-step is 1/2**max_step_cuts of the step",
+        Range(0, 30),
+    ),
 )
 
 

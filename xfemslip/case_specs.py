@@ -98,10 +98,12 @@ class SolverSpec:
     tolerance: float = 1.0e-8  # eta_0 on ||residual|| / ||F_ext||
     max_iterations: int = 30  # Newton iterations per load step
     tangent: str = "consistent"  # "consistent" | "secant" (paper eq. 28)
+    max_step_cuts: int = 5  # bisections of a failing load step
     UNITS: ClassVar[dict[str, str]] = {
         "tolerance": "-",
         "max_iterations": "-",
         "tangent": "",
+        "max_step_cuts": "-",
     }
 
 
