@@ -103,4 +103,3 @@ def check_memory(spec) -> None:
             f"{limit / 1e9:.3g} GB available ({source}); use fewer elements, or set "
             f"{ENV_LIMIT} (bytes) to allow more"
         )
-

@@ -347,9 +347,7 @@ class NewtonSolver:
                 r, eta = self._residual(u, lam, res)
             du = self._solve(res, r, k, it, eta)
             pt_prev, gt_prev, prev_regime = res.pt, res.gt, regime
-            u, res, r, eta = self._line_search(
-                u, du, lam, eta, pt_prev, gt_prev, law
-            )
+            u, res, r, eta = self._line_search(u, du, lam, eta, pt_prev, gt_prev, law)
         raise AssertionError("unreachable")
 
     def _line_search(self, u, du, lam, eta0, pt_prev, gt_prev, law=None):
