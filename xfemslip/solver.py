@@ -347,7 +347,20 @@ class NewtonSolver:
                 r, eta = self._residual(u, lam, res)
             du = self._solve(res, r, k, it, eta)
             pt_prev, gt_prev, prev_regime = res.pt, res.gt, regime
+            eta_before = eta
             u, res, r, eta = self._line_search(u, du, lam, eta, pt_prev, gt_prev, law)
+            if self.mode == kernels.TANGENT_SECANT and not eta < eta_before:
+                # the secant direction is no descent direction (it drops the
+                # n-t coupling of the slip law): one consistent iteration
+                log.fallbacks += 1
+                logger.info(
+                    "step %d/%d iteration %d: the secant tangent gave no descent; "
+                    "the next iteration uses the consistent tangent",
+                    k,
+                    steps,
+                    it + 1,
+                )
+                res = law.evaluate(u, kernels.TANGENT_CONSISTENT, pt_prev, gt_prev)
         raise AssertionError("unreachable")
 
     def _line_search(self, u, du, lam, eta0, pt_prev, gt_prev, law=None):
@@ -391,6 +404,19 @@ class NewtonSolver:
                 )
             else:
                 why += "; use more load steps or raise [solver] max_iterations"
+        for index, _ in self.p.floating or []:
+            why += (
+                f"; fractures[{index}] cuts the domain in two and one part is held "
+                "by the fracture alone: once the shear driving that part exceeds "
+                "friction x normal force + cohesion x length it has no static "
+                "equilibrium (rigid sliding without bound); prescribe a displacement "
+                "on that part, or raise the friction or cohesion"
+            )
+        if self.mode == kernels.TANGENT_SECANT:
+            why += (
+                '; or set [solver] tangent = "consistent" (the secant tangent '
+                "converges linearly at best)"
+            )
         return why
 
     def _check_floating(self, res, k, it, eta):
@@ -458,6 +484,7 @@ class _NewtonLog:
 
     iterations: int = 0
     freezes: int = 0
+    fallbacks: int = 0  # secant iterations replaced by a consistent one
     residuals: list = None
     switches: list = None
 
