@@ -36,13 +36,15 @@ PENALTY_RATIO_HIGH = 1.0e5
 # Step halvings tried by the line search before keeping the best trial.
 LINE_SEARCH_CUTS = 6
 # Ping-pong remedy: a contact point whose branch of the law (stick, slip +t,
-# slip -t) goes A -> B -> A -> B over four successive iterates is cycling.  It
+# slip -t) alternates A, B, A, B, A, B over six successive iterates is cycling.  It
 # is then frozen in STICK (see _frozen_law) until Newton converges; the true
 # law is then restored and Newton continues from there, so an accepted step
 # always satisfies the true law.  At most
 # PINGPONG_MAX_FREEZES freezes per attempt; after that the attempt fails and
 # the load step is bisected.
 PINGPONG_MAX_FREEZES = 2
+# Periods A, B of the alternation that count as cycling (3: six iterates).
+PINGPONG_PERIODS = 3
 # Load-step bisection: a load step that does not converge is cut in halves, at
 # most this many times by default ([solver] max_step_cuts), so the smallest
 # sub-step is 1/2**5 = 1/32 of the step.  Every converged sub-step commits the
@@ -81,6 +83,7 @@ class StepResult:
     cuts: int = 0  # load-step bisections needed in this step
     substeps: int = 1  # converged sub-steps that make up this step
     freezes: int = 0  # ping-pong freezes (all sub-steps)
+    factors: list = None  # load factors of the converged sub-steps, in order
 
 
 # SuperLU settings for K + K_contact, whose sparsity pattern is symmetric even
@@ -183,12 +186,13 @@ class NewtonSolver:
 
         The step is split into 2**max_cuts units; ``size`` is the current
         sub-step in units.  A converged sub-step commits the contact history
-        and the next one tries the same size again; a failed one is retried
-        from the last committed state at half the size.
+        and the next one tries twice the size; a failed one is retried from
+        the last committed state at half the size.
         """
         units = 1 << self.max_cuts
         done, size = 0, units
         cuts = substeps = iterations = freezes = 0
+        factors = []  # load factors of the converged sub-steps
         while done < units:
             end = min(done + size, units)
             lam = lam1 if end == units else lam0 + (lam1 - lam0) * end / units
@@ -218,6 +222,9 @@ class NewtonSolver:
             self.p.contact.commit(res)
             u = u_new
             done = end
+            factors.append(lam)
+            if cuts:  # after a success, try a sub-step twice as long again
+                size = min(2 * size, units)
             substeps += 1
             iterations += log.iterations
             freezes += log.freezes
@@ -241,6 +248,7 @@ class NewtonSolver:
                 cuts=cuts,
                 substeps=substeps,
                 freezes=freezes,
+                factors=factors,
             )
         )
         return u
@@ -407,10 +415,11 @@ class NewtonSolver:
         for index, _ in self.p.floating or []:
             why += (
                 f"; fractures[{index}] cuts the domain in two and one part is held "
-                "by the fracture alone: once the shear driving that part exceeds "
-                "friction x normal force + cohesion x length it has no static "
-                "equilibrium (rigid sliding without bound); prescribe a displacement "
-                "on that part, or raise the friction or cohesion"
+                "by the fracture alone: when the shear driving that part reaches "
+                "friction x normal force + cohesion x length there is no static "
+                "equilibrium (rigid sliding without bound), and close to it Newton "
+                "may not find one; prescribe a displacement on that part, or raise "
+                "the friction or cohesion"
             )
         if self.mode == kernels.TANGENT_SECANT:
             why += (
@@ -507,13 +516,16 @@ def _short_reason(err) -> str:
 
 
 def _cycling(history):
-    """Points whose tangential branch went A -> B -> A -> B over the last four
-    iterates (A != B, both closed), or None."""
-    if len(history) < 4:
+    """Points whose tangential branch alternated A, B, A, B, ... over the last
+    PINGPONG_PERIODS * 2 iterates (A != B, both closed), or None."""
+    n = 2 * PINGPONG_PERIODS
+    if len(history) < n:
         return None
-    a, b, c, d = history[-4:]
-    closed = (a != OPEN) & (b != OPEN)
-    mask = (a == c) & (b == d) & (a != b) & closed
+    last = history[-n:]
+    a, b = last[-2], last[-1]
+    mask = (a != b) & (a != OPEN) & (b != OPEN)
+    for i, regime in enumerate(last):
+        mask &= regime == (a if i % 2 == 0 else b)
     return mask if mask.any() else None
 
 

@@ -40,6 +40,9 @@ RESERVOIR = ROOT / "cases" / "reservoir_depletion.toml"
 OPEN, STICK, SLIP = 0, 1, 2
 
 STRESS = (-20.0e6, -40.0e6, 0.0)  # far field of the crack cases [Pa]
+# with shear, so that a horizontal crack (along element edges) slips:
+# tau = 8 MPa > f |sigma_n| = 4 MPa at f = 0.1
+SHEAR_STRESS = (-20.0e6, -40.0e6, 8.0e6)
 A = 0.5  # crack half-length [m]
 E0 = 5.0e9  # Young's modulus of the crack cases [Pa]
 
@@ -127,6 +130,7 @@ class Crack:
     steps: int = 1
     tip: str = "branch"
     max_iterations: int = 30
+    stress: tuple = STRESS  # far field (xx, yy, xy) [Pa]
 
     @property
     def h(self) -> float:
@@ -139,7 +143,7 @@ class Crack:
             E=self.E,
             nu=self.nu,
             plane="plane_strain",
-            stress=STRESS,
+            stress=self.stress,
             psi_deg=self.psi,
             friction=self.friction,
             cohesion=self.cohesion,
@@ -192,7 +196,7 @@ max_iterations = {self.max_iterations}
 
     def no_slip_cohesion(self) -> float:
         """Cohesion above which the closed form says the crack sticks [Pa]."""
-        t_n, t_t = cf.crack_tractions(STRESS, self.psi)
+        t_n, t_t = cf.crack_tractions(self.stress, self.psi)
         return max(0.0, abs(t_t) - self.friction * max(0.0, -t_n))
 
 
@@ -218,7 +222,7 @@ def _profile_args(crack: Crack) -> dict:
         E=crack.E,
         nu=crack.nu,
         plane="plane_strain",
-        stress=STRESS,
+        stress=crack.stress,
         psi_deg=crack.psi,
         friction=crack.friction,
         cohesion=crack.cohesion,
