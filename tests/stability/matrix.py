@@ -241,9 +241,20 @@ def run_crack(crack: Crack, tangent="consistent", folder=None) -> tuple:
 # ------------------------------------------------------------- reservoir cases
 
 
-def reservoir_text(*, n=20, angle=45.0, friction=0.1, cohesion=0.0, steps=1,
-                   points=None, extra_fractures="", E=5.0e9, nu=0.3,
-                   initial_stress=None, max_iterations=30) -> str:
+def reservoir_text(
+    *,
+    n=20,
+    angle=45.0,
+    friction=0.1,
+    cohesion=0.0,
+    steps=1,
+    points=None,
+    extra_fractures="",
+    E=5.0e9,
+    nu=0.3,
+    initial_stress=None,
+    max_iterations=30,
+) -> str:
     """The reservoir case on an n x n mesh with one fracture (and extra ones)."""
     text = RESERVOIR.read_text()
     text = text.replace("elements = [50, 50]", f"elements = [{n}, {n}]")
@@ -256,7 +267,9 @@ def reservoir_text(*, n=20, angle=45.0, friction=0.1, cohesion=0.0, steps=1,
     text = text.replace("max_iterations = 30", f"max_iterations = {max_iterations}")
     if points is not None:
         text = text.replace("center = [0.5, 0.5]", f"points = {points!r}")
-        text = text.replace("length = 0.6\n", "").replace(f"angle = {float(angle)!r}\n", "")
+        text = text.replace("length = 0.6\n", "").replace(
+            f"angle = {float(angle)!r}\n", ""
+        )
     if initial_stress is not None:
         xx, yy, xy = initial_stress
         text = text.replace(
@@ -280,8 +293,9 @@ def window_reference(angle: float, friction: float) -> tuple[bool, float]:
 # ------------------------------------------------------------------ the block
 
 
-def block_text(*, shear, pressure=10.0e6, friction=0.5, cohesion=0.0, n=10,
-               steps=1, kn=5.0e12) -> str:
+def block_text(
+    *, shear, pressure=10.0e6, friction=0.5, cohesion=0.0, n=10, steps=1, kn=5.0e12
+) -> str:
     """A 2 m x 1 m box cut by a horizontal fault at y = 0.55 (through-going):
     bottom edge fixed, top edge loaded by (shear, -pressure), sides free.  The
     top block is held by the fault alone."""
