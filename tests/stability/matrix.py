@@ -274,7 +274,8 @@ def reservoir_text(
         xx, yy, xy = initial_stress
         text = text.replace(
             "[boundary]",
-            f"[loading.initial_stress]\nxx = {xx!r}\nyy = {yy!r}\nxy = {xy!r}\n\n[boundary]",
+            f"[loading.initial_stress]\nxx = {xx!r}\nyy = {yy!r}\nxy = {xy!r}\n\n"
+            "[boundary]",
         )
     return text + extra_fractures
 

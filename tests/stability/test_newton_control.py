@@ -53,7 +53,7 @@ def test_bisection_keeps_the_friction_history_exact():
     step = cut.steps[-1]
     assert step.cuts >= 1 and step.substeps >= 2  # premise: bisection was needed
     assert step.factors[-1] == 1.0
-    assert all(b > a for a, b in zip(step.factors, step.factors[1:]))
+    assert all(b > a for a, b in zip(step.factors[:-1], step.factors[1:], strict=True))
     # without bisection, the full step fails with these settings
     plain = solve(text, RESERVOIR, "secant", max_iterations=8, max_step_cuts=0)
     assert not plain.converged and "bisection" not in plain.error
@@ -88,13 +88,13 @@ def test_exhausted_bisection_says_what_was_tried():
 
 
 def test_cycling_detection_and_frozen_law():
-    A, B, O = STICK, SLIP, 0
-    seq = [np.array([A, A, O, B]), np.array([B, A, A, B])] * 3
+    A, B, O_ = STICK, SLIP, 0
+    seq = [np.array([A, A, O_, B]), np.array([B, A, A, B])] * 3
     mask = _cycling(seq)
     assert mask.tolist() == [True, False, False, False]
     assert _cycling(seq[1:]) is None  # five iterates: not yet three periods
     # open <-> closed is left to the normal law (never frozen)
-    assert _cycling([np.array([A]), np.array([O])] * 3) is None
+    assert _cycling([np.array([A]), np.array([O_])] * 3) is None
 
 
 def test_frozen_points_stick_but_may_open():
