@@ -44,6 +44,7 @@ STRESS = (-20.0e6, -40.0e6, 0.0)  # far field of the crack cases [Pa]
 # tau = 8 MPa > f |sigma_n| = 4 MPa at f = 0.1
 SHEAR_STRESS = (-20.0e6, -40.0e6, 8.0e6)
 A = 0.5  # crack half-length [m]
+H32_N = 32  # elements per side of the crack cases
 E0 = 5.0e9  # Young's modulus of the crack cases [Pa]
 
 

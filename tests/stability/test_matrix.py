@@ -51,8 +51,8 @@ def test_penalty_sweep_consistent(kt_kn):
     """kn h / E from 1e-1 to 1e8, kt / kn = 1e-3 and 1: every case converges;
     the slip written (the whole jump, penalty compliance included) approaches
     the closed form as the penalty stiffens, and is within 2 % once
-    kt h / E >= 10.  Measured, kt = kn: 1.8 % at 0.1, 1.03 % at 1e2 .. 1e8
-    (12 Newton iterations at 1e8); kt = 1e-3 kn: 55 % at 0.1."""
+    kt h / E >= 10.  Measured, kt = kn: 19.1 % at 0.1, 2.2 % at 1, 1.01 ..
+    1.08 % at 1e2 .. 1e8; kt = 1e-3 kn: 55 % at 0.1."""
     errors = []
     for penalty in (0.1, 1.0, 1e2, 1e4, 1e6, 1e8):
         out, err, _ = run_crack(Crack(penalty=penalty, kt_kn=kt_kn))
@@ -63,9 +63,10 @@ def test_penalty_sweep_consistent(kt_kn):
     assert errors[0] > errors[-1]
 
 
-@pytest.mark.parametrize(("penalty", "limit"), [(0.1, 0.03), (1e2, 0.02), (1e8, 0.02)])
+@pytest.mark.parametrize(("penalty", "limit"), [(0.1, 0.25), (1e2, 0.02), (1e8, 0.02)])
 def test_penalty_extremes_consistent(penalty, limit):
-    """Default-tier subset of the sweep above (measured 1.8 %, 1.03 %, 1.08 %)."""
+    """Default-tier subset of the sweep above (measured 19.1 %: the penalty
+    compliance of kn h / E = 0.1 is in the jump; 1.01 %; 1.08 %)."""
     out, err, _ = run_crack(Crack(penalty=penalty))
     assert out.converged, out.error
     assert err < limit, err
