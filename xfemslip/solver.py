@@ -454,7 +454,7 @@ class NewtonSolver:
         try:
             du = _lu_solve(A, r)
         except RuntimeError as exc:  # "Factor is exactly singular"
-            raise self._fail_final(
+            raise self._fail(
                 k,
                 it,
                 eta,
