@@ -36,10 +36,10 @@ PENALTY_RATIO_HIGH = 1.0e5
 # Step halvings tried by the line search before keeping the best trial.
 LINE_SEARCH_CUTS = 6
 # Ping-pong remedy: a contact point whose branch of the law (stick, slip +t,
-# slip -t) alternates A, B, A, B, A, B over six successive iterates is cycling.  It
-# is then frozen in STICK (see _frozen_law) until Newton converges; the true
-# law is then restored and Newton continues from there, so an accepted step
-# always satisfies the true law.  At most
+# slip -t) alternates A, B, A, B, A, B over six successive iterates is
+# cycling.  It is then frozen in STICK (see _frozen_law) until Newton
+# converges; the true law is then restored and Newton continues from there,
+# so an accepted step always satisfies the true law.  At most
 # PINGPONG_MAX_FREEZES freezes per attempt; after that the attempt fails and
 # the load step is bisected.
 PINGPONG_MAX_FREEZES = 2
