@@ -62,7 +62,7 @@ def row(group, case, tangent, out, ref, versus) -> None:
         f"| {extra} | {fmt(out.max_slip)} | {ref} | {versus} |"
     )
     if not out.converged:
-        why = out.error.partition(" did not converge: ")[2][:300]
+        why = out.error.partition(" did not converge: ")[2][:500]
         failures.append(f"- {group}, {case}, {tangent}: {why}")
     print(rows[-1], f"({out.seconds:.2f} s)", flush=True)
 
