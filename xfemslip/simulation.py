@@ -259,6 +259,8 @@ def write_output(model: Model, results, out_dir: Path, *, converged, wall, itera
         "load_steps": int(spec.loading.steps),
         "newton_iterations": int(sum(iterations)),
         "newton_iterations_per_step": np.array(iterations, dtype=np.int64),
+        # load-step bisections per written step (issue 4; 0 = not cut)
+        "load_step_cuts_per_step": np.array([r.cuts for r in results], dtype=np.int64),
         "wall_time_s": float(wall),
         "tangent": spec.solver.tangent,
         "n_dofs": int(model.problem.n_dofs),
