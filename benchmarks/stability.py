@@ -170,7 +170,7 @@ def block() -> None:
                 )
                 if out.converged:
                     res = out.steps[-1].contact
-                    w = out.model.ip.weight
+                    w = out.model.contact.weight
                     versus = (
                         f"sum p_T w / (tau L) = {np.sum(w * res.pt) / (tau * 2.0):.7f}"
                     )

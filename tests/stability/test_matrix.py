@@ -22,6 +22,8 @@ from matrix import (
     Crack,
     block_text,
     block_threshold,
+    crack_error,
+    point_fields,
     reservoir_text,
     run_crack,
     solve,
@@ -80,19 +82,21 @@ def test_penalty_sweep_secant(penalty):
 
 
 @SLOW
-def test_secant_with_extreme_penalty_fails_clearly():
-    """kn h / E = 1e8 with the secant tangent: no convergence (the secant
-    drops the n-t coupling of the slip law); the message says to lower the
-    penalty or use the consistent tangent."""
-    crack = Crack(penalty=1e8)
-    crack.max_iterations = 30
-    with_cuts = 0  # bisection cannot help here; keep the test fast
+def test_secant_with_extreme_penalty_converges_or_says_why():
+    """kn h / E = 1e8 with the secant tangent: measured here, no convergence
+    (the secant drops the n-t coupling of the slip law); the message must say
+    to lower the penalty or use the consistent tangent.  (With the contact
+    patches of a later main it converges in 8 iterations: then the slip must
+    be right.)"""
     import tempfile
 
     with tempfile.TemporaryDirectory() as tmp:
-        text, path = crack.write(Path(tmp))
-        out = solve(text, path, "secant", max_step_cuts=with_cuts)
-    assert not out.converged
+        text, path = Crack(penalty=1e8).write(Path(tmp))
+        out = solve(text, path, "secant", max_step_cuts=0)  # cuts cannot help
+    if out.converged:
+        err, _ = crack_error(Crack(penalty=1e8), out)
+        assert err < 0.02
+        return
     assert "kn*h/E up to 1.0e+08" in out.error
     assert "lower kn/kt" in out.error and 'tangent = "consistent"' in out.error
     assert not out.steps
@@ -181,11 +185,11 @@ def test_two_parallel_fractures_one_element_apart(tangent):
     single = solve(one, RESERVOIR, tangent)
     pair = solve(two, RESERVOIR, tangent)
     assert single.converged and pair.converged, pair.error
-    res = pair.steps[-1].contact
+    gt, state = point_fields(pair.steps[-1].contact)
     frac = pair.model.ip.fracture
     for i in (0, 1):
-        assert np.mean(res.state[frac == i] == SLIP) > 0.5
-        assert np.max(np.abs(res.gt[frac == i])) < single.max_slip
+        assert np.mean(state[frac == i] == SLIP) > 0.5
+        assert np.max(np.abs(gt[frac == i])) < single.max_slip
     assert np.all(np.isfinite(pair.steps[-1].u))
 
 
@@ -232,7 +236,7 @@ def test_block_below_the_sliding_threshold_holds(friction, cohesion, fraction, t
     )
     assert out.converged, out.error
     res = out.steps[-1].contact
-    w = out.model.ip.weight
+    w = out.model.contact.weight  # of each contact point (or patch)
     assert np.sum(w * res.pt) == pytest.approx(tau * length, rel=1e-6)
     assert np.sum(w * res.pn) == pytest.approx(-p * length, rel=1e-6)
     bound = cohesion - friction * res.pn
