@@ -259,8 +259,8 @@ class NewtonSolver:
         marker = " did not converge: "
         head, _, tail = text.partition(marker)
         new = ConvergenceError(
-            f"{head}{marker}even after {cuts} bisection(s) of the load step (down "
-            f"to {fraction:.3g} of it): {tail}",
+            f"{head}{marker}even after cutting the load step {cuts} time(s) "
+            f"(sub-steps down to {fraction:.3g} of it): {tail}",
             step=err.step,
             iteration=err.iteration,
             residual=err.residual,
