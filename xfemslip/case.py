@@ -167,6 +167,14 @@ SOLVER_OPTIONS: tuple[Option, ...] = (
         "pointwise penalty XFEM; 0 = pointwise (every Gauss point on its own)",
         Range(0.0, 100.0),
     ),
+    Option(
+        "max_step_cuts",
+        int,
+        5,
+        "bisections of a load step that does not converge (0: none); the "
+        "smallest sub-step is 1/2**max_step_cuts of the step",
+        Range(0, 30),
+    ),
 )
 
 

@@ -116,11 +116,13 @@ class SolverSpec:
     max_iterations: int = 30  # Newton iterations per load step
     tangent: str = "consistent"  # "consistent" | "secant" (paper eq. 28)
     contact_patch: float = CONTACT_PATCH_CELLS  # patch length [cells]; 0 = pointwise
+    max_step_cuts: int = 5  # bisections of a failing load step
     UNITS: ClassVar[dict[str, str]] = {
         "tolerance": "-",
         "max_iterations": "-",
         "tangent": "",
         "contact_patch": "cells",
+        "max_step_cuts": "-",
     }
 
 

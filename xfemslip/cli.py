@@ -12,7 +12,8 @@ Exit codes:
   that validates key by key but cannot be built, e.g. intersecting fractures --
   ``xfemslip.errors.UsageError``, a missing case file, bad command-line
   options);
-- 130: interrupted (Ctrl-C).
+- 130: interrupted (Ctrl-C, SIGINT); 143: terminated (SIGTERM, see
+  ``xfemslip.interrupt``).
 
 A library error is reported as one line ``Error: <message>`` on stderr; the
 traceback is shown only with ``--debug``.  Any other exception is a bug and
@@ -40,12 +41,14 @@ from xfemslip.errors import (
     UsageError,
     XfemslipError,
 )
+from xfemslip.interrupt import Terminated, sigterm_as_interrupt
 
 logger = logging.getLogger(__name__)
 
 EXIT_FAILURE = 1
 EXIT_USAGE = 2
 EXIT_INTERRUPTED = 130  # 128 + SIGINT, the shell convention
+EXIT_TERMINATED = 143  # 128 + SIGTERM
 
 _HANDLER_NAME = "xfemslip-cli"
 
@@ -107,11 +110,18 @@ def _reported_errors(debug: bool) -> Iterator[None]:
         click.echo(f"Error: {_one_line(err)}", err=True)
         usage = isinstance(err, CaseError | UsageError | GeometryError | MeshError)
         raise click.exceptions.Exit(EXIT_USAGE if usage else EXIT_FAILURE) from None
-    except KeyboardInterrupt:
+    except KeyboardInterrupt as err:
         if debug:
             click.secho(traceback.format_exc().rstrip(), err=True, dim=True)
-        click.echo("Error: interrupted", err=True)
-        raise click.exceptions.Exit(EXIT_INTERRUPTED) from None
+        term = isinstance(err, Terminated)
+        click.echo(
+            f"Error: interrupted ({'SIGTERM' if term else 'SIGINT'}); a file being "
+            "written was removed, no partial file is left under a final name",
+            err=True,
+        )
+        raise click.exceptions.Exit(
+            EXIT_TERMINATED if term else EXIT_INTERRUPTED
+        ) from None
 
 
 def _load(case: Path):
@@ -166,7 +176,7 @@ def run(
     debug: bool,
 ) -> None:
     """Run the case file CASE and write its results."""
-    with _reported_errors(debug):
+    with _reported_errors(debug), sigterm_as_interrupt():
         _configure_logging(verbose, quiet)
         spec = _load(case)
         from xfemslip.simulation import run_case

@@ -23,6 +23,7 @@ from xfemslip.enrichment import EnrichedCells, build_enriched_cells, find_candid
 from xfemslip.errors import ConvergenceError, GeometryError, OutputError, UsageError
 from xfemslip.geometry import build_fractures
 from xfemslip.material import elasticity_matrix
+from xfemslip.memory import check_memory
 from xfemslip.mesh import Mesh, build_mesh
 from xfemslip.post import STATE_CODES, bulk_fields, fracture_fields, vis_mesh
 from xfemslip.quadrature import InterfacePoints, interface_points
@@ -70,7 +71,9 @@ def _naming_the_file(spec):
 
 
 def _geometry(spec):
-    """Mesh and fractures."""
+    """Mesh and fractures (after the memory estimate: nothing large is
+    allocated for a case that would not fit)."""
+    check_memory(spec)
     mesh = build_mesh(spec.mesh.x, spec.mesh.y)
     box = np.array([mesh.x[0], mesh.x[-1], mesh.y[0], mesh.y[-1]])
     with _naming_the_file(spec):
@@ -212,6 +215,7 @@ def run_case(
         spec.solver.tolerance,
         spec.solver.max_iterations,
         spec.solver.tangent,
+        max_step_cuts=spec.solver.max_step_cuts,
     )
     failure = None
     try:
@@ -250,6 +254,11 @@ def write_output(model: Model, results, out_dir: Path, *, converged, wall, itera
             f"cannot create output directory {out_dir}: {exc.strerror}"
         ) from None
     fields = [step_fields(model, r) for r in results]
+    bad = _first_non_finite(fields)
+    if bad is not None:  # never write NaN/inf: keep the finite steps only
+        index, name = bad
+        fields, results = fields[:index], results[:index]
+        iterations, converged = list(iterations[:index]), False
     attrs = {
         "format_version": 1,
         "xfemslip_version": __version__,
@@ -258,6 +267,8 @@ def write_output(model: Model, results, out_dir: Path, *, converged, wall, itera
         "load_steps": int(spec.loading.steps),
         "newton_iterations": int(sum(iterations)),
         "newton_iterations_per_step": np.array(iterations, dtype=np.int64),
+        # load-step bisections per written step (issue 4; 0 = not cut)
+        "load_step_cuts_per_step": np.array([r.cuts for r in results], dtype=np.int64),
         "wall_time_s": float(wall),
         "tangent": spec.solver.tangent,
         "contact_patch_cells": float(spec.solver.contact_patch),
@@ -278,6 +289,34 @@ def write_output(model: Model, results, out_dir: Path, *, converged, wall, itera
             model, results, fields, out_dir, spec.loading.steps > 1, vtu
         )
     _remove_stale(out_dir, written)
+    if bad is not None:
+        step = bad[0] + 1
+        raise ConvergenceError(
+            f"load step {step} gave a non-finite {bad[1]} (NaN or inf), which is "
+            f"not written; {len(fields)} finite step(s) kept. Lower the penalty "
+            "stiffnesses kn/kt or use more load steps",
+            step=step,
+            iteration=0,
+            residual=float("nan"),
+        )
+
+
+def _first_non_finite(fields):
+    """(index, field name) of the first step holding NaN or inf, or None."""
+    for index, f in enumerate(fields):
+        arrays = {
+            "displacement": f.displacement,
+            "stress": f.stress,
+            "stress_zz": f.stress_zz,
+            "principal_stress": f.principal_stress,
+        }
+        for i, fr in enumerate(f.fractures):
+            for name in ("slip", "opening", "normal_traction", "shear_traction"):
+                arrays[f"fractures[{i}].{name}"] = getattr(fr, name)
+        for name, value in arrays.items():
+            if not np.all(np.isfinite(value)):
+                return index, name
+    return None
 
 
 def _remove_stale(out_dir: Path, written: set) -> None:

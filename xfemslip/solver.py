@@ -15,6 +15,7 @@ systems are solved with SuperLU (scipy), which handles the non-symmetric case.
 
 from __future__ import annotations
 
+import dataclasses
 import logging
 import math
 from dataclasses import dataclass
@@ -34,6 +35,22 @@ logger = logging.getLogger(__name__)
 PENALTY_RATIO_HIGH = 1.0e5
 # Step halvings tried by the line search before keeping the best trial.
 LINE_SEARCH_CUTS = 6
+# Ping-pong remedy: a contact point whose branch of the law (stick, slip +t,
+# slip -t) alternates A, B, A, B, A, B over six successive iterates is
+# cycling.  It is then frozen in STICK (see _frozen_law) until Newton
+# converges; the true law is then restored and Newton continues from there,
+# so an accepted step always satisfies the true law.  At most
+# PINGPONG_MAX_FREEZES freezes per attempt; after that the attempt fails and
+# the load step is bisected.
+PINGPONG_MAX_FREEZES = 2
+# Periods A, B of the alternation that count as cycling (3: six iterates).
+PINGPONG_PERIODS = 3
+# Load-step bisection: a load step that does not converge is cut in halves, at
+# most this many times by default ([solver] max_step_cuts), so the smallest
+# sub-step is 1/2**5 = 1/32 of the step.  Every converged sub-step commits the
+# friction history, exactly as a load step does; a failed attempt leaves the
+# committed state untouched (nothing is committed before convergence).
+DEFAULT_STEP_CUTS = 5
 
 TANGENTS = {"consistent": kernels.TANGENT_CONSISTENT, "secant": kernels.TANGENT_SECANT}
 
@@ -61,8 +78,12 @@ class StepResult:
     u: np.ndarray
     contact: ContactResult
     iterations: int
-    residuals: list  # eta at every iteration
-    switches: list  # stick/slip/open switches at every iteration
+    residuals: list  # eta at every iteration (of the last sub-step)
+    switches: list  # stick/slip/open switches at every iteration (idem)
+    cuts: int = 0  # load-step bisections needed in this step
+    substeps: int = 1  # converged sub-steps that make up this step
+    freezes: int = 0  # ping-pong freezes (all sub-steps)
+    factors: list = None  # load factors of the converged sub-steps, in order
 
 
 # SuperLU settings for K + K_contact, whose sparsity pattern is symmetric even
@@ -103,9 +124,16 @@ class NewtonSolver:
     """Newton-Raphson over load steps on a Problem; keeps the converged steps."""
 
     def __init__(
-        self, problem: Problem, tolerance: float, max_iterations: int, tangent: str
+        self,
+        problem: Problem,
+        tolerance: float,
+        max_iterations: int,
+        tangent: str,
+        *,
+        max_step_cuts: int = DEFAULT_STEP_CUTS,
     ):
         self.p = problem
+        self.max_cuts = int(max_step_cuts)
         self.tol = tolerance
         self.max_it = max_iterations
         self.mode = TANGENTS[tangent]
@@ -123,9 +151,21 @@ class NewtonSolver:
         self.completed: list[StepResult] = []
 
     def run(self, steps: int) -> list[StepResult]:
+        """Proportional loading in ``steps`` equal load steps."""
+        return self.run_path([k / steps for k in range(1, steps + 1)])
+
+    def run_path(self, factors) -> list[StepResult]:
+        """Load steps ending at the load factors ``factors`` (from 0), in order.
+
+        Proportional loading is ``run``; a path like [1, 0, 1, 0] loads and
+        unloads (friction is path dependent: the history carries over).
+        """
         u = np.zeros(self.p.n_dofs)
-        for k in range(1, steps + 1):
-            u = self._step(u, k, steps)
+        lam0 = 0.0
+        n = len(factors)
+        for k, lam in enumerate(factors, start=1):
+            u = self._advance(u, lam0, float(lam), k, n)
+            lam0 = float(lam)
         return self.completed
 
     def _residual(self, u, lam, res: ContactResult):
@@ -141,26 +181,121 @@ class NewtonSolver:
         eta = norm / ref if ref > 0.0 else (0.0 if norm == 0.0 else math.inf)
         return r[self.free], eta
 
-    def _step(self, u, k, steps):
-        lam = k / steps
+    def _advance(self, u, lam0, lam1, k, steps):
+        """Load step k from lam0 to lam1, bisected on failure (max_cuts times).
+
+        The step is split into 2**max_cuts units; ``size`` is the current
+        sub-step in units.  A converged sub-step commits the contact history
+        and the next one tries twice the size; a failed one is retried from
+        the last committed state at half the size.
+        """
+        units = 1 << self.max_cuts
+        done, size = 0, units
+        cuts = substeps = iterations = freezes = 0
+        factors = []  # load factors of the converged sub-steps
+        while done < units:
+            end = min(done + size, units)
+            lam = lam1 if end == units else lam0 + (lam1 - lam0) * end / units
+            try:
+                u_new, res, log = self._newton(u, lam, k, steps)
+            except ConvergenceError as err:
+                if not getattr(err, "retryable", True) or size == 1:
+                    if cuts:
+                        raise self._after_cuts(err, cuts, size / units) from None
+                    raise
+                size //= 2
+                cuts += 1
+                lam_from = lam0 + (lam1 - lam0) * done / units
+                lam_to = lam0 + (lam1 - lam0) * (done + size) / units
+                logger.info(
+                    "step %d/%d: cutting the load step (cut %d of at most %d): "
+                    "load factor %.6g -> %.6g (%s)",
+                    k,
+                    steps,
+                    cuts,
+                    self.max_cuts,
+                    lam_from,
+                    lam_to,
+                    _short_reason(err),
+                )
+                continue
+            self.p.contact.commit(res)
+            u = u_new
+            done = end
+            factors.append(lam)
+            if cuts:  # after a success, try a sub-step twice as long again
+                size = min(2 * size, units)
+            substeps += 1
+            iterations += log.iterations
+            freezes += log.freezes
+        if cuts:
+            logger.info(
+                "step %d/%d converged in %d sub-steps after %d cut(s)",
+                k,
+                steps,
+                substeps,
+                cuts,
+            )
+        self.completed.append(
+            StepResult(
+                k,
+                lam1,
+                u.copy(),
+                res,
+                iterations,
+                log.residuals,
+                log.switches,
+                cuts=cuts,
+                substeps=substeps,
+                freezes=freezes,
+                factors=factors,
+            )
+        )
+        return u
+
+    def _after_cuts(self, err, cuts, fraction):
+        """The error of the last attempt, saying that bisection did not help."""
+        text = str(err)
+        marker = " did not converge: "
+        head, _, tail = text.partition(marker)
+        new = ConvergenceError(
+            f"{head}{marker}even after cutting the load step {cuts} time(s) "
+            f"(sub-steps down to {fraction:.3g} of it): {tail}",
+            step=err.step,
+            iteration=err.iteration,
+            residual=err.residual,
+            increment=err.increment,
+            flips=err.flips,
+        )
+        return new
+
+    def _newton(self, u, lam, k, steps):
+        """Newton to load factor lam from u and the committed history.
+
+        Returns (u, contact result, _NewtonLog); raises ConvergenceError.
+        Nothing is committed here.
+        """
         c = self.p.contact
         u = u.copy()
         u[self.p.fixed] = lam * self.p.fixed_values
         pt_prev, gt_prev = c.pt_committed.copy(), c.gt_committed.copy()
         prev_regime = _regime(c.state_committed, c.pt_committed)
-        residuals = []
-        switches = []
-        res = c.evaluate(u, self.mode, pt_prev, gt_prev)
+        log = _NewtonLog()
+        history = []  # regimes of the iterates under the current law
+        law = c  # the contact law evaluated: c, or c with frozen points
+        frozen = None
+        res = law.evaluate(u, self.mode, pt_prev, gt_prev)
         r, eta = self._residual(u, lam, res)
         for it in range(self.max_it + 1):
             regime = _regime(res.state, res.pt)
             flips = int(np.count_nonzero(regime != prev_regime))
-            residuals.append(eta)
-            switches.append(flips)
+            log.residuals.append(eta)
+            log.switches.append(flips)
+            history.append(regime)
             logger.info(
                 "step %d/%d iteration %d: eta = %.3e; contact points: %d slip, %d "
                 "stick, "
-                "%d open; %d switched",
+                "%d open; %d switched%s",
                 k,
                 steps,
                 it,
@@ -169,26 +304,74 @@ class NewtonSolver:
                 np.count_nonzero(res.state == STICK),
                 np.count_nonzero(res.state == OPEN),
                 flips,
+                "" if frozen is None else f"; {int(frozen.sum())} frozen",
             )
             if not np.isfinite(eta):
                 raise self._fail(k, it, eta, flips, "the residual is not finite")
+            if eta <= self.tol and frozen is not None:
+                # converged with frozen points: restore the true law, go on
+                logger.info(
+                    "step %d/%d: converged with %d frozen point(s); "
+                    "releasing them and checking the true contact law",
+                    k,
+                    steps,
+                    int(frozen.sum()),
+                )
+                law, frozen, history = c, None, []
+                res = law.evaluate(u, self.mode, pt_prev, gt_prev)
+                r, eta = self._residual(u, lam, res)
+                regime = _regime(res.state, res.pt)
+                history.append(regime)
             if eta <= self.tol:
                 self._check_floating(res, k, it, eta)
-                c.commit(res)
-                self.completed.append(
-                    StepResult(k, lam, u.copy(), res, it, residuals, switches)
-                )
-                return u
+                if not (np.all(np.isfinite(u)) and _finite(res)):
+                    raise self._fail(
+                        k, it, eta, flips, "the solution is not finite (overflow)"
+                    )
+                log.iterations = it
+                return u, res, log
             if it == self.max_it:
                 raise self._fail(
-                    k, it, eta, flips, self._no_convergence_reason(switches)
+                    k, it, eta, flips, self._no_convergence_reason(log.switches)
                 )
+            cycling = _cycling(history)
+            if cycling is not None and log.freezes < PINGPONG_MAX_FREEZES:
+                frozen = cycling if frozen is None else (frozen | cycling)
+                law = _frozen_law(c, frozen)
+                log.freezes += 1
+                logger.info(
+                    "step %d/%d iteration %d: %d contact point(s) ping-pong "
+                    "between stick and slip; freezing their state (freeze %d of "
+                    "at most %d)",
+                    k,
+                    steps,
+                    it,
+                    int(cycling.sum()),
+                    log.freezes,
+                    PINGPONG_MAX_FREEZES,
+                )
+                history = []
+                res = law.evaluate(u, self.mode, pt_prev, gt_prev)
+                r, eta = self._residual(u, lam, res)
             du = self._solve(res, r, k, it, eta)
             pt_prev, gt_prev, prev_regime = res.pt, res.gt, regime
-            u, res, r, eta = self._line_search(u, du, lam, eta, pt_prev, gt_prev)
+            eta_before = eta
+            u, res, r, eta = self._line_search(u, du, lam, eta, pt_prev, gt_prev, law)
+            if self.mode == kernels.TANGENT_SECANT and not eta < eta_before:
+                # the secant direction is no descent direction (it drops the
+                # n-t coupling of the slip law): one consistent iteration
+                log.fallbacks += 1
+                logger.info(
+                    "step %d/%d iteration %d: the secant tangent gave no descent; "
+                    "the next iteration uses the consistent tangent",
+                    k,
+                    steps,
+                    it + 1,
+                )
+                res = law.evaluate(u, kernels.TANGENT_CONSISTENT, pt_prev, gt_prev)
         raise AssertionError("unreachable")
 
-    def _line_search(self, u, du, lam, eta0, pt_prev, gt_prev):
+    def _line_search(self, u, du, lam, eta0, pt_prev, gt_prev, law=None):
         """Backtracking on eta along the Newton direction (Armijo on the norm).
 
         The full step is tried first and kept whenever it lowers eta, so
@@ -197,7 +380,7 @@ class NewtonSolver:
         (open <-> slip ping-pong); halving the step up to LINE_SEARCH_CUTS
         times restores a decrease.  If none decreases, the best trial is kept.
         """
-        c = self.p.contact
+        c = self.p.contact if law is None else law
         best = None
         alpha = 1.0
         for _ in range(LINE_SEARCH_CUTS + 1):
@@ -229,13 +412,27 @@ class NewtonSolver:
                 )
             else:
                 why += "; use more load steps or raise [solver] max_iterations"
+        for index, _ in self.p.floating or []:
+            why += (
+                f"; fractures[{index}] cuts the domain in two and one part is held "
+                "by the fracture alone: when the shear driving that part reaches "
+                "friction x normal force + cohesion x length there is no static "
+                "equilibrium (rigid sliding without bound), and close to it Newton "
+                "may not find one; prescribe a displacement on that part, or raise "
+                "the friction or cohesion"
+            )
+        if self.mode == kernels.TANGENT_SECANT:
+            why += (
+                '; or set [solver] tangent = "consistent" (the secant tangent '
+                "converges linearly at best)"
+            )
         return why
 
     def _check_floating(self, res, k, it, eta):
         """A block held only by a fracture with no sticking point slides unbounded."""
         for index, mask in self.p.floating or []:
             if mask.any() and not np.any(res.state[mask] == STICK):
-                raise self._fail(
+                raise self._fail_final(
                     k,
                     it,
                     eta,
@@ -270,6 +467,12 @@ class NewtonSolver:
             raise self._fail(k, it, eta, 0, "the linear solve gave non-finite values")
         return du
 
+    def _fail_final(self, k, it, eta, flips, why):
+        """A failure that a smaller load step cannot cure (no bisection)."""
+        err = self._fail(k, it, eta, flips, why)
+        err.retryable = False
+        return err
+
     def _fail(self, k, it, eta, flips, why):
         return ConvergenceError(
             f"load step {k} did not converge: {why}; iteration {it}, residual eta = "
@@ -282,3 +485,61 @@ class NewtonSolver:
             residual=eta,
             flips=flips,
         )
+
+
+@dataclass
+class _NewtonLog:
+    """What one Newton solve did."""
+
+    iterations: int = 0
+    freezes: int = 0
+    fallbacks: int = 0  # secant iterations replaced by a consistent one
+    residuals: list = None
+    switches: list = None
+
+    def __post_init__(self):
+        self.residuals = []
+        self.switches = []
+
+
+def _finite(res: ContactResult) -> bool:
+    return all(
+        np.all(np.isfinite(a)) for a in (res.force, res.gn, res.gt, res.pn, res.pt)
+    )
+
+
+def _short_reason(err) -> str:
+    """The 'why' part of a ConvergenceError message, for the log."""
+    text = str(err)
+    why = text.partition(" did not converge: ")[2]
+    return why.partition("; iteration ")[0] or text
+
+
+def _cycling(history):
+    """Points whose tangential branch alternated A, B, A, B, ... over the last
+    PINGPONG_PERIODS * 2 iterates (A != B, both closed), or None."""
+    n = 2 * PINGPONG_PERIODS
+    if len(history) < n:
+        return None
+    last = history[-n:]
+    a, b = last[-2], last[-1]
+    mask = (a != b) & (a != OPEN) & (b != OPEN)
+    for i, regime in enumerate(last):
+        mask &= regime == (a if i % 2 == 0 else b)
+    return mask if mask.any() else None
+
+
+def _frozen_law(c: ContactSet, frozen) -> ContactSet:
+    """The contact set with the frozen points held in STICK.
+
+    A cycling point alternates between two branches of the law (stick and
+    slip, or slip forward and backward); holding it in stick (an infinite
+    cohesion, so the trial traction is always within the bound) is the
+    branch that adds stiffness.  The normal law stays free (a point may still
+    open).  The kernel is unchanged: only the cohesion of the frozen points
+    differs, and the result is never committed: the true law is restored and
+    checked before a step is accepted.
+    """
+    cohesion = c.cohesion.copy()
+    cohesion[frozen] = math.inf
+    return dataclasses.replace(c, cohesion=cohesion)

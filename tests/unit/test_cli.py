@@ -241,7 +241,7 @@ def test_run_interrupted(runner, fake, case_file):
     fake.outcome = KeyboardInterrupt()
     result = runner.invoke(cli, ["run", "-q", str(case_file)])
     assert result.exit_code == 130
-    assert _stderr_lines(result)[-1] == "Error: interrupted"
+    assert _stderr_lines(result)[-1].startswith("Error: interrupted (SIGINT)")
     assert "Traceback" not in result.stderr
 
 

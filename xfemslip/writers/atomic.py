@@ -14,6 +14,8 @@ import os
 from collections.abc import Iterator
 from pathlib import Path
 
+import numpy as np
+
 from xfemslip.errors import OutputError
 
 logger = logging.getLogger(__name__)
@@ -71,3 +73,17 @@ def atomic_path(final: Path | str) -> Iterator[Path]:
         _remove_quietly(tmp)
         raise
     logger.debug("wrote %s", final)
+
+
+def refuse_non_finite(value, name: str) -> None:
+    """Never write NaN or inf: raise OutputError naming the array.
+
+    The last line of defence; ``simulation`` turns a non-finite solution into a
+    ConvergenceError before any writer is called.
+    """
+    array = np.asarray(value)
+    if array.dtype.kind in "fc" and not np.all(np.isfinite(array)):
+        bad = int(np.count_nonzero(~np.isfinite(array)))
+        raise OutputError(
+            f"refusing to write {name}: {bad} non-finite value(s) (NaN or inf)"
+        )

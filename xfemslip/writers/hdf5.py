@@ -40,7 +40,7 @@ import numpy as np
 
 from xfemslip import __version__
 from xfemslip.writers import FractureFields, StepFields
-from xfemslip.writers.atomic import atomic_path
+from xfemslip.writers.atomic import atomic_path, refuse_non_finite
 
 logger = logging.getLogger(__name__)
 
@@ -222,6 +222,7 @@ def _dataset(
     group: h5py.Group, name: str, value: np.ndarray, units: str
 ) -> h5py.Dataset:
     """Create one dataset without timestamps and tag it with its units."""
+    refuse_non_finite(value, f"{group.name}/{name}")
     dataset = group.create_dataset(name, data=value, track_times=False)
     dataset.attrs["units"] = units
     return dataset

@@ -24,7 +24,7 @@ import meshio
 import numpy as np
 
 from xfemslip.writers import FractureFields, VisMesh
-from xfemslip.writers.atomic import atomic_path
+from xfemslip.writers.atomic import atomic_path, refuse_non_finite
 
 logger = logging.getLogger(__name__)
 
@@ -219,5 +219,11 @@ def _pad_3d(xy, name: str) -> np.ndarray:
 
 def _write_vtu(path: Path | str, mesh: meshio.Mesh) -> None:
     """Write ``mesh`` as VTU (binary, zlib) through a temporary file."""
+    refuse_non_finite(mesh.points, f"{path}: points")
+    for name, value in mesh.point_data.items():
+        refuse_non_finite(value, f"{path}: {name}")
+    for name, blocks in mesh.cell_data.items():
+        for value in blocks:
+            refuse_non_finite(value, f"{path}: {name}")
     with atomic_path(Path(path)) as tmp:
         meshio.write(tmp, mesh, file_format="vtu")

@@ -1,0 +1,242 @@
+"""Faults: interruption (SIGINT, SIGTERM), a full or unwritable output
+directory, an existing output directory, and a non-finite state.
+
+Contract (output-format.md): a failed or interrupted run never leaves a
+truncated file under a final name; the CLI says what happened in one line.
+"""
+
+from __future__ import annotations
+
+import errno
+import os
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import h5py
+import numpy as np
+import pytest
+from click.testing import CliRunner
+
+import xfemslip.simulation as simulation
+from xfemslip.cli import cli
+from xfemslip.errors import OutputError
+from xfemslip.writers import hdf5
+
+ROOT = Path(__file__).resolve().parents[2]
+RESERVOIR = ROOT / "cases" / "reservoir_depletion.toml"
+
+
+def case_file(folder: Path, *, n=10, steps=3, formats='["h5", "vtu"]') -> Path:
+    text = RESERVOIR.read_text()
+    text = text.replace("elements = [50, 50]", f"elements = [{n}, {n}]")
+    text = text.replace("steps = 1", f"steps = {steps}")
+    text = text.replace('formats = ["h5", "vtu"]', f"formats = {formats}")
+    folder.mkdir(parents=True, exist_ok=True)
+    path = folder / "case.toml"
+    path.write_text(text)
+    return path
+
+
+@pytest.fixture
+def runner() -> CliRunner:
+    try:  # click < 8.2 mixes stderr into stdout unless told otherwise
+        return CliRunner(mix_stderr=False)
+    except TypeError:
+        return CliRunner()
+
+
+def _error_line(result) -> str:
+    lines = [line for line in result.stderr.splitlines() if line.strip()]
+    assert lines and lines[-1].startswith("Error: "), result.stderr
+    assert sum(line.startswith("Error: ") for line in lines) == 1
+    assert "Traceback" not in result.stderr
+    return lines[-1]
+
+
+def _no_partial_files(out: Path) -> list[str]:
+    """Names under out; none temporary, every final .h5 complete."""
+    names = (
+        sorted(str(p.relative_to(out)) for p in out.rglob("*")) if out.exists() else []
+    )
+    assert not any(Path(n).name.startswith(".") for n in names), names
+    for name in names:
+        if name.endswith(".h5"):
+            with h5py.File(out / name, "r") as f:
+                assert "mesh/points" in f
+    return names
+
+
+# ------------------------------------------------------------- interruption
+
+
+@pytest.mark.parametrize(
+    ("sig", "code", "name"),
+    [(signal.SIGINT, 130, "SIGINT"), (signal.SIGTERM, 143, "SIGTERM")],
+)
+def test_signal_during_a_run_leaves_no_partial_file(tmp_path, sig, code, name):
+    """A real process, interrupted while it iterates (many load steps, so it
+    is still running when the signal arrives)."""
+    case = case_file(tmp_path, n=30, steps=400)
+    out = tmp_path / "out"
+    env = dict(os.environ, PYTHONPATH=str(ROOT))
+    proc = subprocess.Popen(
+        [sys.executable, "-m", "xfemslip", "run", str(case), "-o", str(out)],
+        stderr=subprocess.PIPE,
+        text=True,
+        env=env,
+    )
+    lines = []
+    deadline = time.monotonic() + 120
+    for line in proc.stderr:  # wait until Newton is iterating
+        lines.append(line)
+        if "step 3/400" in line or time.monotonic() > deadline:
+            break
+    proc.send_signal(sig)
+    _, rest = proc.communicate(timeout=120)
+    stderr = "".join(lines) + rest
+    assert proc.returncode == code, stderr[-2000:]
+    last = stderr.strip().splitlines()[-1]
+    assert last.startswith(f"Error: interrupted ({name})"), last
+    assert "no partial file" in last
+    assert "Traceback" not in stderr
+    assert _no_partial_files(out) == []  # interrupted while solving: nothing
+
+
+def test_interrupt_while_writing_removes_the_file(tmp_path, runner, monkeypatch):
+    """Ctrl-C in the middle of writing result.h5: no result.h5, no temporary."""
+    calls = []
+
+    def interrupted(group, name, value, units):
+        calls.append(name)
+        if len(calls) == 4:
+            raise KeyboardInterrupt
+        return original(group, name, value, units)
+
+    original = hdf5._dataset
+    monkeypatch.setattr(hdf5, "_dataset", interrupted)
+    out = tmp_path / "out"
+    result = runner.invoke(cli, ["run", "-q", str(case_file(tmp_path)), "-o", str(out)])
+    assert result.exit_code == 130
+    assert _error_line(result).startswith("Error: interrupted (SIGINT)")
+    assert len(calls) == 4  # premise: it was writing
+    assert "result.h5" not in _no_partial_files(out)
+
+
+# ------------------------------------------------------- full / unwritable
+
+
+def test_full_disk_is_a_clear_error_and_leaves_no_file(tmp_path, runner, monkeypatch):
+    """ENOSPC raised by the HDF5 writer half-way through the file."""
+    calls = []
+
+    def full(group, name, value, units):
+        calls.append(name)
+        if len(calls) == 5:
+            raise OSError(errno.ENOSPC, os.strerror(errno.ENOSPC))
+        return original(group, name, value, units)
+
+    original = hdf5._dataset
+    monkeypatch.setattr(hdf5, "_dataset", full)
+    out = tmp_path / "out"
+    result = runner.invoke(cli, ["run", "-q", str(case_file(tmp_path)), "-o", str(out)])
+    assert result.exit_code == 1
+    line = _error_line(result)
+    assert f"cannot write {out / 'result.h5'}" in line
+    assert "No space left on device" in line
+    assert _no_partial_files(out) == []
+
+
+def test_full_disk_while_writing_vtu(tmp_path, runner, monkeypatch):
+    """result.h5 is complete; the VTU that failed is not there at all."""
+    import meshio
+
+    def full(*args, **kwargs):
+        raise OSError(errno.ENOSPC, os.strerror(errno.ENOSPC))
+
+    monkeypatch.setattr(meshio, "write", full)
+    out = tmp_path / "out"
+    result = runner.invoke(cli, ["run", "-q", str(case_file(tmp_path)), "-o", str(out)])
+    assert result.exit_code == 1
+    line = _error_line(result)
+    assert "cannot write" in line and ".vtu: No space left on device" in line
+    names = _no_partial_files(out)
+    assert "result.h5" in names and not any(n.endswith(".vtu") for n in names)
+
+
+def test_output_under_a_file_is_a_clear_error(tmp_path, runner):
+    blocker = tmp_path / "blocker"
+    blocker.write_text("not a directory")
+    out = blocker / "out"
+    result = runner.invoke(cli, ["run", "-q", str(case_file(tmp_path)), "-o", str(out)])
+    assert result.exit_code == 1
+    line = _error_line(result)
+    assert f"cannot create output directory {out}" in line
+    assert blocker.read_text() == "not a directory"
+
+
+def test_existing_output_is_refused_untouched(tmp_path, runner):
+    """README: an output folder holding results is refused (exit 2) unless
+    --overwrite; the earlier files stay byte for byte."""
+    case = case_file(tmp_path, steps=1, formats='["h5"]')
+    out = tmp_path / "out"
+    first = runner.invoke(cli, ["run", "-q", str(case), "-o", str(out)])
+    assert first.exit_code == 0
+    before = (out / "result.h5").read_bytes()
+    again = runner.invoke(cli, ["run", "-q", str(case), "-o", str(out)])
+    assert again.exit_code == 2
+    assert "--overwrite" in _error_line(again)
+    assert (out / "result.h5").read_bytes() == before
+    forced = runner.invoke(cli, ["run", "-q", str(case), "-o", str(out), "--overwrite"])
+    assert forced.exit_code == 0
+    assert _no_partial_files(out) == ["result.h5"]
+
+
+# -------------------------------------------------------------- NaN / inf
+
+
+def test_non_finite_state_is_a_convergence_error(tmp_path, runner, monkeypatch):
+    """A non-finite field in step 2 of 3 (injected): exit 1, the message says
+    so, result.h5 keeps step 1 only, converged = false, no NaN anywhere."""
+    original = simulation.step_fields
+
+    def poisoned(model, r):
+        fields = original(model, r)
+        if r.step == 2:
+            fields.stress = fields.stress.copy()
+            fields.stress[0, 0] = np.nan
+        return fields
+
+    monkeypatch.setattr(simulation, "step_fields", poisoned)
+    out = tmp_path / "out"
+    result = runner.invoke(cli, ["run", "-q", str(case_file(tmp_path)), "-o", str(out)])
+    assert result.exit_code == 1
+    line = _error_line(result)
+    assert "load step 2 gave a non-finite stress" in line
+    with h5py.File(out / "result.h5", "r") as f:
+        assert not bool(f.attrs["converged"])
+        assert sorted(f["steps"]) == ["0001"]
+        for name in ("fields/stress", "fields/displacement"):
+            assert np.all(np.isfinite(f[name][()]))
+    assert not any(n.endswith("0002.vtu") for n in _no_partial_files(out))
+
+
+def test_writers_refuse_nan(tmp_path):
+    """The last line of defence: the HDF5 writer never writes NaN or inf."""
+    with pytest.raises(OutputError, match="non-finite"):
+        hdf5.write_result(
+            tmp_path / "result.h5",
+            points=np.array([[0.0, 0.0], [1.0, np.inf], [1.0, 1.0], [0.0, 1.0]]),
+            cells=np.array([[0, 1, 2, 3]]),
+            steps=[],
+            attrs={
+                "case_toml": "",
+                "converged": False,
+                "newton_iterations": 0,
+                "wall_time_s": 0.0,
+            },
+            load_steps=1,
+        )
+    assert os.listdir(tmp_path) == []

@@ -1,0 +1,150 @@
+"""Newton control of issue 4: load-step bisection and the ping-pong remedy.
+
+- Bisection: a load step that fails is retried from the last committed state
+  in halves.  The friction history must be exactly that of a run that takes
+  the converged sub-steps as ordinary load steps: same answer to the last bit
+  (so a failed attempt leaves no trace in the committed state).
+- Ping-pong: points whose stick/slip branch alternates are held in stick
+  until Newton converges; the true law is then restored and checked, so an
+  accepted step satisfies the true Coulomb law and is the same solution as
+  without the remedy.
+
+Measured (reservoir 18 x 18, k_N h / E = 1e8, cohesion 2.5 MPa, secant
+tangent, max_iterations = 8): the full step fails, the step is cut once, the
+sub-steps converge at load factors [0.5, 1.0] (14 iterations), and the plain
+run over those factors gives a bitwise-identical displacement.  (On 20 x 20:
+5 cuts, sub-steps [0.5, 0.75, 0.875, 1.0], also bitwise identical.)
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from matrix import (
+    RESERVOIR,
+    SLIP,
+    STICK,
+    block_text,
+    block_threshold,
+    reservoir_text,
+    solve,
+)
+
+import xfemslip.solver as solver_module
+from xfemslip.solver import _cycling, _frozen_law
+
+pytestmark = pytest.mark.verification
+
+E, N = 5.0e9, 18
+
+
+def stiff_cohesive_case():
+    kn = 1.0e8 * E * N  # kn h / E = 1e8
+    text = reservoir_text(n=N, cohesion=2.5e6)
+    return text.replace("kn = 5.0e12", f"kn = {kn!r}").replace(
+        "kt = 5.0e12", f"kt = {kn!r}"
+    )
+
+
+def test_bisection_keeps_the_friction_history_exact():
+    text = stiff_cohesive_case()
+    cut = solve(text, RESERVOIR, "secant", max_iterations=8)
+    assert cut.converged, cut.error
+    step = cut.steps[-1]
+    assert step.cuts >= 1 and step.substeps >= 2  # premise: bisection was needed
+    assert step.factors[-1] == 1.0
+    assert all(b > a for a, b in zip(step.factors[:-1], step.factors[1:], strict=True))
+    # without bisection, the full step fails with these settings
+    plain = solve(text, RESERVOIR, "secant", max_iterations=8, max_step_cuts=0)
+    assert not plain.converged and "cutting the load step" not in plain.error
+    # the converged sub-steps as ordinary load steps: the same bits
+    explicit = solve(
+        text,
+        RESERVOIR,
+        "secant",
+        factors=step.factors,
+        max_iterations=200,
+        max_step_cuts=0,
+    )
+    assert explicit.converged and explicit.cuts == 0
+    np.testing.assert_array_equal(explicit.steps[-1].u, step.u)
+    np.testing.assert_array_equal(
+        explicit.steps[-1].contact.slip_plastic, step.contact.slip_plastic
+    )
+    # ... and the consistent tangent agrees to the tolerance
+    cons = solve(text, RESERVOIR, "consistent", factors=step.factors)
+    scale = np.max(np.abs(step.u))
+    assert np.max(np.abs(cons.steps[-1].u - step.u)) < 1e-6 * scale
+
+
+def test_exhausted_bisection_says_what_was_tried():
+    """Beyond the rigid-sliding threshold the block has no equilibrium."""
+    text = block_text(shear=1.1 * block_threshold(10e6, 0.5, 0.0), friction=0.5)
+    out = solve(text, RESERVOIR, "consistent", max_iterations=10, max_step_cuts=2)
+    assert not out.converged
+    assert "even after cutting the load step" in out.error
+    assert "(sub-steps down to 0.25 of it)" in out.error
+    assert "fractures[0] cuts the domain in two" in out.error
+    assert "prescribe a displacement" in out.error
+
+
+def test_cycling_detection_and_frozen_law():
+    A, B, O_ = STICK, SLIP, 0
+    seq = [np.array([A, A, O_, B]), np.array([B, A, A, B])] * 3
+    mask = _cycling(seq)
+    assert mask.tolist() == [True, False, False, False]
+    assert _cycling(seq[1:]) is None  # five iterates: not yet three periods
+    # open <-> closed is left to the normal law (never frozen)
+    assert _cycling([np.array([A]), np.array([O_])] * 3) is None
+
+
+def test_frozen_points_stick_but_may_open():
+    text = reservoir_text(n=12, friction=0.1)
+    out = solve(text, RESERVOIR)
+    model, step = out.model, out.steps[-1]
+    c = model.contact
+    res = step.contact
+    assert np.mean(res.state == SLIP) > 0.8  # premise
+    frozen = np.zeros(c.n, bool)
+    frozen[::2] = True
+    law = _frozen_law(c, frozen)
+    # committed history is now the step's; from the previous one (zeros) the
+    # same u evaluates stick at the frozen points, slip elsewhere
+    zero = np.zeros(c.n)
+    law.slip_committed = zero
+    got = law.evaluate(step.u, 0, zero, zero)
+    closed = got.state != 0
+    assert np.all(got.state[frozen & closed] == STICK)
+    np.testing.assert_allclose(
+        got.pt[frozen & closed], c.kt[frozen & closed] * got.gt[frozen & closed]
+    )
+    assert c.cohesion.max() < np.inf  # the real contact set is untouched
+
+
+def test_ping_pong_remedy_accepts_only_the_true_law(monkeypatch):
+    """The freeze -> converge -> release -> check cycle, forced: with a
+    detector of one period every switch counts as cycling, so the first
+    stick -> slip switches of the reservoir fracture are frozen in stick.  The
+    accepted step must still be the one found without the remedy, on the
+    true Coulomb law (measured on 20 x 20: 1 freeze, 3 iterations against 2).
+    With the default (three periods) no case of the stress matrix froze."""
+    text = reservoir_text(n=20, angle=45.0, friction=0.1)
+    monkeypatch.setattr(solver_module, "PINGPONG_PERIODS", 1)
+    frozen = solve(text, RESERVOIR)
+    monkeypatch.setattr(solver_module, "PINGPONG_MAX_FREEZES", 0)
+    free = solve(text, RESERVOIR)
+    assert frozen.converged and free.converged
+    assert frozen.freezes >= 1 and free.freezes == 0
+    a, b = frozen.steps[-1], free.steps[-1]
+    np.testing.assert_array_equal(a.contact.state, b.contact.state)
+    scale = np.max(np.abs(b.u))
+    assert np.max(np.abs(a.u - b.u)) < 1e-7 * scale
+    # the true Coulomb law at every point of the accepted step
+    c = frozen.model.contact
+    bound = c.cohesion - c.friction * a.contact.pn
+    closed = a.contact.state != 0
+    assert np.all(np.abs(a.contact.pt[closed]) <= bound[closed] * (1 + 1e-12))
+    slipping = a.contact.state == SLIP
+    np.testing.assert_allclose(
+        np.abs(a.contact.pt[slipping]), bound[slipping], rtol=1e-12
+    )
