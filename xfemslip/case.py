@@ -157,6 +157,14 @@ SOLVER_OPTIONS: tuple[Option, ...] = (
         "contact tangent: 'consistent' (Newton) or 'secant' (paper eq. 28)",
         ("consistent", "secant"),
     ),
+    Option(
+        "linear_solver",
+        str,
+        "auto",
+        "linear solver of the Newton systems: 'superlu' (sparse LU, factorization "
+        "kept), 'amg' (pyamg-preconditioned GMRES) or 'auto' (amg from 60,000 dofs)",
+        ("auto", "superlu", "amg"),
+    ),
 )
 
 

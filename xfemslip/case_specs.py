@@ -98,10 +98,12 @@ class SolverSpec:
     tolerance: float = 1.0e-8  # eta_0 on ||residual|| / ||F_ext||
     max_iterations: int = 30  # Newton iterations per load step
     tangent: str = "consistent"  # "consistent" | "secant" (paper eq. 28)
+    linear_solver: str = "auto"  # "auto" | "superlu" | "amg" (xfemslip.linsolve)
     UNITS: ClassVar[dict[str, str]] = {
         "tolerance": "-",
         "max_iterations": "-",
         "tangent": "",
+        "linear_solver": "",
     }
 
 

@@ -113,6 +113,7 @@ def build_model(spec) -> Model:
         penalty_ratio=max((max(f.kn, f.kt) for f in fractures), default=0.0)
         * mesh.h_min
         / mat.E,
+        node_xy=mesh.nodes,
     )
     logger.info(
         "model: %d x %d cells, %d fracture(s), %d dofs (%d nodes enriched with %d "
@@ -204,6 +205,7 @@ def run_case(
         spec.solver.tolerance,
         spec.solver.max_iterations,
         spec.solver.tangent,
+        spec.solver.linear_solver,
     )
     failure = None
     try:

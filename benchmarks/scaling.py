@@ -1,0 +1,223 @@
+#!/usr/bin/env python3
+"""Scaling of the reservoir case (cases/reservoir_depletion.toml with [mesh]
+elements = [n, n]) against the floor: ONE factorize-and-solve of the uncracked
+system on the same mesh, measured in the same run.
+
+    python benchmarks/scaling.py --sizes 50 100 200 400 --solvers auto superlu
+    python benchmarks/scaling.py --sizes 50 100 --plot benchmarks/scaling.png
+
+Every measurement runs in its own subprocess so that the peak memory
+(resource.getrusage maxrss) belongs to it alone.  For each size and linear
+solver: the cracked run (build = mesh, fractures, enrichment, assembly, contact;
+Newton = every load step, every linear solve) and the floor (the same mesh
+without the fracture: assembly, then one solve of K u = F with the same linear
+solver).  Times are the median of --runs runs (each a fresh process); memory
+is the largest maxrss of those runs.  Output files are not written.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import re
+import statistics
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[1]
+CASE = ROOT / "cases" / "reservoir_depletion.toml"
+
+
+def case_text(n: int, cracked: bool) -> str:
+    text = CASE.read_text()
+    text = re.sub(r"elements = \[\d+, \d+\]", f"elements = [{n}, {n}]", text)
+    if not cracked:
+        text = re.sub(r"\[\[fractures\]\].*?(?=\n\[loading\])", "", text, flags=re.S)
+    return text
+
+
+def one(n: int, solver: str, cracked: bool) -> dict:
+    """Measure in this process; returns a dict (printed as JSON)."""
+    import resource
+
+    import numpy as np
+
+    from xfemslip.case import loads_case
+    from xfemslip.simulation import build_model
+    from xfemslip.solver import NewtonSolver
+
+    spec = loads_case(case_text(n, cracked), CASE)
+    t0 = time.perf_counter()
+    model = build_model(spec)
+    t1 = time.perf_counter()
+    newton = NewtonSolver(
+        model.problem,
+        spec.solver.tolerance,
+        spec.solver.max_iterations,
+        spec.solver.tangent,
+        solver,
+    )
+    t2 = time.perf_counter()
+    out = {"n": n, "solver": solver, "cracked": cracked}
+    if cracked:
+        newton.run(spec.loading.steps)
+        res = newton.completed[-1]
+        out["iterations"] = [r.iterations for r in newton.completed]
+        out["max_slip"] = float(np.max(np.abs(res.contact.gt)))
+        out["contact_dofs"] = int(np.unique(newton.c_dofs[newton.c_dofs >= 0]).size)
+    else:
+        p = model.problem
+        u = np.zeros(p.n_dofs)
+        u[p.fixed] = p.fixed_values
+        rhs = (p.F_unit - p.K @ u)[newton.free]
+        x = newton.linear.solve(None, rhs)
+        err = np.linalg.norm(newton.K_ff @ x - rhs) / np.linalg.norm(rhs)
+        out["residual"] = float(err)
+    t3 = time.perf_counter()
+    st = newton.linear.stats
+    out.update(
+        dofs=int(model.problem.n_dofs),
+        method=st["method"],
+        build=t1 - t0,
+        setup=t2 - t1,
+        solve=t3 - t2,
+        total=t3 - t0,
+        factorizations=st["factorizations"],
+        factor_time=st["factor_time"],
+        amg_setup=st["setup_time"],
+        krylov_iterations=st["krylov_iterations"],
+        maxrss_mib=resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0,
+    )
+    return out
+
+
+def measure(n, solver, cracked, runs, timeout):
+    rows = []
+    for _ in range(runs):
+        cmd = [sys.executable, __file__, "--one", str(n), solver]
+        cmd += ["cracked" if cracked else "floor"]
+        try:
+            proc = subprocess.run(
+                cmd, capture_output=True, text=True, timeout=timeout, env=os.environ
+            )
+        except subprocess.TimeoutExpired:
+            return {"n": n, "solver": solver, "cracked": cracked, "error": "timeout"}
+        if proc.returncode != 0:
+            tail = proc.stderr.strip().splitlines()[-1:] or ["?"]
+            return {"n": n, "solver": solver, "cracked": cracked, "error": tail[0]}
+        rows.append(json.loads(proc.stdout.strip().splitlines()[-1]))
+    med = dict(rows[0])
+    for key in ("build", "setup", "solve", "total", "factor_time", "amg_setup"):
+        med[key] = statistics.median(r[key] for r in rows)
+    med["maxrss_mib"] = max(r["maxrss_mib"] for r in rows)
+    med["runs"] = len(rows)
+    return med
+
+
+def table(results) -> str:
+    lines = [
+        "| n x n | dofs | linear solver | build [s] | Newton [s] (its) | "
+        "factorizations / Krylov its | peak RSS [MiB] | floor [s] (RSS) | "
+        "Newton / floor | (build + Newton) / (build + floor) | "
+        "Newton / SuperLU floor |",
+        "| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |",
+    ]
+    floors = {(r["n"], r["solver"]): r for r in results if not r["cracked"]}
+    for r in results:
+        if not r["cracked"]:
+            continue
+        f = floors.get((r["n"], r["solver"]), {})
+        f_lu = floors.get((r["n"], "superlu"), {})
+        if "error" in r:
+            lines.append(f"| {r['n']} | | {r['solver']} | {r['error']} |||||||")
+            continue
+        fl = f.get("solve")
+        ratio = f"{r['solve'] / fl:.2f}" if fl else "-"
+        ratio2 = (
+            f"{(r['build'] + r['solve']) / (f['build'] + fl):.2f}" if fl else "-"
+        )
+        ratio_lu = f"{r['solve'] / f_lu['solve']:.2f}" if f_lu.get("solve") else "-"
+        floor = f"{fl:.2f} ({f['maxrss_mib']:.0f})" if fl else f.get("error", "-")
+        lines.append(
+            f"| {r['n']} | {r['dofs']:,} | {r['method']} | {r['build']:.2f} | "
+            f"{r['solve']:.2f} ({sum(r['iterations'])}) | "
+            f"{r['factorizations']} / {r['krylov_iterations']} | "
+            f"{r['maxrss_mib']:.0f} | {floor} | {ratio} | {ratio2} | {ratio_lu} |"
+        )
+    return "\n".join(lines)
+
+
+def plot(results, path):
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig, ax = plt.subplots(figsize=(5.0, 3.6), dpi=90)
+    styles = {True: "-o", False: "--s"}
+    for solver in sorted({r["solver"] for r in results}):
+        for cracked in (True, False):
+            rows = [
+                r
+                for r in results
+                if r["solver"] == solver and r["cracked"] == cracked and "error" not in r
+            ]
+            if not rows:
+                continue
+            label = f"{solver}: " + ("Newton solve" if cracked else "floor (1 solve)")
+            ax.loglog(
+                [r["dofs"] for r in rows],
+                [r["solve"] for r in rows],
+                styles[cracked],
+                label=label,
+            )
+    ax.set_xlabel("dofs")
+    ax.set_ylabel("time [s]")
+    ax.grid(True, which="both", alpha=0.3)
+    ax.legend(fontsize=7)
+    fig.tight_layout()
+    fig.savefig(path)
+
+
+def main() -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--sizes", type=int, nargs="+", default=[50, 100, 200])
+    ap.add_argument("--solvers", nargs="+", default=["auto", "superlu"])
+    ap.add_argument("--runs", type=int, default=3)
+    ap.add_argument("--timeout", type=float, default=3600.0)
+    ap.add_argument("--json", type=Path, help="append the results to this file")
+    ap.add_argument("--plot", type=Path, help="write a log-log plot (PNG)")
+    ap.add_argument("--one", nargs=3, help=argparse.SUPPRESS)
+    args = ap.parse_args()
+    if args.one:
+        n, solver, kind = args.one
+        print(json.dumps(one(int(n), solver, kind == "cracked")))
+        return 0
+    results = []
+    if args.json and args.json.exists():
+        results = json.loads(args.json.read_text())
+    for n in args.sizes:
+        for solver in args.solvers:
+            for cracked in (False, True):
+                r = measure(n, solver, cracked, args.runs, args.timeout)
+                results = [
+                    x
+                    for x in results
+                    if (x["n"], x["solver"], x["cracked"]) != (n, solver, cracked)
+                ]
+                results.append(r)
+                print(json.dumps(r), flush=True)
+                if args.json:
+                    args.json.write_text(json.dumps(results, indent=1))
+    results.sort(key=lambda r: (r["n"], r["solver"], not r["cracked"]))
+    print(table(results))
+    if args.plot:
+        plot(results, args.plot)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
