@@ -11,8 +11,10 @@ Every measurement runs in its own subprocess so that the peak memory
 solver: the cracked run (build = mesh, fractures, enrichment, assembly, contact;
 Newton = every load step, every linear solve) and the floor (the same mesh
 without the fracture: assembly, then one solve of K u = F with the same linear
-solver).  Times are the median of --runs runs (each a fresh process); memory
-is the largest maxrss of those runs.  Output files are not written.
+solver).  Times are the median of --runs runs (each a fresh process, the
+configurations interleaved run by run); memory is the largest maxrss of those
+runs.  Output files are not written.  Set OPENBLAS_NUM_THREADS=1 on a shared
+machine (see benchmarks/RESULTS.md).
 """
 
 from __future__ import annotations
@@ -50,9 +52,9 @@ def one(n: int, solver: str, cracked: bool) -> dict:
     from xfemslip.solver import NewtonSolver
 
     spec = loads_case(case_text(n, cracked), CASE)
-    t0 = time.perf_counter()
+    t0, c0 = time.perf_counter(), time.process_time()
     model = build_model(spec)
-    t1 = time.perf_counter()
+    t1, c1 = time.perf_counter(), time.process_time()
     newton = NewtonSolver(
         model.problem,
         spec.solver.tolerance,
@@ -60,7 +62,7 @@ def one(n: int, solver: str, cracked: bool) -> dict:
         spec.solver.tangent,
         solver,
     )
-    t2 = time.perf_counter()
+    t2, c2 = time.perf_counter(), time.process_time()
     out = {"n": n, "solver": solver, "cracked": cracked}
     if cracked:
         newton.run(spec.loading.steps)
@@ -76,7 +78,7 @@ def one(n: int, solver: str, cracked: bool) -> dict:
         x = newton.linear.solve(None, rhs)
         err = np.linalg.norm(newton.K_ff @ x - rhs) / np.linalg.norm(rhs)
         out["residual"] = float(err)
-    t3 = time.perf_counter()
+    t3, c3 = time.perf_counter(), time.process_time()
     st = newton.linear.stats
     out.update(
         dofs=int(model.problem.n_dofs),
@@ -85,6 +87,8 @@ def one(n: int, solver: str, cracked: bool) -> dict:
         setup=t2 - t1,
         solve=t3 - t2,
         total=t3 - t0,
+        build_cpu=c1 - c0,
+        solve_cpu=c3 - c2,
         factorizations=st["factorizations"],
         factor_time=st["factor_time"],
         amg_setup=st["setup_time"],
@@ -94,36 +98,56 @@ def one(n: int, solver: str, cracked: bool) -> dict:
     return out
 
 
-def measure(n, solver, cracked, runs, timeout):
-    rows = []
+def run_once(n, solver, cracked, timeout):
+    cmd = [sys.executable, __file__, "--one", str(n), solver]
+    cmd += ["cracked" if cracked else "floor"]
+    base = {"n": n, "solver": solver, "cracked": cracked}
+    try:
+        proc = subprocess.run(
+            cmd, capture_output=True, text=True, timeout=timeout, env=os.environ
+        )
+    except subprocess.TimeoutExpired:
+        return dict(base, error=f"timeout ({timeout:.0f} s)")
+    if proc.returncode != 0:
+        tail = proc.stderr.strip().splitlines()[-1:] or [f"exit {proc.returncode}"]
+        return dict(base, error=tail[0][:80])
+    return json.loads(proc.stdout.strip().splitlines()[-1])
+
+
+def measure(n, configs, runs, timeout):
+    """Median of `runs` runs of each (solver, cracked) config; the configs are
+    interleaved run by run so that a change of machine load hits all alike."""
+    rows = {c: [] for c in configs}
     for _ in range(runs):
-        cmd = [sys.executable, __file__, "--one", str(n), solver]
-        cmd += ["cracked" if cracked else "floor"]
-        try:
-            proc = subprocess.run(
-                cmd, capture_output=True, text=True, timeout=timeout, env=os.environ
-            )
-        except subprocess.TimeoutExpired:
-            return {"n": n, "solver": solver, "cracked": cracked, "error": "timeout"}
-        if proc.returncode != 0:
-            tail = proc.stderr.strip().splitlines()[-1:] or ["?"]
-            return {"n": n, "solver": solver, "cracked": cracked, "error": tail[0]}
-        rows.append(json.loads(proc.stdout.strip().splitlines()[-1]))
-    med = dict(rows[0])
-    for key in ("build", "setup", "solve", "total", "factor_time", "amg_setup"):
-        med[key] = statistics.median(r[key] for r in rows)
-    med["maxrss_mib"] = max(r["maxrss_mib"] for r in rows)
-    med["runs"] = len(rows)
-    return med
+        for c in configs:
+            if rows[c] and "error" in rows[c][-1]:
+                continue
+            rows[c].append(run_once(n, *c, timeout))
+    out = []
+    for c in configs:
+        ok = [r for r in rows[c] if "error" not in r]
+        if not ok:
+            out.append(rows[c][-1])
+            continue
+        med = dict(ok[0])
+        keys = ("build", "setup", "solve", "total", "factor_time", "amg_setup")
+        for key in keys + ("build_cpu", "solve_cpu"):
+            med[key] = statistics.median(r[key] for r in ok)
+        med["maxrss_mib"] = max(r["maxrss_mib"] for r in ok)
+        med["runs"] = len(ok)
+        out.append(med)
+    return out
 
 
 def table(results) -> str:
+    """Markdown table; ratios on CPU time (robust to a shared machine), wall
+    times in parentheses."""
     lines = [
-        "| n x n | dofs | linear solver | build [s] | Newton [s] (its) | "
-        "factorizations / Krylov its | peak RSS [MiB] | floor [s] (RSS) | "
-        "Newton / floor | (build + Newton) / (build + floor) | "
-        "Newton / SuperLU floor |",
-        "| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |",
+        "| n x n | dofs | linear solver | build [s] | Newton [s] | Newton its | "
+        "factorizations / Krylov its | peak RSS [MiB] | floor [s] | "
+        "floor RSS [MiB] | Newton / floor | Newton / SuperLU floor | "
+        "(build + Newton) / (build + floor) |",
+        "| " + " | ".join(["---"] * 13) + " |",
     ]
     floors = {(r["n"], r["solver"]): r for r in results if not r["cracked"]}
     for r in results:
@@ -132,20 +156,28 @@ def table(results) -> str:
         f = floors.get((r["n"], r["solver"]), {})
         f_lu = floors.get((r["n"], "superlu"), {})
         if "error" in r:
-            lines.append(f"| {r['n']} | | {r['solver']} | {r['error']} |||||||")
+            lines.append(f"| {r['n']} | | {r['solver']} | {r['error']} |" + " |" * 9)
             continue
-        fl = f.get("solve")
-        ratio = f"{r['solve'] / fl:.2f}" if fl else "-"
-        ratio2 = (
-            f"{(r['build'] + r['solve']) / (f['build'] + fl):.2f}" if fl else "-"
+        fl = f.get("solve_cpu")
+        ratio = f"{r['solve_cpu'] / fl:.2f}" if fl else "-"
+        ratio_lu = (
+            f"{r['solve_cpu'] / f_lu['solve_cpu']:.2f}"
+            if f_lu.get("solve_cpu")
+            else "-"
         )
-        ratio_lu = f"{r['solve'] / f_lu['solve']:.2f}" if f_lu.get("solve") else "-"
-        floor = f"{fl:.2f} ({f['maxrss_mib']:.0f})" if fl else f.get("error", "-")
+        whole = (
+            f"{(r['build_cpu'] + r['solve_cpu']) / (f['build_cpu'] + fl):.2f}"
+            if fl
+            else "-"
+        )
+        floor = f"{fl:.2f} ({f['solve']:.2f})" if fl else f.get("error", "-")
+        floor_rss = f"{f['maxrss_mib']:.0f}" if fl else "-"
         lines.append(
-            f"| {r['n']} | {r['dofs']:,} | {r['method']} | {r['build']:.2f} | "
-            f"{r['solve']:.2f} ({sum(r['iterations'])}) | "
+            f"| {r['n']} | {r['dofs']:,} | {r['method']} | {r['build_cpu']:.2f} | "
+            f"{r['solve_cpu']:.2f} ({r['solve']:.2f}) | {sum(r['iterations'])} | "
             f"{r['factorizations']} / {r['krylov_iterations']} | "
-            f"{r['maxrss_mib']:.0f} | {floor} | {ratio} | {ratio2} | {ratio_lu} |"
+            f"{r['maxrss_mib']:.0f} | {floor} | {floor_rss} | {ratio} | {ratio_lu} | "
+            f"{whole} |"
         )
     return "\n".join(lines)
 
@@ -163,19 +195,21 @@ def plot(results, path):
             rows = [
                 r
                 for r in results
-                if r["solver"] == solver and r["cracked"] == cracked and "error" not in r
+                if r["solver"] == solver
+                and r["cracked"] == cracked
+                and "error" not in r
             ]
             if not rows:
                 continue
             label = f"{solver}: " + ("Newton solve" if cracked else "floor (1 solve)")
             ax.loglog(
                 [r["dofs"] for r in rows],
-                [r["solve"] for r in rows],
+                [r["solve_cpu"] for r in rows],
                 styles[cracked],
                 label=label,
             )
     ax.set_xlabel("dofs")
-    ax.set_ylabel("time [s]")
+    ax.set_ylabel("CPU time [s]")
     ax.grid(True, which="both", alpha=0.3)
     ax.legend(fontsize=7)
     fig.tight_layout()
@@ -200,18 +234,14 @@ def main() -> int:
     if args.json and args.json.exists():
         results = json.loads(args.json.read_text())
     for n in args.sizes:
-        for solver in args.solvers:
-            for cracked in (False, True):
-                r = measure(n, solver, cracked, args.runs, args.timeout)
-                results = [
-                    x
-                    for x in results
-                    if (x["n"], x["solver"], x["cracked"]) != (n, solver, cracked)
-                ]
-                results.append(r)
-                print(json.dumps(r), flush=True)
-                if args.json:
-                    args.json.write_text(json.dumps(results, indent=1))
+        configs = [(s, c) for s in args.solvers for c in (False, True)]
+        for r in measure(n, configs, args.runs, args.timeout):
+            key = (r["n"], r["solver"], r["cracked"])
+            results = [x for x in results if (x["n"], x["solver"], x["cracked"]) != key]
+            results.append(r)
+            print(json.dumps(r), flush=True)
+        if args.json:
+            args.json.write_text(json.dumps(results, indent=1))
     results.sort(key=lambda r: (r["n"], r["solver"], not r["cracked"]))
     print(table(results))
     if args.plot:

@@ -21,9 +21,11 @@ linear_solver``), each keeping what does not change:
 - ``"amg"``: GMRES preconditioned with the same Schwarz sweep, with a
   smoothed-aggregation AMG V-cycle (pyamg, rigid-body modes as near-nullspace)
   on the standard dofs in place of the back-solve; the exact band solve
-  carries the enrichment and the stiff, non-symmetric contact coupling.  The AMG hierarchy is built once per run (the standard block is part
-  of K_ff); only the small band is refactored per Newton system.  A system without enriched dofs is solved by AMG-preconditioned CG.
-  If GMRES does not converge, the system is solved by SuperLU instead.
+  carries the enrichment and the stiff, non-symmetric contact coupling.  The
+  AMG hierarchy is built once per run (the standard block is part of K_ff);
+  only the small band is refactored per Newton system.  A system without
+  enriched dofs is solved by AMG-preconditioned CG.  If the Krylov solve does
+  not converge, the system is solved by SuperLU instead.
 - ``"auto"`` (default): ``"amg"`` from AUTO_AMG_MIN_DOFS free dofs up when
   pyamg is installed and the node coordinates are known, ``"superlu"`` below.
 
@@ -53,7 +55,7 @@ LINEAR_SOLVERS = ("auto", "superlu", "amg")
 
 # "auto" switches from SuperLU to AMG at this many free dofs (measured on the
 # reservoir case, benchmarks/RESULTS.md "Speed and scale").
-AUTO_AMG_MIN_DOFS = 60_000
+AUTO_AMG_MIN_DOFS = 50_000
 # Relative residual ||A x - b|| / ||b|| at which the Krylov solves stop.
 KRYLOV_RTOL = 1.0e-10
 # GMRES iterations with a kept factorization tried before refactoring, and
@@ -290,7 +292,12 @@ class LinearSolver:
             band = self._band(LU_BAND_LAYERS, Kc)
             if 0 < band.size <= LU_BAND_MAX_FRACTION * A.shape[0]:
                 x = self._schwarz_gmres(
-                    A.tocsr(), r, lu.solve, band, 2, REUSE_MAX_ITERATIONS,
+                    A.tocsr(),
+                    r,
+                    lu.solve,
+                    band,
+                    2,
+                    REUSE_MAX_ITERATIONS,
                     REUSE_MAX_ITERATIONS,
                 )
                 if x is not None:
@@ -338,8 +345,13 @@ class LinearSolver:
 
             M = LinearOperator(A.shape, matvec=self._amg, dtype=float)
             x, info = cg(
-                A, r, M=M, rtol=KRYLOV_RTOL, atol=0.0,
-                maxiter=AMG_MAX_ITERATIONS, callback=callback,
+                A,
+                r,
+                M=M,
+                rtol=KRYLOV_RTOL,
+                atol=0.0,
+                maxiter=AMG_MAX_ITERATIONS,
+                callback=callback,
             )
             self.stats["krylov_iterations"] += count[0]
             if info == 0 and np.all(np.isfinite(x)):
