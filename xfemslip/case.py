@@ -162,7 +162,8 @@ SOLVER_OPTIONS: tuple[Option, ...] = (
         str,
         "auto",
         "linear solver of the Newton systems: 'superlu' (sparse LU, factorization "
-        "kept), 'amg' (pyamg-preconditioned GMRES) or 'auto' (amg from 50,000 free dofs)",
+        "kept), 'amg' (pyamg-preconditioned GMRES) or 'auto' (amg from 50,000 "
+        "free dofs)",
         ("auto", "superlu", "amg"),
     ),
 )
