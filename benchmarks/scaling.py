@@ -3,8 +3,10 @@
 elements = [n, n]) against the floor: ONE factorize-and-solve of the uncracked
 system on the same mesh, measured in the same run.
 
-    python benchmarks/scaling.py --sizes 50 100 200 400 --solvers auto superlu
-    python benchmarks/scaling.py --sizes 50 100 --plot benchmarks/scaling.png
+    python benchmarks/scaling.py --sizes 50 100 200 400 --solvers superlu amg \
+        --runs 3 --json a.json
+    python benchmarks/scaling.py --sizes 700 1000 --solvers amg --runs 1 --json b.json
+    python benchmarks/scaling.py --merge a.json b.json --plot benchmarks/scaling.png
 
 Every measurement runs in its own subprocess so that the peak memory
 (resource.getrusage maxrss) belongs to it alone.  For each size and linear
@@ -224,11 +226,24 @@ def main() -> int:
     ap.add_argument("--timeout", type=float, default=3600.0)
     ap.add_argument("--json", type=Path, help="append the results to this file")
     ap.add_argument("--plot", type=Path, help="write a log-log plot (PNG)")
+    ap.add_argument(
+        "--merge",
+        type=Path,
+        nargs="+",
+        help="measure nothing: table (and --plot) of these --json files",
+    )
     ap.add_argument("--one", nargs=3, help=argparse.SUPPRESS)
     args = ap.parse_args()
     if args.one:
         n, solver, kind = args.one
         print(json.dumps(one(int(n), solver, kind == "cracked")))
+        return 0
+    if args.merge:
+        results = [r for path in args.merge for r in json.loads(path.read_text())]
+        results.sort(key=lambda r: (r["n"], r["solver"], not r["cracked"]))
+        print(table(results))
+        if args.plot:
+            plot(results, args.plot)
         return 0
     results = []
     if args.json and args.json.exists():
