@@ -163,7 +163,7 @@ SOLVER_OPTIONS: tuple[Option, ...] = (
         "auto",
         "linear solver of the Newton systems: 'superlu' (sparse LU, factorization "
         "kept), 'amg' (pyamg-preconditioned GMRES) or 'auto' (amg from 50,000 "
-        "free dofs)",
+        "free dofs on cells up to 4:1)",
         ("auto", "superlu", "amg"),
     ),
 )

@@ -119,11 +119,18 @@ def test_whole_run_agrees_between_linear_solvers(monkeypatch):
 
 
 def test_auto_choice():
-    assert choose("auto", linsolve.AUTO_AMG_MIN_DOFS - 1, True) == "superlu"
-    assert choose("auto", linsolve.AUTO_AMG_MIN_DOFS, True) == "amg"
-    assert choose("auto", 10**7, False) == "superlu"  # no coordinates
-    assert choose("superlu", 10**7, True) == "superlu"
-    assert choose("amg", 10, True) == "amg"
+    g = np.linspace(0.0, 1.0, 11)
+    square = np.column_stack([np.repeat(g, 11), np.tile(g, 11)])
+    stretched = square * [1.0, 5.0]  # cells 0.1 x 0.5
+    assert linsolve.cell_aspect_ratio(square) == pytest.approx(1.0)
+    assert linsolve.cell_aspect_ratio(stretched) == pytest.approx(5.0)
+    n = linsolve.AUTO_AMG_MIN_DOFS
+    assert choose("auto", n - 1, square) == "superlu"
+    assert choose("auto", n, square) == "amg"
+    assert choose("auto", n, stretched) == "superlu"  # AMG fails on such meshes
+    assert choose("auto", 10**7, None) == "superlu"  # no coordinates
+    assert choose("superlu", 10**7, square) == "superlu"
+    assert choose("amg", 10, None) == "amg"
 
 
 def test_rigid_body_modes_are_the_nullspace_of_an_unconstrained_mesh():
