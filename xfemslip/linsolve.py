@@ -60,7 +60,7 @@ LINEAR_SOLVERS = ("auto", "superlu", "amg")
 # "auto" switches from SuperLU to AMG at this many free dofs (measured on the
 # reservoir case, benchmarks/RESULTS.md "Speed and scale"), on meshes whose
 # cells are no more elongated than AUTO_AMG_MAX_ASPECT: on a graded mesh with
-# cells up to 150:1 the AMG-preconditioned GMRES did not converge in 300
+# cells up to 146:1 the AMG-preconditioned GMRES did not converge in 300
 # iterations (58k dofs).
 AUTO_AMG_MIN_DOFS = 50_000
 AUTO_AMG_MAX_ASPECT = 4.0
@@ -273,9 +273,10 @@ class LinearSolver:
 
     def _schwarz_gmres(self, A, r, coarse, band, cycles, restart, cap):
         """GMRES on A x = r, preconditioned by one multiplicative Schwarz sweep:
-        `coarse` (an approximate inverse of the whole matrix; on the dofs
-        `coarse_dofs` only), an exact LU solve on the dofs `band` with the
-        current matrix, and (cycles == 2) `coarse` again."""
+        `coarse` (an approximate inverse: the kept factorization, or the AMG
+        V-cycle on the standard dofs), an exact LU solve on the dofs `band`
+        with the current matrix, and (cycles == 2) `coarse` again.  None when
+        GMRES does not converge or the band matrix is singular."""
         from scipy.sparse.linalg import LinearOperator
 
         t = time.perf_counter()
