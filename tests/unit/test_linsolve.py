@@ -166,3 +166,20 @@ def test_case_option(tmp_path):
     assert spec.solver.linear_solver == "amg"
     with pytest.raises(CaseError, match="solver.linear_solver: must be one of"):
         loads_case(text.replace("max_iterations = 30", 'linear_solver = "lu"'), "c")
+
+
+@pytest.mark.slow
+def test_default_solver_at_the_amg_size_agrees_with_superlu():
+    """160 x 160 (53k free dofs): "auto" picks AMG with the default band and
+    limits; the slip and the Newton iterations equal those of SuperLU."""
+    out = {}
+    for method in ("auto", "superlu"):
+        model = build_model(loads_case(_text(160), CASE))
+        newton = NewtonSolver(model.problem, 1e-8, 30, "consistent", method)
+        steps = newton.run(1)
+        out[method] = (newton.linear.stats, steps[-1].iterations, steps[-1].contact.gt)
+    (st_a, it_a, gt_a), (st_s, it_s, gt_s) = out["auto"], out["superlu"]
+    assert st_a["method"] == "amg" and st_a["factorizations"] == 0
+    assert st_s["factorizations"] == 1 and st_s["krylov_iterations"] > 0
+    assert it_a == it_s == 2
+    assert np.max(np.abs(gt_a - gt_s)) <= 1e-8 * np.max(np.abs(gt_s))
