@@ -175,6 +175,15 @@ SOLVER_OPTIONS: tuple[Option, ...] = (
         "smallest sub-step is 1/2**max_step_cuts of the step",
         Range(0, 30),
     ),
+    Option(
+        "linear_solver",
+        str,
+        "auto",
+        "linear solver of the Newton systems: 'superlu' (sparse LU, factorization "
+        "kept), 'amg' (pyamg-preconditioned GMRES) or 'auto' (amg from 50,000 "
+        "free dofs on cells up to 4:1)",
+        ("auto", "superlu", "amg"),
+    ),
 )
 
 

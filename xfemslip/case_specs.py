@@ -117,12 +117,14 @@ class SolverSpec:
     tangent: str = "consistent"  # "consistent" | "secant" (paper eq. 28)
     contact_patch: float = CONTACT_PATCH_CELLS  # patch length [cells]; 0 = pointwise
     max_step_cuts: int = 5  # bisections of a failing load step
+    linear_solver: str = "auto"  # "auto" | "superlu" | "amg" (xfemslip.linsolve)
     UNITS: ClassVar[dict[str, str]] = {
         "tolerance": "-",
         "max_iterations": "-",
         "tangent": "",
         "contact_patch": "cells",
         "max_step_cuts": "-",
+        "linear_solver": "",
     }
 
 

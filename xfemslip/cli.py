@@ -222,7 +222,7 @@ def info() -> None:
     rows = [("xfemslip", __version__), ("python", platform.python_version())]
     rows += [
         (name, _dist_version(name))
-        for name in ("numpy", "scipy", "numba", "h5py", "meshio", "click")
+        for name in ("numpy", "scipy", "numba", "pyamg", "h5py", "meshio", "click")
     ]
     rows += numba_settings()
     rows += [("executable", sys.executable)]

@@ -124,6 +124,7 @@ def build_model(spec) -> Model:
         penalty_ratio=float(np.max(np.maximum(contact.kn, contact.kt), initial=0.0))
         * mesh.h_min
         / mat.E,
+        node_xy=mesh.nodes,
     )
     logger.info(
         "model: %d x %d cells, %d fracture(s), %d dofs (%d nodes enriched with %d "
@@ -215,6 +216,7 @@ def run_case(
         spec.solver.tolerance,
         spec.solver.max_iterations,
         spec.solver.tangent,
+        spec.solver.linear_solver,
         max_step_cuts=spec.solver.max_step_cuts,
     )
     failure = None

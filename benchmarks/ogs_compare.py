@@ -1,0 +1,247 @@
+#!/usr/bin/env python3
+"""xfemslip against OpenGeoSys (LIE + Coulomb) on the same frictional crack,
+whole-process wall time against L2 slip error.
+
+The problem (the one of ../shared/peers/ogs/ogs_lie_slip.py): a 20 m x 20 m
+box, a crack of length 2a = 2 m at 45 degrees through the centre, far-field
+stress sxx = -20 MPa, syy = -40 MPa applied as edge tractions, f = 0.1,
+c = 0, kn = kt = 5e12 Pa/m, E = 5 GPa, nu = 0.3, plane strain, one load step.
+Error: relative L2 norm of slip - exact slip along the crack (Phan et al.,
+xfemslip.closed_form.slip_profile).
+
+xfemslip: a graded mesh, cells of size h over [-0.8, 0.8]^2 (the crack and a
+margin) growing by 1.3 per cell to the edges; the bottom edge has u_y = 0 (the
+case format needs one prescribed displacement; OGS holds the box by two corner
+points instead), the other edges are traction edges.  Time: `xfemslip run`
+(h5 + VTU output), warm Numba cache, median of --runs processes.
+
+OGS: `ogs_lie_slip.py --quads --h-frac H` (gmsh Quad4 mesh graded from H on the
+crack to 1 m); time: the `ogs` process alone (OMP_NUM_THREADS=1, its own
+wall clock measured by the script), median of --runs; gmsh meshing not counted.
+
+    python benchmarks/ogs_compare.py --xfem-h 0.1 0.05 0.025 0.0125 \
+        --ogs-h 0.01 0.005 0.0025 --runs 3 \
+        --ogs-python ../ogs-venv/bin/python \
+        --ogs-script ../shared/peers/ogs/ogs_lie_slip.py
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import math
+import os
+import re
+import resource
+import statistics
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+import numpy as np
+
+ROOT = Path(__file__).resolve().parents[1]
+OGS_PY = ROOT.parent / "ogs-venv/bin/python"
+OGS_SCRIPT = ROOT.parent / "shared/peers/ogs/ogs_lie_slip.py"
+A, E, NU, F, PSI = 1.0, 5.0e9, 0.3, 0.1, 45.0
+STRESS = (-20.0e6, -40.0e6, 0.0)
+
+
+def graded(h, fine=0.8, half=10.0, growth=1.3):
+    """Node coordinates: uniform h on [-fine, fine], then growing cells."""
+    n = max(1, round(2 * fine / h))
+    core = np.linspace(-fine, fine, n + 1)
+    outer = []
+    x, step = fine, core[1] - core[0]
+    while x < half - 1e-9:
+        step = step * growth
+        x = min(half, x + step)
+        if half - x < 0.5 * step:
+            x = half
+        outer.append(x)
+    outer = np.array(outer)
+    return np.concatenate([-outer[::-1], core, outer])
+
+
+def xfem_case(h) -> str:
+    x = graded(h)
+    t = (math.cos(math.radians(PSI)), math.sin(math.radians(PSI)))
+    coords = ", ".join(f"{v:.12g}" for v in x)
+    return f"""name = "ogs-compare"
+[mesh]
+x = [{coords}]
+y = [{coords}]
+[material]
+E = {E!r}
+nu = {NU!r}
+model = "plane_strain"
+[[fractures]]
+points = [[{-A * t[0]!r}, {-A * t[1]!r}], [{A * t[0]!r}, {A * t[1]!r}]]
+friction = {F!r}
+cohesion = 0.0
+kn = 5.0e12
+kt = 5.0e12
+[loading]
+stress = {{ xx = {STRESS[0]!r}, yy = {STRESS[1]!r}, xy = 0.0 }}
+[boundary]
+bottom = {{ uy = 0.0, traction = true }}
+top = "traction"
+left = "traction"
+right = "traction"
+"""
+
+
+def run_xfem(h, runs, folder: Path) -> dict:
+    import h5py
+
+    from xfemslip.closed_form import relative_l2, slip_profile
+
+    case = folder / f"case_{h:g}.toml"
+    case.write_text(xfem_case(h))
+    out = folder / f"out_{h:g}"
+    cmd = [sys.executable, "-m", "xfemslip", "run", "-q", "--overwrite", str(case)]
+    cmd += ["-o", str(out)]
+    subprocess.run(cmd, check=True, capture_output=True)  # warm the Numba cache
+    walls, cpus = [], []
+    for _ in range(runs):
+        before = resource.getrusage(resource.RUSAGE_CHILDREN)
+        start = time.perf_counter()
+        subprocess.run(cmd, check=True, capture_output=True)
+        walls.append(time.perf_counter() - start)
+        after = resource.getrusage(resource.RUSAGE_CHILDREN)
+        cpus.append(after.ru_utime - before.ru_utime + after.ru_stime - before.ru_stime)
+    with h5py.File(out / "result.h5", "r") as f:
+        s = f["fractures/0/s"][()]
+        slip = f["fractures/0/slip"][()]
+        dofs = int(f.attrs["n_dofs"])
+        its = int(f.attrs["newton_iterations"])
+    exact = slip_profile(s, A, E, NU, "plane_strain", STRESS, PSI, F)
+    sign = np.sign(np.sum(slip * exact)) or 1.0
+    err = relative_l2(s, sign * slip, exact)
+    return {
+        "code": "xfemslip",
+        "h": h,
+        "dofs": dofs,
+        "newton": its,
+        "err_L2": err,
+        "wall": statistics.median(walls),
+        "walls": walls,
+        "cpu": statistics.median(cpus),
+    }
+
+
+def run_ogs(h, runs, folder: Path, python=OGS_PY, script=OGS_SCRIPT) -> dict:
+    walls, cpus = [], []
+    for i in range(runs):
+        wd = folder / f"ogs_{h:g}_{i}"
+        cmd = [str(python), str(script), "--quads", "--h-frac", str(h)]
+        cmd += ["--workdir", str(wd)]
+        env = {k: v for k, v in os.environ.items() if k != "PYTHONPATH"}
+        subprocess.run(cmd, check=True, capture_output=True, env=env)
+        summary = json.loads((wd / "summary.json").read_text())
+        walls.append(summary["run"]["wall_s"])
+        timev = (wd / "ogs.stderr").read_text()  # /usr/bin/time -v of ogs
+        user = re.search(r"User time \(seconds\): ([0-9.]+)", timev)
+        system = re.search(r"System time \(seconds\): ([0-9.]+)", timev)
+        cpus.append(float(user.group(1)) + float(system.group(1)))
+    return {
+        "code": "OGS",
+        "h": h,
+        "dofs": summary["mesh"]["dofs"],
+        "newton": sum(summary["run"]["newton_iters_per_step"]),
+        "err_L2": summary["result"]["err_L2_rel"],
+        "wall": statistics.median(walls),
+        "walls": walls,
+        "cpu": statistics.median(cpus),
+    }
+
+
+def at_error(rows, err, key="wall"):
+    """Time to reach slip error `err`: interpolated log-log on the cost-error
+    front (runs sorted by time, each kept only if it is more accurate than
+    every cheaper one) between the two runs that bracket it; None outside."""
+    front, best = [], math.inf
+    for r in sorted(rows, key=lambda r: r[key]):
+        if r["err_L2"] < best:
+            front.append(r)
+            best = r["err_L2"]
+    pts = sorted((r["err_L2"], r[key]) for r in front)
+    for (e0, w0), (e1, w1) in zip(pts, pts[1:], strict=False):
+        if e0 <= err <= e1 and e1 > e0:
+            u = math.log(err / e0) / math.log(e1 / e0)
+            return math.exp(math.log(w0) + u * math.log(w1 / w0))
+    return None
+
+
+def main() -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--xfem-h", type=float, nargs="+", default=[0.1, 0.05, 0.025])
+    ap.add_argument("--ogs-h", type=float, nargs="+", default=[0.01, 0.005, 0.0025])
+    ap.add_argument("--runs", type=int, default=3)
+    ap.add_argument("--json", type=Path)
+    ap.add_argument("--report", type=Path, help="run nothing: tables of a --json file")
+    ap.add_argument(
+        "--ogs-python",
+        type=Path,
+        default=OGS_PY,
+        help="python of a venv with ogs [default: ../ogs-venv]",
+    )
+    ap.add_argument(
+        "--ogs-script",
+        type=Path,
+        default=OGS_SCRIPT,
+        help="ogs_lie_slip.py [default: ../shared/peers/ogs]",
+    )
+    args = ap.parse_args()
+    if args.report:
+        report(json.loads(args.report.read_text()))
+        return 0
+    rows = []
+    with tempfile.TemporaryDirectory() as tmp:
+        folder = Path(tmp)
+        for h in args.xfem_h:
+            rows.append(run_xfem(h, args.runs, folder))
+            print(json.dumps(rows[-1]), flush=True)
+        for h in args.ogs_h:
+            rows.append(run_ogs(h, args.runs, folder, args.ogs_python, args.ogs_script))
+            print(json.dumps(rows[-1]), flush=True)
+    if args.json:
+        args.json.write_text(json.dumps(rows, indent=1))
+    report(rows)
+    return 0
+
+
+def report(rows):
+    """The two tables: every run, and the times at equal slip error."""
+    print(
+        "| code | h on the crack [m] | dofs | Newton its | L2 slip error | "
+        "wall [s] | CPU [s] |"
+    )
+    print("| --- | --- | --- | --- | --- | --- | --- |")
+    for r in rows:
+        print(
+            f"| {r['code']} | {r['h']:g} | {r['dofs']:,} | {r['newton']} | "
+            f"{100 * r['err_L2']:.2f} % | {r['wall']:.2f} | {r['cpu']:.2f} |"
+        )
+    xf = [r for r in rows if r["code"] == "xfemslip"]
+    og = [r for r in rows if r["code"] == "OGS"]
+    print(
+        "\n| L2 slip error | xfemslip wall (CPU) [s] | OGS wall (CPU) [s] | "
+        "OGS / xfemslip, wall (CPU) |"
+    )
+    print("| --- | --- | --- | --- |")
+    for r in og:
+        w = at_error(xf, r["err_L2"])
+        c = at_error(xf, r["err_L2"], "cpu")
+        if w is not None:
+            print(
+                f"| {100 * r['err_L2']:.2f} % | {w:.2f} ({c:.2f}) | "
+                f"{r['wall']:.2f} ({r['cpu']:.2f}) | "
+                f"{r['wall'] / w:.1f} ({r['cpu'] / c:.1f}) |"
+            )
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,407 @@
+"""Linear solves of the Newton systems (K_ff + K_c) du = r.
+
+K_ff, the bulk stiffness on the free dofs, is the same for the whole run; only
+K_c, the contact tangent on the enriched dofs along the fractures, changes
+between Newton iterations and load steps.  Two strategies (``[solver]
+linear_solver``), each keeping what does not change:
+
+- ``"superlu"``: sparse LU (scipy SuperLU, minimum degree on A^T + A in
+  symmetric mode, a residual-checked fallback to COLAMD with partial pivoting).
+  The first Newton matrix of the run is factored and the factorization kept.
+  A system whose contact tangent equals the factored one (no fracture, a
+  fracture that stays stuck, a settled set under the secant tangent) costs one
+  back-solve.  Otherwise the change (on the enriched dofs only) is handled by
+  GMRES preconditioned with one multiplicative Schwarz sweep: back-solve with
+  the kept factorization, then an exact LU solve of the current matrix on a
+  band of LU_BAND_LAYERS matrix neighbours around the enriched dofs (small:
+  the dofs along the fractures).  Measured on the reservoir case at 400 x 400:
+  11 GMRES iterations, about 0.3 of a refactorization (GMRES with the kept
+  factorization alone needs 121 at 200 x 200; a second back-solve after the
+  band solve saves at most one iteration and cost 11.0 against 8.9 s).  If
+  GMRES has not converged in REUSE_MAX_ITERATIONS iterations the matrix is
+  refactored and kept.
+- ``"amg"``: GMRES preconditioned with the same Schwarz sweep: one
+  smoothed-aggregation AMG V-cycle (pyamg, rigid-body modes as near-nullspace)
+  on the standard dofs in place of the back-solve, then the exact band solve,
+  which carries the enrichment and the stiff, non-symmetric contact coupling
+  (a second V-cycle after it saves iterations but not time: 28 against 42
+  iterations, 2.0 against 1.5 s CPU at 200 x 200).  The
+  AMG hierarchy is built once per run (the standard block is part of K_ff);
+  only the small band is refactored per Newton system.  A system without
+  enriched dofs is solved by AMG-preconditioned CG.
+  If the Krylov solve does not converge, that system and the rest of the run
+  go to SuperLU.
+- ``"auto"`` (default): ``"amg"`` from AUTO_AMG_MIN_DOFS free dofs up on
+  meshes with cell aspect ratios up to AUTO_AMG_MAX_ASPECT (pyamg installed,
+  node coordinates known), ``"superlu"`` otherwise.
+
+Why not a low-rank (Woodbury) update or a Schur complement on the contact
+dofs: both cost one back-solve per contact dof, and on the reservoir case at
+200 x 200 (82k dofs, 518 contact dofs) one back-solve is 1/40 of a
+factorization, so the update would cost about 13 factorizations.
+
+The friction tangent is not symmetric while slipping, hence GMRES (not CG)
+whenever a contact tangent is present.  Iterative solves stop at a relative
+residual KRYLOV_RTOL, far below the Newton tolerance, so Newton converges as
+with the direct solve.
+"""
+
+from __future__ import annotations
+
+import importlib.util
+import logging
+import time
+
+import numpy as np
+import scipy.sparse as sp
+
+logger = logging.getLogger(__name__)
+
+LINEAR_SOLVERS = ("auto", "superlu", "amg")
+
+# "auto" switches from SuperLU to AMG at this many free dofs (measured on the
+# reservoir case, benchmarks/RESULTS.md "Speed and scale"), on meshes whose
+# cells are no more elongated than AUTO_AMG_MAX_ASPECT: on a graded mesh with
+# cells up to 146:1 the AMG-preconditioned GMRES did not converge in 300
+# iterations (58k dofs).
+AUTO_AMG_MIN_DOFS = 50_000
+AUTO_AMG_MAX_ASPECT = 4.0
+# Relative residual ||A x - b|| / ||b|| at which the Krylov solves stop.
+KRYLOV_RTOL = 1.0e-10
+# GMRES iterations with a kept factorization tried before refactoring, and
+# the layers of the band solved exactly with the current matrix.
+REUSE_MAX_ITERATIONS = 20
+LU_BAND_LAYERS = 12
+# A band holding more than this fraction of the dofs costs about as much as a
+# refactorization: refactor instead (small meshes).
+LU_BAND_MAX_FRACTION = 0.25
+# GMRES restart length and total iteration cap of the AMG path.
+AMG_RESTART = 60
+AMG_MAX_ITERATIONS = 150
+# Layers of matrix neighbours around the enriched dofs in the exact band solve.
+AMG_BAND_LAYERS = 3
+
+# SuperLU settings for K + K_contact, whose sparsity pattern is symmetric even
+# when the slip tangent's values are not: minimum degree on A^T + A in symmetric
+# mode, preferring diagonal pivots (measured: 2x faster than the default COLAMD
+# at 82k dofs, 0.19 vs 0.31 s at 21k).  The pivot threshold 0.1 keeps partial
+# pivoting for the non-symmetric friction coupling; a solve whose residual is
+# poor is redone with COLAMD and full partial pivoting.
+LU_FAST = {
+    "permc_spec": "MMD_AT_PLUS_A",
+    "diag_pivot_thresh": 0.1,
+    "options": {"SymmetricMode": True},
+}
+LU_SAFE = {"permc_spec": "COLAMD", "diag_pivot_thresh": 1.0}
+LU_RESIDUAL = 1.0e-8  # relative residual of a direct solve that triggers the fallback
+
+
+def pyamg_available() -> bool:
+    return importlib.util.find_spec("pyamg") is not None
+
+
+def choose(method: str, n_free: int, node_xy=None) -> str:
+    """The strategy "auto" stands for at this size and mesh."""
+    if method != "auto":
+        return method
+    if (
+        n_free >= AUTO_AMG_MIN_DOFS
+        and node_xy is not None
+        and cell_aspect_ratio(node_xy) <= AUTO_AMG_MAX_ASPECT
+        and pyamg_available()
+    ):
+        return "amg"
+    return "superlu"
+
+
+def cell_aspect_ratio(node_xy) -> float:
+    """Largest cell aspect ratio of a structured rectilinear mesh, from its
+    grid lines: max(max hx / min hy, max hy / min hx)."""
+    hx = np.diff(np.unique(node_xy[:, 0]))
+    hy = np.diff(np.unique(node_xy[:, 1]))
+    if hx.size == 0 or hy.size == 0:
+        return 1.0
+    return float(max(hx.max() / hy.min(), hy.max() / hx.min()))
+
+
+def _splu(A, settings):
+    from scipy.sparse.linalg import splu
+
+    return splu(A, **settings)
+
+
+def lu_factor(A):
+    """SuperLU factorization with the fast settings, and a solve function that
+    falls back to COLAMD with partial pivoting when the residual is poor."""
+    A = sp.csc_matrix(A)
+    lu = _splu(A, LU_FAST)
+
+    def solve(b):
+        x = lu.solve(b)
+        norm_b = np.linalg.norm(b)
+        if not np.all(np.isfinite(x)) or np.linalg.norm(A @ x - b) > LU_RESIDUAL * (
+            norm_b
+        ):
+            logger.debug("linear solve: residual too large, refactoring with COLAMD")
+            x = _splu(A, LU_SAFE).solve(b)
+        return x
+
+    return lu, solve
+
+
+def lu_solve(A, b):
+    """Solve A x = b with SuperLU (fast settings, safe ones if the residual is poor)."""
+    return lu_factor(A)[1](b)
+
+
+def _gmres(A, b, M, restart, maxiter):
+    """GMRES from zero until ||A x - b|| <= KRYLOV_RTOL ||b|| (the true
+    residual: scipy's test is on the preconditioned one, so GMRES is restarted
+    from its answer while the true residual is too large and iterations are
+    left); returns (x, converged, iterations)."""
+    from scipy.sparse.linalg import gmres
+
+    count = [0]
+
+    def callback(_):
+        count[0] += 1
+
+    x = np.zeros_like(b)
+    target = KRYLOV_RTOL * np.linalg.norm(b)
+    ok = False
+    while count[0] < maxiter:
+        left = maxiter - count[0]
+        before = count[0]
+        x, _ = gmres(
+            A,
+            b,
+            x0=x,
+            M=M,
+            rtol=KRYLOV_RTOL,
+            atol=0.0,
+            restart=min(restart, left),
+            maxiter=max(1, -(-left // restart)),
+            callback=callback,
+            callback_type="pr_norm",
+        )
+        if not np.all(np.isfinite(x)):
+            break
+        ok = np.linalg.norm(A @ x - b) <= target
+        if ok or count[0] == before:
+            break
+    return x, bool(ok), count[0]
+
+
+def rigid_body_modes(xy: np.ndarray, component: np.ndarray) -> np.ndarray:
+    """(m, 3) translations and in-plane rotation at dofs of the given node
+    coordinates (m, 2) and components (m,) 0 = x, 1 = y."""
+    B = np.zeros((xy.shape[0], 3))
+    B[component == 0, 0] = 1.0
+    B[component == 1, 1] = 1.0
+    xc = xy - xy.mean(axis=0)
+    B[:, 2] = np.where(component == 0, -xc[:, 1], xc[:, 0])
+    return B
+
+
+class LinearSolver:
+    """Solves (K_ff + K_c) x = r for a run, keeping what does not change.
+
+    K_ff : bulk stiffness on the free dofs (constant for the run).
+    method : "auto" | "superlu" | "amg".
+    free : global dof of each free dof (n_free,).
+    node_xy : (n_nodes, 2) node coordinates; standard dofs are 2*node + c and
+        every dof from 2*n_nodes on is enriched.  Needed by "amg" (rigid-body
+        modes); without it "auto" means "superlu".
+    """
+
+    def __init__(self, K_ff, method="auto", free=None, node_xy=None):
+        if method not in LINEAR_SOLVERS:
+            raise ValueError(f"linear solver must be one of {LINEAR_SOLVERS}")
+        self.K = sp.csr_matrix(K_ff)
+        n = self.K.shape[0]
+        self.free = np.arange(n) if free is None else np.asarray(free)
+        self.node_xy = node_xy
+        self.method = choose(method, n, node_xy)
+        if self.method == "amg" and node_xy is None:
+            raise ValueError("the AMG linear solver needs the node coordinates")
+        self.stats = {
+            "method": self.method,
+            "factorizations": 0,
+            "factor_time": 0.0,
+            "setup_time": 0.0,
+            "solves": 0,
+            "krylov_iterations": 0,
+            "solve_time": 0.0,
+        }
+        self._lu = None  # (SuperLU object, checked solve, K_c it factors)
+        self._amg = None  # V-cycle on the standard dofs
+        self._bands = {}
+        logger.debug("linear solver: %s (%d free dofs)", self.method, n)
+
+    # ------------------------------------------------------------------ #
+    def solve(self, Kc, r):
+        """x with (K_ff + Kc) x = r; Kc is (n_free, n_free) sparse or None.
+
+        Raises RuntimeError when the matrix is singular (as SuperLU does).
+        """
+        start = time.perf_counter()
+        if Kc is None:
+            Kc = sp.csr_matrix(self.K.shape)
+        Kc = sp.csr_matrix(Kc)
+        if self.method == "amg":
+            x = self._solve_amg(Kc, r)
+        else:
+            x = self._solve_superlu(Kc, r)
+        self.stats["solves"] += 1
+        self.stats["solve_time"] += time.perf_counter() - start
+        return x
+
+    # ------------------------------------------------------------------ #
+    def _band(self, layers, Kc):
+        """Free dofs within `layers` matrix neighbours of the enriched dofs
+        (without node coordinates: of the dofs the contact tangent touches)."""
+        if layers not in self._bands:
+            if self.node_xy is None:
+                band = np.diff(sp.csr_matrix(Kc).indptr) > 0
+            else:
+                band = self.free >= 2 * self.node_xy.shape[0]
+            if band.any():
+                pattern = self.K.copy()
+                pattern.data = np.ones_like(pattern.data)
+                for _ in range(layers):
+                    band |= (pattern @ band.astype(float)) > 0
+            self._bands[layers] = np.nonzero(band)[0]
+        return self._bands[layers]
+
+    def _schwarz_gmres(self, A, r, coarse, band, cycles, restart, cap):
+        """GMRES on A x = r, preconditioned by one multiplicative Schwarz sweep:
+        `coarse` (an approximate inverse: the kept factorization, or the AMG
+        V-cycle on the standard dofs), an exact LU solve on the dofs `band`
+        with the current matrix, and (cycles == 2) `coarse` again.  None when
+        GMRES does not converge or the band matrix is singular."""
+        from scipy.sparse.linalg import LinearOperator
+
+        t = time.perf_counter()
+        try:
+            band_lu, _ = lu_factor(A[band][:, band])
+        except RuntimeError:  # singular band: let SuperLU judge the whole matrix
+            return None
+        self.stats["factor_time"] += time.perf_counter() - t
+
+        def sweep(v):
+            x = coarse(v)
+            x[band] += band_lu.solve((v - A @ x)[band])
+            if cycles == 2:
+                x += coarse(v - A @ x)
+            return x
+
+        M = LinearOperator(A.shape, matvec=sweep, dtype=float)
+        x, ok, its = _gmres(A, r, M, restart, cap)
+        self.stats["krylov_iterations"] += its
+        logger.debug("linear solve: Schwarz-GMRES, %d iterations (%s)", its, ok)
+        return x if ok else None
+
+    def _factor(self, A, Kc):
+        t = time.perf_counter()
+        lu, solve = lu_factor(A)
+        self.stats["factorizations"] += 1
+        self.stats["factor_time"] += time.perf_counter() - t
+        self._lu = (lu, solve, Kc)
+        return solve
+
+    def _solve_superlu(self, Kc, r):
+        A = (self.K + Kc).tocsc()
+        if self._lu is not None:
+            lu, solve, Kc_ref = self._lu
+            if _same(Kc, Kc_ref):
+                return solve(r)
+            band = self._band(LU_BAND_LAYERS, Kc)
+            if 0 < band.size <= LU_BAND_MAX_FRACTION * A.shape[0]:
+                x = self._schwarz_gmres(
+                    A.tocsr(),
+                    r,
+                    lu.solve,
+                    band,
+                    1,
+                    REUSE_MAX_ITERATIONS,
+                    REUSE_MAX_ITERATIONS,
+                )
+                if x is not None:
+                    return x
+        return self._factor(A, Kc)(r)
+
+    # ------------------------------------------------------------------ #
+    def _setup_amg(self):
+        import pyamg
+
+        t = time.perf_counter()
+        n_std = 2 * self.node_xy.shape[0]
+        std = np.nonzero(self.free < n_std)[0]
+        dof = self.free[std]
+        B = rigid_body_modes(self.node_xy[dof // 2], dof % 2)
+        K_ss = self.K[std][:, std].tocsr()
+        ml = pyamg.smoothed_aggregation_solver(K_ss, B=B)
+        V = ml.aspreconditioner(cycle="V")
+
+        def cycle(v):
+            x = np.zeros(v.shape)
+            x[std] = V @ v[std]
+            return x
+
+        self._amg = cycle
+        self.stats["setup_time"] += time.perf_counter() - t
+        logger.debug(
+            "AMG: %d levels, operator complexity %.2f",
+            len(ml.levels),
+            ml.operator_complexity(),
+        )
+
+    def _solve_amg(self, Kc, r):
+        from scipy.sparse.linalg import LinearOperator, cg
+
+        if self._amg is None:
+            self._setup_amg()
+        A = (self.K + Kc).tocsr()
+        band = self._band(AMG_BAND_LAYERS, Kc)
+        if band.size == 0:  # no enrichment: SPD, CG with the V-cycle
+            count = [0]
+
+            def callback(_):
+                count[0] += 1
+
+            M = LinearOperator(A.shape, matvec=self._amg, dtype=float)
+            x, info = cg(
+                A,
+                r,
+                M=M,
+                rtol=KRYLOV_RTOL,
+                atol=0.0,
+                maxiter=AMG_MAX_ITERATIONS,
+                callback=callback,
+            )
+            self.stats["krylov_iterations"] += count[0]
+            if info == 0 and np.all(np.isfinite(x)):
+                return x
+        else:
+            x = self._schwarz_gmres(
+                A, r, self._amg, band, 1, AMG_RESTART, AMG_MAX_ITERATIONS
+            )
+            if x is not None:
+                return x
+        logger.warning(
+            "AMG-preconditioned Krylov solve did not converge; SuperLU solves "
+            "this and the later systems of the run"
+        )
+        self.method = "superlu"
+        return self._factor(A.tocsc(), Kc)(r)
+
+
+def _same(a, b) -> bool:
+    """Two sparse matrices equal entry by entry (same stored pattern)."""
+    return (
+        a.shape == b.shape
+        and a.nnz == b.nnz
+        and np.array_equal(a.indptr, b.indptr)
+        and np.array_equal(a.indices, b.indices)
+        and np.array_equal(a.data, b.data)
+    )
