@@ -60,7 +60,7 @@ def _describe_fracture(spec: FractureSpec) -> list[str]:
         f", radius {_with_unit(spec.tip_radius, units['tip_radius'])}"
         if spec.tip_radius is not None
         else (
-            ", radius 0.1 x length within 4-8 tip-cell sizes (automatic)"
+            ", radius 0.1 x length within 4-6 tip-cell sizes (automatic)"
             if spec.tip == "branch"
             else ""
         )

@@ -32,11 +32,15 @@ GEOMETRY_TOL = 1.0e-9
 # TIP_RADIUS_MAX_CELLS tip-cell sizes: at least enough nodes for the functions to
 # act, at most a bounded number of enriched nodes per tip (the cost and the
 # conditioning grow with (radius / h)^2).  Measured on the inclined crack
-# (benchmarks/RESULTS.md): slip L2 error 0.80 / 0.41 / 0.14 % at h = a/10, a/20,
-# a/40 against 0.80 / 0.41 / 0.29 % with a fixed 4-cell radius.
+# (benchmarks/RESULTS.md), slip L2 error at h = a/10, a/20, a/40: 0.80 / 0.41 /
+# 0.16 % with this 6-cell cap (order 1.18), 0.14 % with an 8-cell cap, 0.23 %
+# with 5 cells (order 0.91), 0.29 % with a fixed 4-cell radius.  The cap of 8
+# made the SuperLU factorization of the 160 x 160 reservoir case 3x slower than
+# 4 cells (its band of changed dofs too wide to keep the factorization); 6
+# costs 2x, the price of order >= 1.
 DEFAULT_TIP = "branch"
 TIP_RADIUS_CELLS = 4.0
-TIP_RADIUS_MAX_CELLS = 8.0
+TIP_RADIUS_MAX_CELLS = 6.0
 TIP_RADIUS_FRACTION = 0.1
 
 

@@ -28,7 +28,7 @@ psi, f, c, plane                                 n = 32  n = 64  n = 128
 150 deg, f = 0 (frictionless), plane stress              0.52 %
 ===============================================  ======  ======  =======
 
-With the geometric branch radius (0.1 x length, within 4-8 tip cells) the
+With the geometric branch radius (0.1 x length, within 4-6 tip cells) the
 psi = 30 row is 0.99 / 0.59 / 0.19 % and the least-squares order over the
 three meshes 1.20 (it was 0.84 with a fixed 4-cell radius), see
 ``test_slip_error_converges``.  The 3 % limit of the brief is the acceptance
