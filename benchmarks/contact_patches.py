@@ -24,94 +24,37 @@ from __future__ import annotations
 
 import argparse
 import logging
-import math
 import tempfile
 from pathlib import Path
 
-import h5py
 import numpy as np
 
 from xfemslip import closed_form as cf
-from xfemslip.case import load_case
-from xfemslip.simulation import run_case
-
-A, HALF, CENTER = 0.5, 1.0, (0.0123, -0.0077)
-STRESS, E, NU = (-20e6, -40e6, 0.0), 5e9, 0.3
+from xfemslip import verify as V
 
 
 def run(folder: Path, n, psi=30.0, friction=0.1, penalty=100.0, patch=None):
-    """Solve; return (relative L2 slip error or max|slip|, oscillation, iterations)."""
-    folder.mkdir(parents=True, exist_ok=True)
-    field = dict(
-        center=CENTER,
-        a=A,
-        E=E,
-        nu=NU,
-        plane="plane_strain",
-        stress=STRESS,
-        psi_deg=psi,
-        friction=friction,
-    )
-    k = np.linspace(-HALF, HALF, 8 * n + 1)
-    edges = {
-        "bottom": np.column_stack([k, np.full_like(k, -HALF)]),
-        "top": np.column_stack([k, np.full_like(k, HALF)]),
-        "left": np.column_stack([np.full_like(k, -HALF), k]),
-        "right": np.column_stack([np.full_like(k, HALF), k]),
-    }
-    for name, pts in edges.items():
-        vals = cf.displacement(pts, **field)
-        rows = "".join(
-            f"{x:.17g},{y:.17g},{u:.17g},{v:.17g}\n"
-            for (x, y), (u, v) in zip(pts, vals, strict=True)
-        )
-        (folder / f"{name}.csv").write_text("x,y,ux,uy\n" + rows)
-    t = (math.cos(math.radians(psi)), math.sin(math.radians(psi)))
-    p0 = [CENTER[0] - A * t[0], CENTER[1] - A * t[1]]
-    p1 = [CENTER[0] + A * t[0], CENTER[1] + A * t[1]]
-    kn = penalty * E / (2 * HALF / n)
-    solver = "" if patch is None else f"contact_patch = {patch!r}\n"
-    text = f"""
-[domain]
-size = [2.0, 2.0]
-origin = [-1.0, -1.0]
-[mesh]
-elements = [{n}, {n}]
-[material]
-E = {E!r}
-nu = {NU!r}
-model = "plane_strain"
-[[fractures]]
-points = [{p0!r}, {p1!r}]
-friction = {friction!r}
-kn = {kn!r}
-kt = {kn!r}
-[boundary]
-bottom = {{ file = "bottom.csv" }}
-top = {{ file = "top.csv" }}
-left = {{ file = "left.csv" }}
-right = {{ file = "right.csv" }}
-[solver]
-{solver}[output]
-formats = ["h5"]
-"""
-    case = folder / "case.toml"
-    case.write_text(text)
-    summary = run_case(load_case(case), folder / "out")
-    with h5py.File(folder / "out" / "result.h5") as h:
-        s, slip = h["fractures/0/s"][()], h["fractures/0/slip"][()]
-        pn = h["fractures/0/normal_traction"][()]
-        its = int(h.attrs["newton_iterations"])
-    exact = cf.slip_profile(s, A, E, NU, "plane_strain", STRESS, psi, friction)
-    inner = np.abs(s - A) < 0.9 * A
-    osc = float(np.max(np.abs(pn[inner] - pn[inner].mean())) / abs(pn[inner].mean()))
+    """Solve; return (relative L2 slip error or max|slip|, oscillation, iterations).
+
+    The case is ``xfemslip verify``'s (``verify.write_case``), with
+    ``[solver] contact_patch`` added when ``patch`` is given.
+    """
+    prob = V.Problem(f"psi{psi:g}-f{friction:g}", psi, friction=friction)
+    path = V.write_case(folder, n, prob, None, penalty)
+    if patch is not None:
+        path.write_text(path.read_text() + f"\n[solver]\ncontact_patch = {patch!r}\n")
+    solved = V.solve_case(path)
+    fa = V.fracture_arrays(solved)
+    s, slip = fa["s"], fa["slip"]
+    exact = cf.slip_profile(s, **V.profile_kwargs(prob))
     if np.any(exact):
         err = cf.relative_l2(s, slip, exact)
     else:
-        _, tau = cf.crack_tractions(STRESS, psi)
-        err = float(np.max(np.abs(slip)) / (4 * (1 - NU**2) / E * abs(tau) * A))
-    del summary
-    return err, osc, its
+        _, tau = cf.crack_tractions(V.STRESS, psi)
+        err = float(
+            np.max(np.abs(slip)) / (4 * (1 - V.NU**2) / V.E * abs(tau) * V.HALF_LENGTH)
+        )
+    return err, V.oscillation(s, fa["pn"]), solved.iterations
 
 
 def main() -> None:

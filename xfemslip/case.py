@@ -113,6 +113,7 @@ __all__ = [
     "describe",
     "load_case",
     "loads_case",
+    "read_text",
 ]
 
 
@@ -341,17 +342,21 @@ def load_case(path: str | Path) -> CaseSpec:
     each with its key path.
     """
     path = Path(path)
+    return loads_case(read_text(path, "case file"), path)
+
+
+def read_text(path: Path, what: str) -> str:
+    """The UTF-8 text of an input file; CaseError naming it if unreadable."""
     try:
-        text = path.read_text(encoding="utf-8")
+        return path.read_text(encoding="utf-8")
     except OSError as exc:
         raise CaseError(
-            path, [("", f"cannot read the case file: {exc.strerror or exc}")]
+            path, [("", f"cannot read the {what}: {exc.strerror or exc}")]
         ) from None
     except UnicodeDecodeError as exc:
         raise CaseError(
             path, [("", f"not a UTF-8 text file: {exc.reason} at byte {exc.start}")]
         ) from None
-    return loads_case(text, path)
 
 
 def loads_case(text: str, path: str | Path = "<string>") -> CaseSpec:

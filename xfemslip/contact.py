@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import logging
 from dataclasses import dataclass, field
+from functools import cached_property
 
 import numpy as np
 
@@ -33,6 +34,8 @@ class ContactResult:
     ... ``slip_plastic`` and ``blocks`` are per patch; ``point_*`` are the same
     quantities at every interface point (jumps evaluated at the point itself,
     tractions and state those of its patch), which is what the output reports.
+    They are computed on first access only, so Newton iterations and line-search
+    trials do not pay for them.
     """
 
     force: np.ndarray  # (n_dofs,) contact internal force [N/m]
@@ -43,11 +46,35 @@ class ContactResult:
     pt: np.ndarray  # (m,) [Pa]
     state: np.ndarray  # (m,) int8
     slip_plastic: np.ndarray  # (m,) [m]
-    point_gn: np.ndarray = None  # (n,) [m]
-    point_gt: np.ndarray = None  # (n,) [m]
-    point_pn: np.ndarray = None  # (n,) [Pa]
-    point_pt: np.ndarray = None  # (n,) [Pa]
-    point_state: np.ndarray = None  # (n,) int8
+    # the displacement it was evaluated at (a reference, not a copy: the solver
+    # never changes an array in place once it has been evaluated)
+    u: np.ndarray = field(repr=False, default=None)  # (n_dofs,) [m]
+    contact: ContactSet = field(repr=False, default=None)
+
+    @cached_property
+    def _point_jump(self) -> np.ndarray:
+        c = self.contact
+        return _point_jumps(self.u, c.point_dofs, c.point_coef)
+
+    @property
+    def point_gn(self) -> np.ndarray:  # (n,) [m]
+        return np.einsum("nk,nk->n", self._point_jump, self.contact.point_normal)
+
+    @property
+    def point_gt(self) -> np.ndarray:  # (n,) [m]
+        return np.einsum("nk,nk->n", self._point_jump, self.contact.point_tangent)
+
+    @property
+    def point_pn(self) -> np.ndarray:  # (n,) [Pa]
+        return self.pn[self.contact.patch]
+
+    @property
+    def point_pt(self) -> np.ndarray:  # (n,) [Pa]
+        return self.pt[self.contact.patch]
+
+    @property
+    def point_state(self) -> np.ndarray:  # (n,) int8
+        return self.state[self.contact.patch]
 
 
 @dataclass
@@ -64,12 +91,12 @@ class ContactSet:
     ``[solver] contact_patch = 0`` every interface point is its own patch.
     """
 
-    dofs: np.ndarray  # (m, 2J) int64
-    coef: np.ndarray  # (n, J)
-    normal: np.ndarray  # (n, 2)
-    tangent: np.ndarray  # (n, 2)
-    weight: np.ndarray  # (n,) [m]
-    pn0: np.ndarray  # (n,) in-situ normal traction [Pa]
+    dofs: np.ndarray  # (m, 2J) int64, m patches
+    coef: np.ndarray  # (m, J)
+    normal: np.ndarray  # (m, 2)
+    tangent: np.ndarray  # (m, 2)
+    weight: np.ndarray  # (m,) patch length [m]
+    pn0: np.ndarray  # (m,) in-situ normal traction [Pa]
     kn: np.ndarray
     kt: np.ndarray
     friction: np.ndarray
@@ -82,7 +109,7 @@ class ContactSet:
     point_normal: np.ndarray = field(default=None)  # (n, 2)
     point_tangent: np.ndarray = field(default=None)  # (n, 2)
     slip_committed: np.ndarray = field(default=None)  # (m,) [m]
-    state_committed: np.ndarray = field(default=None)  # (n,) int8
+    state_committed: np.ndarray = field(default=None)  # (m,) int8
     gt_committed: np.ndarray = field(default=None)
     pt_committed: np.ndarray = field(default=None)
 
@@ -123,8 +150,6 @@ class ContactSet:
             state,
             slip,
         )
-        jump = _point_jumps(u, self.point_dofs, self.point_coef)
-        p = self.patch
         return ContactResult(
             force=scatter_vector(self.dofs, out_f, self.n_dofs),
             blocks=out_K,
@@ -134,11 +159,8 @@ class ContactSet:
             pt=pt,
             state=state,
             slip_plastic=slip,
-            point_gn=np.einsum("nk,nk->n", jump, self.point_normal),
-            point_gt=np.einsum("nk,nk->n", jump, self.point_tangent),
-            point_pn=pn[p],
-            point_pt=pt[p],
-            point_state=state[p],
+            u=u,
+            contact=self,
         )
 
     def tangent_matrix(self, result: ContactResult):
@@ -160,6 +182,12 @@ def _point_jumps(u, dofs, coef) -> np.ndarray:
     return np.column_stack([(coef * ux).sum(axis=1), (coef * uy).sum(axis=1)])
 
 
+def _cell_size(mesh, cells) -> np.ndarray:
+    """sqrt of the area of each cell [m]: the local h of patches and penalty."""
+    b = mesh.bounds[cells]
+    return np.sqrt((b[:, 1] - b[:, 0]) * (b[:, 3] - b[:, 2]))
+
+
 def contact_patches(mesh, fractures, ip, length_cells: float) -> np.ndarray:
     """Patch index (n,) of every interface point.
 
@@ -173,8 +201,7 @@ def contact_patches(mesh, fractures, ip, length_cells: float) -> np.ndarray:
     n = ip.n
     if n == 0 or length_cells <= 0.0:
         return np.arange(n, dtype=np.int64)
-    b = mesh.bounds[ip.cell]
-    size = np.sqrt((b[:, 1] - b[:, 0]) * (b[:, 3] - b[:, 2]))
+    size = _cell_size(mesh, ip.cell)
     seg = np.zeros(n, np.int64)
     for fi, fr in enumerate(fractures):
         m = ip.fracture == fi
@@ -228,11 +255,10 @@ def _patch_operators(patch, weight, coef, dofs):
     val = (coef * (weight / W[patch])[:, None]).ravel()
     keep = xdof >= 0
     rows, xdof, val = rows[keep], xdof[keep], val[keep]
-    key = rows * (int(xdof.max()) + 1) + xdof
-    uniq, inv = np.unique(key, return_inverse=True)
+    stride = int(xdof.max()) + 1
+    uniq, inv = np.unique(rows * stride + xdof, return_inverse=True)
     vsum = np.bincount(inv, weights=val)
-    urow = uniq // (int(xdof.max()) + 1)
-    udof = uniq % (int(xdof.max()) + 1)
+    urow, udof = np.divmod(uniq, stride)
     count = np.bincount(urow, minlength=m)
     Jm = int(count.max())
     start = np.concatenate([[0], np.cumsum(count)[:-1]])
@@ -307,33 +333,25 @@ def build_contact(
     patch = contact_patches(mesh, fractures, ip, patch_cells)
     p_coef, p_dofs, W = _patch_operators(patch, ip.weight, coef, dofs)
     n = W.size
-    first = np.zeros(n, np.int64)
-    first[patch[::-1]] = np.arange(ip.n)[::-1]  # one point of each patch
+    _, first = np.unique(patch, return_index=True)  # one point of each patch
     frac = ip.fracture[first]
     normal = np.ascontiguousarray(ip.normal[first])
     tangent = np.ascontiguousarray(ip.tangent[first])
     par = {
-        name: np.array(
-            [_or_nan(getattr(fractures[f], name)) for f in frac],
-            dtype=float,
-        )
+        name: np.array([_or_nan(getattr(fractures[f], name)) for f in frac], float)
         for name in ("kn", "kt", "friction", "cohesion")
     }
-    if n:
-        b = mesh.bounds[ip.cell]
-        size = np.sqrt((b[:, 1] - b[:, 0]) * (b[:, 3] - b[:, 2]))
-        h = np.bincount(patch, weights=ip.weight * size) / W  # mean over the patch
-        for name in ("kn", "kt"):
-            auto = np.isnan(par[name])
-            if auto.any():
-                if E is None:
-                    raise ValueError("automatic penalty needs E")
-                par[name][auto] = AUTO_PENALTY * E / h[auto]
-    if n == 0:
-        par = {name: np.zeros(0) for name in ("kn", "kt", "friction", "cohesion")}
+    # mean cell size over each patch, for the automatic penalty
+    h = np.bincount(patch, weights=ip.weight * _cell_size(mesh, ip.cell)) / W
+    for name in ("kn", "kt"):
+        auto = np.isnan(par[name])
+        if auto.any():
+            if E is None:
+                raise ValueError("automatic penalty needs E")
+            par[name][auto] = AUTO_PENALTY * E / h[auto]
     pn0 = np.zeros(n)
     slip0 = np.zeros(n)
-    if initial_stress is not None and n:
+    if initial_stress is not None:
         sxx, syy, sxy = initial_stress
         sig = np.array([[sxx, sxy], [sxy, syy]])
         trac = normal @ sig
@@ -359,5 +377,5 @@ def build_contact(
     cs.slip_committed = slip0
     cs.state_committed = np.full(n, STICK, np.int8)
     cs.gt_committed = np.zeros(n)
-    cs.pt_committed = -par["kt"] * slip0 if n else np.zeros(0)
+    cs.pt_committed = -par["kt"] * slip0
     return cs

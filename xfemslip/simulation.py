@@ -150,6 +150,19 @@ def build_model(spec) -> Model:
     )
 
 
+def newton_solver(model: Model) -> NewtonSolver:
+    """The Newton solver of a model, with the options of its [solver] table."""
+    opt = model.spec.solver
+    return NewtonSolver(
+        model.problem,
+        opt.tolerance,
+        opt.max_iterations,
+        opt.tangent,
+        opt.linear_solver,
+        max_step_cuts=opt.max_step_cuts,
+    )
+
+
 def floating_parts(mesh, fractures, contact, bc):
     """Fractures cutting the domain in two, one part without prescribed dofs."""
     std = bc.dofs[bc.dofs < 2 * mesh.n_nodes]  # enrichment dofs are not nodes
@@ -211,14 +224,7 @@ def run_case(
     out_dir = Path(out_dir) if out_dir is not None else Path(spec.output.directory)
     _check_out_dir(out_dir, overwrite)
     model = build_model(spec)
-    solver = NewtonSolver(
-        model.problem,
-        spec.solver.tolerance,
-        spec.solver.max_iterations,
-        spec.solver.tangent,
-        spec.solver.linear_solver,
-        max_step_cuts=spec.solver.max_step_cuts,
-    )
+    solver = newton_solver(model)
     failure = None
     try:
         solver.run(spec.loading.steps)

@@ -44,7 +44,7 @@ from pathlib import Path
 
 import tomli_w
 
-from xfemslip.case import loads_case
+from xfemslip.case import loads_case, read_text
 from xfemslip.case_tables import _show, _Table
 from xfemslip.errors import CaseError, GeometryError, MeshError
 from xfemslip.sweep_vary import (
@@ -268,12 +268,4 @@ def _generate(base, base_name, case_path, combos, problems) -> list[SweepCase]:
 def load_sweep(path: str | Path) -> SweepSpec:
     """Read and validate a sweep file; see the module docstring."""
     path = Path(path)
-    try:
-        text = path.read_text(encoding="utf-8")
-    except OSError as exc:
-        raise CaseError(
-            path, [("", f"cannot read the sweep file: {exc.strerror or exc}")]
-        ) from None
-    except UnicodeDecodeError as exc:
-        raise CaseError(path, [("", f"not a UTF-8 text file: {exc.reason}")]) from None
-    return loads_sweep(text, path)
+    return loads_sweep(read_text(path, "sweep file"), path)

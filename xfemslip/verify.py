@@ -42,8 +42,7 @@ from xfemslip import closed_form as cf
 from xfemslip.case import load_case
 from xfemslip.jintegral import stress_intensity_factors
 from xfemslip.post import fracture_fields
-from xfemslip.simulation import build_model
-from xfemslip.solver import NewtonSolver
+from xfemslip.simulation import build_model, newton_solver
 
 logger = logging.getLogger(__name__)
 
@@ -212,13 +211,7 @@ def solve_case(path: Path) -> Solved:
     start = time.perf_counter()
     spec = load_case(path)
     model = build_model(spec)
-    solver = NewtonSolver(
-        model.problem,
-        spec.solver.tolerance,
-        spec.solver.max_iterations,
-        spec.solver.tangent,
-    )
-    results = solver.run(spec.loading.steps)
+    results = newton_solver(model).run(spec.loading.steps)
     wall = time.perf_counter() - start
     last = results[-1]
     return Solved(
@@ -279,7 +272,7 @@ def measure(solved: Solved, prob: Problem, a_over_h: int) -> Row:
     if prob.kind == "stick":
         # scale: the frictionless crack at this angle
         free = replace(prob, friction=0.0, cohesion=0.0)
-        scale_slip = np.max(np.abs(cf.slip_profile(fa["s"], **_profile_kw(free))))
+        scale_slip = np.max(np.abs(cf.slip_profile(fa["s"], **profile_kwargs(free))))
         scale_k = abs(cf.k_ii(STRESS, prob.psi, HALF_LENGTH, 0.0, 0.0))
         row.slip_error = float(np.max(np.abs(fa["slip"])) / scale_slip)
         row.kii_error = float(np.max(np.abs(k_ii)) / scale_k)
@@ -297,17 +290,11 @@ def measure(solved: Solved, prob: Problem, a_over_h: int) -> Row:
     return row
 
 
-def _profile_kw(prob: Problem) -> dict:
-    return dict(
-        a=HALF_LENGTH,
-        E=E,
-        nu=NU,
-        plane=prob.plane,
-        stress=STRESS,
-        psi_deg=prob.psi,
-        friction=prob.friction,
-        cohesion=prob.cohesion,
-    )
+def profile_kwargs(prob: Problem) -> dict:
+    """The keywords of closed_form.slip_profile: those of the field, no centre."""
+    kw = exact_kwargs(prob)
+    del kw["center"]
+    return kw
 
 
 def run_problem(
