@@ -126,8 +126,9 @@ def dislocation_shear(y, s, slip, nu, shear_modulus) -> np.ndarray:
     """sigma_xy(0, y) [Pa] of a piecewise-linear slip (s, slip) on x = 0.
 
     sigma = -mu / (2 pi (1 - nu)) PV int delta'(s) / (s - y) ds, delta =
-    u_y(left) - u_y(right), with delta' constant on each piece, integrated exactly: int_{s0}^{s1} ds / (s - y) =
-    ln|s1 - y| - ln|s0 - y| (the principal value at y inside a piece).  The
+    u_y(left) - u_y(right), with delta' constant on each piece, integrated
+    exactly: int_{s0}^{s1} ds / (s - y) = ln|s1 - y| - ln|s0 - y| (the
+    principal value at y inside a piece).  The
     independent check of (J2): it must cancel (J1).
     """
     y = np.asarray(y, float)

@@ -231,3 +231,25 @@ def test_deplete_writes_tables_and_fields(runner, tmp_path):
         assert f["fractures/0/fluid_pressure"].attrs["units"] == "Pa"
     again = runner.invoke(cli, ["deplete", str(case), "-o", str(out), "-q"])
     assert again.exit_code == 2  # output exists, no --overwrite
+
+
+def test_plots_and_screen_use_the_effective_stress(runner, tmp_path):
+    """The Mohr figure reads the effective normal traction, and ``screen``
+    defaults to the case's far-field pore pressure (region "all": p0 + dp)."""
+    from xfemslip.plot_data import read_result
+
+    extra = FRACTURE + PORE.replace('region = "reservoir"', 'region = "all"')
+    case = tmp_path / "all.toml"
+    case.write_text(BASE.format(extra=extra))
+    out = tmp_path / "out"
+    assert runner.invoke(cli, ["run", str(case), "-o", str(out), "-q"]).exit_code == 0
+    data = read_result(out / "result.h5")
+    assert data.pore_pressure == 10.0e6
+    with h5py.File(out / "result.h5", "r") as f:
+        eff = f["fractures/0/effective_normal_traction"][()]
+    np.testing.assert_array_equal(data.fractures[0].normal_traction, eff)
+    default = runner.invoke(cli, ["screen", str(case)])
+    given = runner.invoke(cli, ["screen", str(case), "-p", "10.0e6"])
+    assert default.exit_code == 0, default.output
+    assert "pore pressure p = 1e+07" in default.output
+    assert default.output == given.output
