@@ -34,7 +34,7 @@ from pathlib import Path
 import numpy as np
 
 from xfemslip.contact import SLIP
-from xfemslip.errors import UsageError
+from xfemslip.errors import ConvergenceError, UsageError
 from xfemslip.simulation import (
     _check_out_dir,
     build_model,
@@ -164,7 +164,6 @@ def critical_depletion(solver, model, steps, tolerance):
     pn0, pt0 = contact.pn0.copy(), contact.pt_committed.copy()
     u = np.zeros(model.problem.n_dofs)
     lam0 = 0.0
-    any_slip_before = False
     prev_res = None
     for k in range(1, steps + 1):
         lam1 = k / steps
@@ -184,16 +183,27 @@ def critical_depletion(solver, model, steps, tolerance):
             pn_lo, pt_lo = _bisect(
                 solver, contact, onsets[fi], fi, bracket, tolerance, centres, change
             )
-            if not any_slip_before:
-                lam_lo = onsets[fi].dp_lower / change if change else 0.0
-                onsets[fi].dp_linear = change * _linear_onset(
-                    contact, fi, pn0, pt0, lam_lo, pn_lo, pt_lo
-                )
+            lam_lo = onsets[fi].dp_lower / change if change else 0.0
+            onsets[fi].dp_linear = change * _linear_onset(
+                contact, fi, pn0, pt0, lam_lo, pn_lo, pt_lo
+            )
         _restore(contact, after)
-        any_slip_before = any_slip_before or any(found)
         prev_res = res
         lam0 = lam1
+    _drop_nonlinear(onsets)
     return onsets, solver.completed
+
+
+def _drop_nonlinear(onsets) -> None:
+    """The linear extrapolation holds only while everything sticks: NaN for a
+    fracture whose stuck lower bracket lies beyond another fracture's onset."""
+    for b in onsets:
+        if any(
+            a is not b and abs(a.dp_upper) <= abs(b.dp_lower)
+            for a in onsets
+            if np.isfinite(a.dp_upper)
+        ):
+            b.dp_linear = np.nan
 
 
 @dataclass
@@ -209,20 +219,35 @@ class _Bracket:
     res0: object  # contact result at lam0 (None at the initial state)
 
 
+def _trial(solver, contact, bracket, lam):
+    """Contact result at load factor lam from the bracket's committed state.
+
+    One Newton solve from lam0 (nothing committed); if it fails, the
+    solver's step cutting from lam0 to lam (its sub-steps commit, so the
+    history is restored afterwards and the step it records is dropped).
+    """
+    _restore(contact, bracket.history)
+    try:
+        return solver._newton(bracket.u, lam, bracket.step, bracket.steps)[1]
+    except ConvergenceError:
+        logger.info("bisection trial at load factor %.6g: cutting the step", lam)
+        _restore(contact, bracket.history)
+        solver._advance(bracket.u, bracket.lam0, lam, bracket.step, bracket.steps)
+        return solver.completed.pop().contact
+
+
 def _bisect(solver, contact, onset, fi, bracket, tolerance, centres, change):
     """Bracket the first slip of fracture fi in (lam0, lam1] (see module doc).
 
     Returns the patch tractions (p_N, p_T) at the stuck lower bracket.
     """
     lo, hi = bracket.lam0, bracket.lam1
-    k, steps = bracket.step, bracket.steps
     hi_res = solver.completed[-1].contact
     lo_res = bracket.res0
     width = tolerance / abs(change) if change else 0.0
     while hi - lo > width:
         mid = 0.5 * (lo + hi)
-        _restore(contact, bracket.history)
-        _, res, _ = solver._newton(bracket.u, mid, k, steps)
+        res = _trial(solver, contact, bracket, mid)
         onset.trials += 1
         if _slipping(contact, res, fi).any():
             hi, hi_res = mid, res

@@ -253,3 +253,33 @@ def test_plots_and_screen_use_the_effective_stress(runner, tmp_path):
     assert default.exit_code == 0, default.output
     assert "pore pressure p = 1e+07" in default.output
     assert default.output == given.output
+
+
+def test_bisection_trial_falls_back_to_step_cutting(monkeypatch):
+    """A bisection trial whose Newton solve fails is redone by the solver's
+    step cutting from the committed state: same bracket, history untouched."""
+    from xfemslip.depletion import critical_depletion
+    from xfemslip.errors import ConvergenceError
+    from xfemslip.simulation import newton_solver
+
+    def run(fail_call):
+        model = build_model(loads_case(BASE.format(extra=FRACTURE + PORE), "p.toml"))
+        solver = newton_solver(model)
+        real, calls = solver._newton, []
+
+        def newton(*args):
+            calls.append(args)
+            if len(calls) == fail_call:
+                raise ConvergenceError("forced", step=2, iteration=0, residual=1.0)
+            return real(*args)
+
+        monkeypatch.setattr(solver, "_newton", newton)
+        onsets, results = critical_depletion(solver, model, 2, 1.0e4)
+        return onsets[0], results, model.contact, len(calls)
+
+    plain, res_plain, c_plain, n_plain = run(fail_call=0)
+    cut, res_cut, c_cut, n_cut = run(fail_call=3)  # steps 1, 2, then trial 1
+    assert n_cut == n_plain + 1
+    assert (cut.dp_lower, cut.dp_upper) == (plain.dp_lower, plain.dp_upper)
+    assert len(res_cut) == len(res_plain) == 2
+    np.testing.assert_array_equal(c_cut.slip_committed, c_plain.slip_committed)
