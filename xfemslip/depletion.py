@@ -153,12 +153,25 @@ def critical_depletion(solver, model, steps, tolerance):
     """Run the steps with bisection of every fracture's first slip.
 
     Returns (onsets, results).  ``tolerance`` [Pa] is the final bracket width
-    in pore pressure.
+    in pore pressure.  A ConvergenceError carries the onsets found so far as
+    its ``onsets`` attribute.
     """
+    onsets = [FractureOnset(fracture=fr.index) for fr in model.fractures]
+    try:
+        _step_and_bisect(solver, model, steps, tolerance, onsets)
+    except ConvergenceError as exc:
+        _drop_nonlinear(onsets)
+        exc.onsets = onsets
+        raise
+    _drop_nonlinear(onsets)
+    return onsets, solver.completed
+
+
+def _step_and_bisect(solver, model, steps, tolerance, onsets) -> None:
+    """The loop of critical_depletion: fills ``onsets`` in place."""
     change = model.pore.change
     contact = model.contact
     n_frac = len(model.fractures)
-    onsets = [FractureOnset(fracture=fr.index) for fr in model.fractures]
     found = [False] * n_frac
     centres = _patch_centres(model)
     pn0, pt0 = contact.pn0.copy(), contact.pt_committed.copy()
@@ -190,8 +203,6 @@ def critical_depletion(solver, model, steps, tolerance):
         _restore(contact, after)
         prev_res = res
         lam0 = lam1
-    _drop_nonlinear(onsets)
-    return onsets, solver.completed
 
 
 def _drop_nonlinear(onsets) -> None:
@@ -299,13 +310,19 @@ def deplete(spec, out_dir=None, *, tolerance=None, plot=False, overwrite=False):
     _check_out_dir(out_dir, overwrite)
     model = build_model(spec)
     solver = newton_solver(model)
-    onsets, results = critical_depletion(solver, model, spec.loading.steps, tolerance)
+    failure = None
+    try:
+        onsets, results = critical_depletion(
+            solver, model, spec.loading.steps, tolerance
+        )
+    except ConvergenceError as exc:  # keep what converged, as `run` does
+        failure, onsets, results = exc, exc.onsets, solver.completed
     iters = [r.iterations for r in results]
     write_output(
         model,
         results,
         out_dir,
-        converged=True,
+        converged=failure is None,
         wall=time.perf_counter() - start,
         iterations=iters,
     )
@@ -320,8 +337,11 @@ def deplete(spec, out_dir=None, *, tolerance=None, plot=False, overwrite=False):
         from xfemslip.plot_depletion import plot_field, plot_slip_vs_depletion
 
         report.written.append(plot_slip_vs_depletion(report, out_dir))
-        report.written.append(plot_field(model, results[-1], out_dir))
+        if results:
+            report.written.append(plot_field(model, results[-1], out_dir))
     report.wall_time_s = time.perf_counter() - start
+    if failure is not None:
+        raise failure
     return report
 
 

@@ -283,3 +283,35 @@ def test_bisection_trial_falls_back_to_step_cutting(monkeypatch):
     assert (cut.dp_lower, cut.dp_upper) == (plain.dp_lower, plain.dp_upper)
     assert len(res_cut) == len(res_plain) == 2
     np.testing.assert_array_equal(c_cut.slip_committed, c_plain.slip_committed)
+
+
+def test_deplete_failure_keeps_the_converged_steps(runner, tmp_path, monkeypatch):
+    """A load step that fails: exit 1, result.h5 of the converged steps with
+    converged = false, and the tables written (like `run`)."""
+    from xfemslip import solver as solver_module
+    from xfemslip.errors import ConvergenceError
+
+    real = solver_module.NewtonSolver._newton
+
+    def newton(self, u, lam, k, steps):
+        if k == 2:
+            raise ConvergenceError(
+                "load step 2 did not converge: forced",
+                step=2,
+                iteration=3,
+                residual=1.0,
+            )
+        return real(self, u, lam, k, steps)
+
+    monkeypatch.setattr(solver_module.NewtonSolver, "_newton", newton)
+    case = tmp_path / "dep.toml"
+    case.write_text(BASE.format(extra=FRACTURE + PORE))
+    out = tmp_path / "out"
+    result = runner.invoke(cli, ["deplete", str(case), "-o", str(out), "-q"])
+    assert result.exit_code == 1
+    assert "load step 2 did not converge" in result.stderr
+    with h5py.File(out / "result.h5", "r") as f:
+        assert not bool(f.attrs["converged"])
+        assert "fields/pore_pressure" in f
+    rows = list(csv.DictReader((out / "slip_vs_depletion.csv").open()))
+    assert [float(r["dp_Pa"]) for r in rows] == [0.0, -10.0e6]
