@@ -48,7 +48,8 @@ the fluid pressure -p_f n; its change is the load on the enriched dofs
 (fluid pressure pushes the faces apart: dp_f > 0 opens).  With alpha = 1 and
 a uniform dp, (1) and (2) cancel on Gamma by the divergence theorem: a
 fracture whose fluid has the surrounding pressure does not perturb a uniform
-depletion (checked in tests/unit/test_poro.py).
+depletion up to the penalty compliance (checked in
+tests/verification/test_depletion.py).
 
 Material regions.  A cell belongs to the reservoir when its centre lies in one
 of the ``[reservoir]`` boxes; its stiffness (intact and enriched cells alike),

@@ -105,7 +105,7 @@ def test_slip_releases_energy():
         tau = offset_fault_shear(y, A, B, C, D, dp, NU)
         slip = offset_fault_slip(y, A, B, C, D, dp, NU, MU)
         ok = np.isfinite(tau)
-        released = -0.5 * np.trapezoid(tau[ok] * slip[ok], y[ok])
+        released = -0.5 * integrate.trapezoid(tau[ok] * slip[ok], y[ok])
         assert released > 0.0
 
 
