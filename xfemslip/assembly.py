@@ -41,27 +41,41 @@ def std_cell_dofs(cells: np.ndarray) -> np.ndarray:
     return np.stack([2 * cells, 2 * cells + 1], axis=2).reshape(cells.shape[0], 8)
 
 
-def _rect_stiffness_shared(hx, hy, D):
-    """Stiffness (m, 8, 8) computed once per distinct rectangle size."""
-    sizes = np.round(np.column_stack([hx, hy]), 15)
-    uniq, inverse = np.unique(sizes, axis=0, return_inverse=True)
-    K_u = kernels.rectangle_stiffness(
-        np.ascontiguousarray(uniq[:, 0]), np.ascontiguousarray(uniq[:, 1]), D
-    )
+def _rect_stiffness_shared(hx, hy, D, material=None):
+    """Stiffness (m, 8, 8) computed once per distinct (rectangle size, material).
+
+    D : (3, 3), or (k, 3, 3) with ``material`` (m,) the index of each cell's D.
+    """
+    D = np.asarray(D, float).reshape(-1, 3, 3)
+    if material is None:
+        material = np.zeros(hx.size, np.int64)
+    key = np.column_stack([np.round(np.column_stack([hx, hy]), 15), material])
+    uniq, inverse = np.unique(key, axis=0, return_inverse=True)
+    K_u = np.zeros((uniq.shape[0], 8, 8))
+    for k in range(D.shape[0]):
+        rows = np.nonzero(uniq[:, 2] == k)[0]
+        if rows.size:
+            K_u[rows] = kernels.rectangle_stiffness(
+                np.ascontiguousarray(uniq[rows, 0]),
+                np.ascontiguousarray(uniq[rows, 1]),
+                np.ascontiguousarray(D[k]),
+            )
     return K_u, inverse.ravel()
 
 
-def assemble_bulk(mesh, D, cand: Candidates, ec: EnrichedCells, ip=None) -> BulkSystem:
-    """Assemble the bulk stiffness and choose the kept enrichments (sliver rule)."""
-    is_enr = np.zeros(mesh.n_cells, bool)
-    is_enr[ec.cells] = True
-    std_cells = np.nonzero(~is_enr)[0]
-    b = mesh.bounds[std_cells]
-    K_u, which = _rect_stiffness_shared(b[:, 1] - b[:, 0], b[:, 3] - b[:, 2], D)
-    std_dofs = std_cell_dofs(mesh.cells[std_cells])
+def _enriched_matrices(mesh, ec, D, material):
+    """K_e, Bbar of the enriched cells, each with its own material's D.
 
-    if ec.cells.size:
-        K_e, Bbar = kernels.enriched_cell_matrices(
+    With several materials every material's matrices are computed for all
+    enriched cells and each cell keeps its own (the enriched cells are few).
+    """
+    D = np.asarray(D, float).reshape(-1, 3, 3)
+    out = None
+    for k in range(D.shape[0]):
+        mine = np.ones(ec.cells.size, bool) if material is None else material == k
+        if not mine.any():
+            continue
+        K_k, B_k = kernels.enriched_cell_matrices(
             np.ascontiguousarray(mesh.bounds[ec.cells]),
             ec.qp_offsets,
             ec.qp_xy,
@@ -70,7 +84,36 @@ def assemble_bulk(mesh, D, cand: Candidates, ec: EnrichedCells, ip=None) -> Bulk
             ec.qp_gradF,
             ec.slot_node,
             ec.slot_fnode,
-            np.ascontiguousarray(D),
+            np.ascontiguousarray(D[k]),
+        )
+        if out is None:
+            out = (K_k, B_k)
+        else:
+            out[0][mine] = K_k[mine]
+    return out
+
+
+def assemble_bulk(
+    mesh, D, cand: Candidates, ec: EnrichedCells, ip=None, cell_material=None
+) -> BulkSystem:
+    """Assemble the bulk stiffness and choose the kept enrichments (sliver rule).
+
+    D : (3, 3) [Pa] for one material, or (k, 3, 3) with ``cell_material``
+    (n_cells,) int64 the material index of every cell (xfemslip.poro).
+    """
+    is_enr = np.zeros(mesh.n_cells, bool)
+    is_enr[ec.cells] = True
+    std_cells = np.nonzero(~is_enr)[0]
+    b = mesh.bounds[std_cells]
+    mat_std = None if cell_material is None else cell_material[std_cells]
+    K_u, which = _rect_stiffness_shared(
+        b[:, 1] - b[:, 0], b[:, 3] - b[:, 2], D, mat_std
+    )
+    std_dofs = std_cell_dofs(mesh.cells[std_cells])
+
+    if ec.cells.size:
+        K_e, Bbar = _enriched_matrices(
+            mesh, ec, D, None if cell_material is None else cell_material[ec.cells]
         )
     else:
         K_e = np.zeros((0, 8, 8))

@@ -57,6 +57,13 @@ from xfemslip.case_grid import (
     MAX_ELEMENTS,
     _read_grid,
 )
+from xfemslip.case_pore import (
+    PORE_PRESSURE_KEYS,
+    PORE_PRESSURE_REGIONS,
+    RESERVOIR_KEYS,
+    _read_pore_pressure,
+    _read_reservoir,
+)
 from xfemslip.case_specs import (
     CONTACT_PATCH_CELLS,
     EDGES,
@@ -68,6 +75,8 @@ from xfemslip.case_specs import (
     MaterialSpec,
     MeshSpec,
     OutputSpec,
+    PorePressureSpec,
+    ReservoirSpec,
     SolverSpec,
 )
 from xfemslip.case_tables import (
@@ -94,6 +103,9 @@ __all__ = [
     "MAX_ELEMENTS",
     "MAX_STEPS",
     "OUTPUT_FORMATS",
+    "PORE_PRESSURE_KEYS",
+    "PORE_PRESSURE_REGIONS",
+    "RESERVOIR_KEYS",
     "SOLVER_OPTIONS",
     "STRESS_KEYS",
     "TIP_KEYS",
@@ -108,7 +120,9 @@ __all__ = [
     "MeshSpec",
     "Option",
     "OutputSpec",
+    "PorePressureSpec",
     "Range",
+    "ReservoirSpec",
     "SolverSpec",
     "describe",
     "load_case",
@@ -134,6 +148,8 @@ TOP_KEYS = (
     "boundary",
     "solver",
     "output",
+    "pore_pressure",
+    "reservoir",
 )
 STRESS_KEYS = ("xx", "yy", "xy")
 MATERIAL_MODELS = ("plane_strain", "plane_stress")
@@ -377,6 +393,8 @@ def loads_case(text: str, path: str | Path = "<string>") -> CaseSpec:
     loading = _read_loading(root, needs_stress)
     solver = _read_solver(root)
     output = _read_output(root, name)
+    pore_pressure = _read_pore_pressure(root)
+    reservoir = _read_reservoir(root, grid)
     if problems:
         raise CaseError(path, problems)
     return CaseSpec(
@@ -392,4 +410,6 @@ def loads_case(text: str, path: str | Path = "<string>") -> CaseSpec:
         boundary=boundary,
         solver=solver,
         output=output,
+        pore_pressure=pore_pressure,
+        reservoir=reservoir,
     )

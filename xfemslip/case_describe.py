@@ -110,6 +110,30 @@ def _describe_stress(stress: tuple[float, float, float] | None) -> str:
     return f"(xx, yy, xy) = ({values}) {LoadingSpec.UNITS['stress']}"
 
 
+def _describe_pore(spec: CaseSpec) -> list[str]:
+    """[pore_pressure] and [reservoir] lines (none when absent)."""
+    lines = []
+    p = spec.pore_pressure
+    if p is not None:
+        where = "the reservoir" if p.region == "reservoir" else "the whole model"
+        lines.append(
+            f"pore pressure: initial {_fmt(p.initial)} Pa, change {_fmt(p.change)} Pa "
+            f"over the load steps (< 0 = depletion), Biot coefficient "
+            f"{_fmt(p.biot)}, acting in {where}; "
+            "effective stress in the bulk (Biot) and on the fractures (Terzaghi)"
+        )
+    r = spec.reservoir
+    if r is not None:
+        boxes = "; ".join(
+            "[" + ", ".join(_fmt(float(v)) for v in b) + "]" for b in r.boxes
+        )
+        lines.append(
+            f"reservoir: E = {_fmt(r.E)} Pa, nu = {_fmt(r.nu)} in box(es) "
+            f"{boxes} m (cells whose centre is inside); [material] is the host rock"
+        )
+    return lines
+
+
 def describe(spec: CaseSpec) -> str:
     """Human-readable summary of a resolved case (SI units, tension positive).
 
@@ -142,6 +166,7 @@ def describe(spec: CaseSpec) -> str:
         "boundary:",
     ]
     lines += [_describe_edge(e, getattr(spec.boundary, e)) for e in EDGES]
+    lines += _describe_pore(spec)
     lines.append("solver:")
     for option in SOLVER_OPTIONS:
         value = getattr(spec.solver, option.name)

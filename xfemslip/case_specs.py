@@ -135,6 +135,41 @@ class OutputSpec:
 
 
 @dataclass(frozen=True, kw_only=True)
+class PorePressureSpec:
+    """[pore_pressure]: initial pore pressure and its change (depletion < 0).
+
+    The change ``change`` [Pa] is applied proportionally over the load steps
+    (``loading.steps``), in the whole model (``region = "all"``) or inside the
+    ``[reservoir]`` only (``region = "reservoir"``).
+    """
+
+    initial: float  # p0 [Pa]
+    change: float  # final dp [Pa]; < 0 = depletion
+    biot: float  # alpha, 0 < alpha <= 1 [-]
+    region: str  # "all" | "reservoir"
+    UNITS: ClassVar[dict[str, str]] = {
+        "initial": "Pa",
+        "change": "Pa",
+        "biot": "-",
+        "region": "",
+    }
+
+
+@dataclass(frozen=True, kw_only=True)
+class ReservoirSpec:
+    """[reservoir]: a region of boxes with its own elastic constants.
+
+    ``boxes`` (k, 4) float64 [x0, y0, x1, y1] [m]; a cell belongs to the
+    reservoir when its centre lies in one of the boxes.
+    """
+
+    boxes: np.ndarray  # (k, 4) float64 [m]
+    E: float  # [Pa]
+    nu: float  # [-]
+    UNITS: ClassVar[dict[str, str]] = {"boxes": "m", "E": "Pa", "nu": "-"}
+
+
+@dataclass(frozen=True, kw_only=True)
 class CaseSpec:
     path: Path  # the case file
     text: str  # the case file's text as read
@@ -148,3 +183,5 @@ class CaseSpec:
     boundary: BoundarySpec
     solver: SolverSpec
     output: OutputSpec
+    pore_pressure: PorePressureSpec | None = None  # None: no pore pressure
+    reservoir: ReservoirSpec | None = None  # None: one material everywhere

@@ -284,6 +284,11 @@ cli.add_command(sweep)
 cli.add_command(plot)
 cli.add_command(screen)
 
+# deplete: its code is in cli_deplete (issue 6, depletion)
+from xfemslip.cli_deplete import deplete  # noqa: E402
+
+cli.add_command(deplete)
+
 
 def main() -> None:
     """Console-script entry point (``xfemslip``)."""

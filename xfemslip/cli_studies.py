@@ -214,9 +214,10 @@ def plot_run(out_dir: Path) -> None:
     "-p",
     "--pore-pressure",
     type=float,
-    default=0.0,
-    show_default=True,
-    help="Pore pressure p [Pa]; effective stress = stress + p I.",
+    default=None,
+    help="Pore pressure p [Pa]; effective stress = stress + p I "
+    "[default: the final far-field pore pressure of CASE's [pore_pressure], "
+    "else 0].",
 )
 @click.option(
     "--friction",
@@ -288,6 +289,8 @@ def screen(
         from xfemslip import screen as scr
 
         stress, fractures = _screen_inputs(case, stress, friction, cohesion, angles)
+        if pore_pressure is None:
+            pore_pressure = _case_pore_pressure(case)
         f0 = friction if friction is not None else fractures[0][2]
         c0 = cohesion if cohesion is not None else fractures[0][3]
         screened = [
@@ -327,6 +330,16 @@ def _angles(step: float):
     import numpy as np
 
     return np.arange(0.0, 180.0, step)
+
+
+def _case_pore_pressure(case) -> float:
+    """Final far-field pore pressure of CASE's [pore_pressure] (initial, plus
+    the change when it acts in the whole model), else 0 [Pa]."""
+    spec = _load(case) if case is not None else None
+    pp = None if spec is None else spec.pore_pressure
+    if pp is None:
+        return 0.0
+    return pp.initial + (pp.change if pp.region == "all" else 0.0)
 
 
 def _screen_inputs(case, stress, friction, cohesion, angles):

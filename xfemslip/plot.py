@@ -256,7 +256,10 @@ def _point_labels(results: Sequence[ResultData]) -> dict:
 def figure_mohr(results: Sequence[ResultData]) -> Figure:
     """The Mohr-Coulomb diagram of every result's stress and fractures; a
     circle per distinct stress state, a failure line per distinct (f, c)."""
-    fig = Figure(figsize=mohr_figsize(results[0].stress_state), layout="constrained")
+    fig = Figure(
+        figsize=mohr_figsize(results[0].stress_state, results[0].pore_pressure),
+        layout="constrained",
+    )
     ax = fig.subplots()
     circles, criteria = set(), set()
     labels = _point_labels(results)
@@ -269,7 +272,7 @@ def figure_mohr(results: Sequence[ResultData]) -> Figure:
         draw_mohr(
             ax,
             data.stress_state,
-            0.0,
+            data.pore_pressure,
             fractures=fractures,
             contact=[(f.normal_traction, f.shear_traction) for f in data.fractures],
             color=f"C{k % 10}",
@@ -286,7 +289,8 @@ def figure_mohr(results: Sequence[ResultData]) -> Figure:
         criteria |= keys
     source = results[0].stress_source
     ax.set_title(
-        f"Mohr-Coulomb diagram (far field: {source}; pore pressure 0; "
+        f"Mohr-Coulomb diagram (far field: {source}; pore pressure "
+        f"{results[0].pore_pressure:g} Pa; "
         "tension positive)",
         fontsize=9,
     )

@@ -28,7 +28,9 @@ class FractureData:
     s: np.ndarray  # (K,) [m]
     points: np.ndarray  # (K, 2) [m]
     slip: np.ndarray  # (K,) [m]
-    normal_traction: np.ndarray  # (K,) [Pa]
+    # (K,) [Pa]: the effective normal traction sigma_n + p_f when the result
+    # has pore pressure (what the Coulomb criterion sees), else sigma_n
+    normal_traction: np.ndarray
     shear_traction: np.ndarray  # (K,) [Pa]
     state: np.ndarray  # (K,) 0 open, 1 stick, 2 slip
     theta: float  # chord angle, first to last point of the case file [deg]
@@ -51,6 +53,9 @@ class ResultData:
     stress_state: tuple[float, float, float]  # far field (xx, yy, xy) [Pa]
     stress_source: str  # "loading.stress" or "mean element stress"
     fractures: list[FractureData] = field(default_factory=list)
+    # far-field pore pressure of the final step [Pa] ([pore_pressure]: initial,
+    # plus the change when it acts in the whole model); 0 without one
+    pore_pressure: float = 0.0
     vis_points: np.ndarray | None = None  # (P, 2) split mesh from result.vtu
     vis_displacement: np.ndarray | None = None  # (P, 2)
     vis_triangles: np.ndarray | None = None  # (T, 3): quads split in two + cut
@@ -85,6 +90,15 @@ def _stress_state(case: dict, stress: np.ndarray, cell_area: np.ndarray):
     return tuple(float(v) for v in mean), "mean element stress"
 
 
+def _far_pore_pressure(case: dict) -> float:
+    """Pore pressure in the far field at the final step [Pa] (0 without one)."""
+    pp = case.get("pore_pressure")
+    if not isinstance(pp, dict):
+        return 0.0
+    change = pp.get("change", 0.0) if pp.get("region", "all") == "all" else 0.0
+    return float(pp.get("initial", 0.0)) + float(change)
+
+
 def _read_fractures(h5, case: dict) -> list[FractureData]:
     tables = case.get("fractures", [])
     out = []
@@ -98,7 +112,11 @@ def _read_fractures(h5, case: dict) -> list[FractureData]:
                 s=group["s"][()],
                 points=group["points"][()],
                 slip=group["slip"][()],
-                normal_traction=group["normal_traction"][()],
+                normal_traction=group[
+                    "effective_normal_traction"
+                    if "effective_normal_traction" in group
+                    else "normal_traction"
+                ][()],
                 shear_traction=group["shear_traction"][()],
                 state=group["state"][()],
                 theta=_chord_angle(table),
@@ -212,6 +230,7 @@ def read_result(path: str | Path, label: str | None = None) -> ResultData:
             principal=h5["fields/principal_stress"][()],
             stress_state=state,
             stress_source=source,
+            pore_pressure=_far_pore_pressure(case),
             fractures=_read_fractures(h5, case),
         )
     vtu = path.with_name("result.vtu")

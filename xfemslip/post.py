@@ -1,6 +1,7 @@
 """Post-processing into the output sign convention (tension positive).
 
-Stress: sigma = sigma0 + D eps, averaged over each element (sub-cells included
+Stress: sigma = sigma0 + D eps (- alpha (p - p0) I with pore pressure, see
+xfemslip.poro), averaged over each element (sub-cells included
 for enriched elements).  Out-of-plane stress in plane strain:
 sigma_zz = nu (sigma_xx + sigma_yy) (the in-situ sigma_zz is taken as
 nu (sigma0_xx + sigma0_yy), consistent with plane strain); zero in plane stress.
@@ -38,37 +39,68 @@ def cell_strain(mesh, bulk, u) -> np.ndarray:
     return eps
 
 
-def bulk_fields(mesh, bulk, D, u, initial_stress, nu, model):
-    """stress (M, 3), stress_zz (M,), principal_stress (M, 2) [Pa]."""
-    stress = cell_strain(mesh, bulk, u) @ D.T
+def bulk_fields(
+    mesh, bulk, D, u, initial_stress, nu, model, cell_material=None, biot_p=None
+):
+    """stress (M, 3), stress_zz (M,), principal_stress (M, 2) [Pa] (total).
+
+    With several materials (xfemslip.poro): D (k, 3, 3), nu (k,) and
+    ``cell_material`` (M,).  With pore pressure, ``biot_p`` = (alpha p0,
+    alpha p (M,)) [Pa] at this step: sigma = sigma0 + D eps - alpha (p - p0) m
+    and, in plane strain, sigma_zz = nu (sigma'_xx + sigma'_yy) - alpha p with
+    sigma' = sigma0 + alpha p0 m + D eps (see xfemslip.poro).
+    """
+    eps = cell_strain(mesh, bulk, u)
+    if cell_material is None:
+        stress = eps @ np.asarray(D).reshape(3, 3).T
+        nu_c = np.full(mesh.n_cells, float(np.ravel(nu)[0]))
+    else:
+        stress = np.einsum("mij,mj->mi", np.asarray(D)[cell_material], eps)
+        nu_c = np.asarray(nu, float)[cell_material]
     if initial_stress is not None:
         stress = stress + np.asarray(initial_stress, float)[None, :]
+    a0, a = (0.0, np.zeros(mesh.n_cells)) if biot_p is None else biot_p
+    # stress is sigma0 + D eps here, i.e. sigma' - alpha p0 m
     szz = (
-        nu * (stress[:, 0] + stress[:, 1])
+        nu_c * (stress[:, 0] + stress[:, 1] + 2.0 * a0) - a
         if model == "plane_strain"
         else np.zeros(len(stress))
     )
+    stress = stress - (a - a0)[:, None] * np.array([1.0, 1.0, 0.0])
     centre = 0.5 * (stress[:, 0] + stress[:, 1])
     radius = np.hypot(0.5 * (stress[:, 0] - stress[:, 1]), stress[:, 2])
     principal = np.column_stack([centre + radius, centre - radius])
     return stress, szz, principal
 
 
-def fracture_fields(ip, res, n_fractures) -> list[FractureFields]:
-    """Contact fields per fracture, ordered by arc length."""
+def fracture_fields(ip, res, n_fractures, fluid=None) -> list[FractureFields]:
+    """Contact fields per fracture, ordered by arc length.
+
+    fluid : (n,) fluid pressure at the interface points [Pa] or None.  The
+    contact law gives the effective normal traction sigma_n'; with a fluid,
+    ``normal_traction`` is the total sigma_n' - p_f and the effective one and
+    p_f are reported too (xfemslip.poro).
+    """
     out = []
     for fi in range(n_fractures):
         m = np.nonzero(ip.fracture == fi)[0]
         m = m[np.argsort(ip.s[m], kind="stable")]
+        pn = res.point_pn[m].copy()
+        extra = {}
+        if fluid is not None:
+            pf = np.asarray(fluid, float)[m].copy()
+            extra = {"fluid_pressure": pf, "effective_normal_traction": pn}
+            pn = pn - pf
         out.append(
             FractureFields(
                 s=ip.s[m].copy(),
                 points=ip.xy[m].copy(),
                 slip=res.point_gt[m].copy(),
                 opening=res.point_gn[m].copy(),
-                normal_traction=res.point_pn[m].copy(),
+                normal_traction=pn,
                 shear_traction=res.point_pt[m].copy(),
                 state=res.point_state[m].astype(np.int8),
+                **extra,
             )
         )
     return out

@@ -25,6 +25,16 @@ from xfemslip.geometry import build_fractures
 from xfemslip.material import elasticity_matrix
 from xfemslip.memory import check_memory
 from xfemslip.mesh import Mesh, build_mesh
+from xfemslip.poro import (
+    Materials,
+    PorePressure,
+    body_load,
+    build_materials,
+    build_pore_pressure,
+    fluid_pressure,
+    fracture_load,
+    make_contact_effective,
+)
 from xfemslip.post import STATE_CODES, bulk_fields, fracture_fields, vis_mesh
 from xfemslip.quadrature import InterfacePoints, interface_points
 from xfemslip.solver import NewtonSolver, Problem, StepResult
@@ -48,6 +58,8 @@ class Model:
     ip: InterfacePoints
     contact: ContactSet
     problem: Problem
+    materials: Materials | None = None  # per-cell constants ([reservoir])
+    pore: PorePressure | None = None  # [pore_pressure]
 
 
 @dataclass
@@ -96,7 +108,12 @@ def build_model(spec) -> Model:
     cand = find_candidates(mesh, fractures)
     ec = build_enriched_cells(mesh, fractures, cand)
     ip = interface_points(fractures, mesh.h_min)
-    bulk = assemble_bulk(mesh, D, cand, ec, ip)
+    materials = build_materials(spec, mesh)
+    if spec.reservoir is None:
+        bulk = assemble_bulk(mesh, D, cand, ec, ip)
+    else:
+        bulk = assemble_bulk(mesh, materials.D, cand, ec, ip, materials.cell)
+    pore = build_pore_pressure(spec, materials)
     contact = build_contact(
         mesh,
         fractures,
@@ -113,6 +130,9 @@ def build_model(spec) -> Model:
     F = traction_load(
         mesh, spec.boundary, spec.loading, ec, cand, bulk.dofmap, fractures
     )
+    if pore is not None:  # Biot body load and fracture fluid load (xfemslip.poro)
+        make_contact_effective(contact, pore)
+        F = F + body_load(mesh, bulk, pore) + fracture_load(contact, ip, pore)
     problem = Problem(
         K=bulk.K,
         F_unit=F,
@@ -147,6 +167,8 @@ def build_model(spec) -> Model:
         ip=ip,
         contact=contact,
         problem=problem,
+        materials=materials,
+        pore=pore,
     )
 
 
@@ -179,15 +201,31 @@ def floating_parts(mesh, fractures, contact, bc):
 
 def step_fields(model: Model, r: StepResult) -> StepFields:
     spec = model.spec
+    mats, pore = model.materials, model.pore
+    hetero = spec.reservoir is not None
+    biot_p = None
+    if pore is not None:
+        p = pore.cell_pressure(r.load_factor)
+        biot_p = (pore.biot * pore.initial, pore.biot * p)
     stress, szz, principal = bulk_fields(
         model.mesh,
         model.bulk,
-        model.D,
+        mats.D if hetero else model.D,
         r.u,
         spec.loading.initial_stress,
-        spec.material.nu,
+        mats.nu if hetero else spec.material.nu,
         spec.material.model,
+        cell_material=mats.cell if hetero else None,
+        biot_p=biot_p,
     )
+    extra = {}
+    fluid = None
+    if pore is not None:
+        extra = {
+            "effective_stress": stress + biot_p[1][:, None] * [1.0, 1.0, 0.0],
+            "pore_pressure": p,
+        }
+        fluid = fluid_pressure(model.ip, pore, r.load_factor)
     n_std = 2 * model.mesh.n_nodes
     return StepFields(
         step=r.step,
@@ -197,7 +235,8 @@ def step_fields(model: Model, r: StepResult) -> StepFields:
         stress=stress,
         stress_zz=szz,
         principal_stress=principal,
-        fractures=fracture_fields(model.ip, r.contact, len(model.fractures)),
+        fractures=fracture_fields(model.ip, r.contact, len(model.fractures), fluid),
+        **extra,
     )
 
 
@@ -356,6 +395,9 @@ def _write_vtu(model, results, fields, out_dir, series, vtu) -> set:
             "stress_zz": f.stress_zz,
             "principal_stress": f.principal_stress,
         }
+        if f.effective_stress is not None:
+            cell_data["effective_stress"] = f.effective_stress
+            cell_data["pore_pressure"] = f.pore_pressure
         fr = [(model.fractures[i].index, ff) for i, ff in enumerate(f.fractures)]
         is_last = r is results[-1]
         if series:

@@ -166,7 +166,9 @@ def test_output_contract(runs, case):
         scale = np.max(np.abs(stress))
         np.testing.assert_allclose(principal, eig, rtol=0, atol=1e-9 * scale)
         szz = f["fields/stress_zz"][()]
-        if (
+        if "pore_pressure" in doc:  # effective stress, per-cell nu (xfemslip.poro)
+            check_poro_fields(f, doc, points, cells, scale)
+        elif (
             doc["material"]["model"] == "plane_strain"
         ):  # eps_zz = 0: s_zz = nu (s_xx + s_yy)
             nu = doc["material"]["nu"]
@@ -203,6 +205,31 @@ def test_output_contract(runs, case):
         files = [d.get("file") for d in pvd.iter("DataSet")]
         assert len(files) == steps
         assert all((out / name).is_file() for name in files)
+
+
+def check_poro_fields(f, doc, points, cells, scale):
+    """With [pore_pressure]: sigma' = sigma + alpha p I, and in plane strain
+    s_zz = nu (s'_xx + s'_yy) - alpha p with the nu of each cell's material
+    (reservoir = cells whose centre is inside a [reservoir] box)."""
+    pp = doc["pore_pressure"]
+    alpha = pp.get("biot", 1.0)
+    stress, szz = f["fields/stress"][()], f["fields/stress_zz"][()]
+    eff, p = f["fields/effective_stress"][()], f["fields/pore_pressure"][()]
+    np.testing.assert_allclose(
+        eff, stress + alpha * p[:, None] * [1.0, 1.0, 0.0], rtol=0, atol=1e-9 * scale
+    )
+    centre = points[cells].mean(axis=1)
+    nu = np.full(len(cells), doc["material"]["nu"])
+    res = doc.get("reservoir")
+    if res is not None:
+        boxes = res["boxes"] if "boxes" in res else [res["box"]]
+        for x0, y0, x1, y1 in boxes:
+            inside = (centre[:, 0] > x0) & (centre[:, 0] < x1)
+            inside &= (centre[:, 1] > y0) & (centre[:, 1] < y1)
+            nu[inside] = res["nu"]
+    if doc["material"].get("model", "plane_strain") == "plane_strain":
+        want = nu * (eff[:, 0] + eff[:, 1]) - alpha * p
+        np.testing.assert_allclose(szz, want, rtol=0, atol=1e-9 * scale)
 
 
 def fracture_ends(frac: dict):

@@ -22,6 +22,9 @@ class FractureFields:
     normal_traction: np.ndarray  # (K,) p_N [Pa], compression negative
     shear_traction: np.ndarray  # (K,) p_T along t [Pa]
     state: np.ndarray  # (K,) int8: 0 open, 1 stick, 2 slip
+    # with [pore_pressure] only (xfemslip.poro); normal_traction is then total
+    fluid_pressure: np.ndarray | None = None  # (K,) p_f [Pa]
+    effective_normal_traction: np.ndarray | None = None  # (K,) p_N + p_f [Pa]
 
 
 @dataclass
@@ -36,6 +39,9 @@ class StepFields:
     stress_zz: np.ndarray  # (M,) [Pa]
     principal_stress: np.ndarray  # (M, 2) [Pa] s_max, s_min
     fractures: list[FractureFields] = field(default_factory=list)
+    # with [pore_pressure] only (xfemslip.poro)
+    effective_stress: np.ndarray | None = None  # (M, 3) sigma + alpha p I [Pa]
+    pore_pressure: np.ndarray | None = None  # (M,) [Pa]
 
 
 @dataclass

@@ -14,6 +14,9 @@ Layout (every dataset carries ``attrs["units"]``: ``"m"``, ``"Pa"`` or ``"-"``):
     /fractures/<i>/s, points, slip, opening, normal_traction, shear_traction,
                    state (int8: 0 open, 1 stick, 2 slip),
                    contact_pressure = max(0, -normal_traction) [Pa]
+    with [pore_pressure] (xfemslip.poro) also: /fields/effective_stress (M, 3)
+    sigma + alpha p I, /fields/pore_pressure (M,), and per fracture
+    fluid_pressure and effective_normal_traction (normal_traction is total)
     /steps/<kkkk>/            only when load_steps > 1; attrs load_factor,
                               newton_iterations; holds fields/displacement and
                               fractures/<i>/* of that step
@@ -177,6 +180,12 @@ def _write_bulk_fields(
         _as_array(step.principal_stress, np.float64, (n_cells, 2), "principal_stress"),
         "Pa",
     )
+    # with pore pressure only (xfemslip.poro); /fields/stress stays total
+    optional = (("effective_stress", (n_cells, 3)), ("pore_pressure", (n_cells,)))
+    for name, shape in optional:
+        value = getattr(step, name, None)
+        if value is not None:
+            _dataset(group, name, _as_array(value, np.float64, shape, name), "Pa")
 
 
 def _write_step(steps_group: h5py.Group, step: StepFields, n_nodes: int) -> None:
@@ -216,6 +225,10 @@ def _write_fracture(group: h5py.Group, fracture: FractureFields) -> None:
     )
     # + 0.0 turns the -0.0 of max(-0.0, 0.0) into 0.0.
     _dataset(group, "contact_pressure", np.maximum(-normal, 0.0) + 0.0, "Pa")
+    for name in ("fluid_pressure", "effective_normal_traction"):  # pore pressure
+        value = getattr(fracture, name, None)
+        if value is not None:
+            _dataset(group, name, _as_array(value, np.float64, (n_points,), name), "Pa")
 
 
 def _dataset(

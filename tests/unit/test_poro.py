@@ -1,0 +1,317 @@
+"""[pore_pressure] / [reservoir]: case keys, per-cell material, loads, output,
+and the ``xfemslip deplete`` command (issue 6, depletion)."""
+
+from __future__ import annotations
+
+import csv
+
+import h5py
+import numpy as np
+import pytest
+from click.testing import CliRunner
+
+from xfemslip.case import loads_case
+from xfemslip.cli import cli
+from xfemslip.errors import CaseError
+from xfemslip.poro import body_load
+from xfemslip.simulation import build_model
+
+BASE = """
+[domain]
+size = [100.0, 60.0]
+
+[mesh]
+elements = [10, 6]
+
+[material]
+E = 20.0e9
+nu = 0.25
+{extra}
+[loading]
+initial_stress = {{ xx = -44.0e6, yy = -62.0e6 }}
+stress = {{ xx = -44.0e6, yy = -62.0e6 }}
+steps = 2
+
+[boundary]
+left = {{ ux = 0.0 }}
+right = {{ ux = 0.0 }}
+bottom = {{ uy = 0.0 }}
+top = "traction"
+"""
+PORE = """
+[pore_pressure]
+initial = 30.0e6
+change = -20.0e6
+region = "reservoir"
+
+[reservoir]
+box = [0.0, 20.0, 100.0, 40.0]
+E = 8.0e9
+nu = 0.2
+"""
+FRACTURE = """
+[[fractures]]
+center = [51.0, 30.0]
+length = 20.0
+angle = 60.0
+friction = 0.5
+"""
+
+
+def _problems(extra):
+    with pytest.raises(CaseError) as err:
+        loads_case(BASE.format(extra=extra), "p.toml")
+    return dict(err.value.problems)
+
+
+@pytest.mark.parametrize(
+    "extra, key, words",
+    [
+        (PORE.replace("region", "biot = 0.0\nregion"), "pore_pressure.biot", "0 <"),
+        (PORE.replace("region", "biot = 1.5\nregion"), "pore_pressure.biot", "<= 1"),
+        (
+            '[pore_pressure]\ninitial = 1.0e6\nchange = -1.0e6\nregion = "reservoir"\n',
+            "pore_pressure.region",
+            "no [reservoir]",
+        ),
+        (
+            PORE.replace("[0.0, 20.0, 100.0, 40.0]", "[50.0, 20.0, 10.0, 40.0]"),
+            "reservoir.box",
+            "x0 < x1",
+        ),
+        (
+            PORE.replace("box = ", "boxes = [[0.0, 1.0, 2.0, 3.0]]\nbox = "),
+            "reservoir",
+            "exactly one of",
+        ),
+        (
+            PORE.replace("[0.0, 20.0, 100.0, 40.0]", "[0.0, 20.0, 100.0]"),
+            "reservoir.box",
+            "4 numbers",
+        ),
+        (
+            PORE.replace("[0.0, 20.0, 100.0, 40.0]", "[200.0, 20.0, 300.0, 40.0]"),
+            "reservoir.box",
+            "no element centre",
+        ),
+        (PORE.replace("nu = 0.2", "nu = 0.5"), "reservoir.nu", "0.5"),
+        (
+            PORE.replace("change", "chnage"),
+            "pore_pressure.chnage",
+            "did you mean 'change'",
+        ),
+        (
+            PORE.replace('region = "reservoir"', 'region = "res"'),
+            "pore_pressure.region",
+            "reservoir",
+        ),
+    ],
+)
+def test_bad_keys_name_the_key(extra, key, words):
+    problems = _problems(extra)
+    assert any(k == key and words in m for k, m in problems.items()), problems
+
+
+def test_initial_pressure_needs_initial_stress():
+    text = BASE.format(extra=PORE).replace(
+        "initial_stress = { xx = -44.0e6, yy = -62.0e6 }\n", ""
+    )
+    with pytest.raises(CaseError) as err:
+        loads_case(text, "p.toml")
+    assert "loading.initial_stress" in str(err.value)
+    assert "pore_pressure.initial" in str(err.value)
+
+
+def test_absent_tables_change_nothing():
+    """Without the new tables the specs are None and the model is the old one."""
+    spec = loads_case(BASE.format(extra=FRACTURE), "p.toml")
+    assert spec.pore_pressure is None and spec.reservoir is None
+    model = build_model(spec)
+    assert model.pore is None
+    assert np.all(model.materials.cell == 0)
+
+
+def test_reservoir_with_host_constants_gives_the_same_stiffness():
+    """Per-cell material: a [reservoir] with the host's E, nu assembles the
+    same K (intact and enriched cells), one with other constants does not."""
+    plain = build_model(loads_case(BASE.format(extra=FRACTURE), "p.toml"))
+    same = PORE.replace("E = 8.0e9", "E = 20.0e9").replace("nu = 0.2", "nu = 0.25")
+    twin = build_model(loads_case(BASE.format(extra=FRACTURE + same), "p.toml"))
+    diff = abs(plain.bulk.K - twin.bulk.K).max()
+    assert diff <= 1e-12 * abs(plain.bulk.K).max()
+    soft = build_model(loads_case(BASE.format(extra=FRACTURE + PORE), "p.toml"))
+    assert abs(plain.bulk.K - soft.bulk.K).max() > 0.1 * abs(plain.bulk.K).max()
+    assert np.count_nonzero(soft.materials.cell) == 20  # 2 rows of 10 cells
+
+
+def test_body_load_is_self_equilibrated_and_points_inwards():
+    """F_body = int B^T m alpha dp: zero resultant, and under depletion the
+    forces on the reservoir's top nodes point down, on its bottom nodes up."""
+    model = build_model(loads_case(BASE.format(extra=FRACTURE + PORE), "p.toml"))
+    F = body_load(model.mesh, model.bulk, model.pore)
+    n_std = 2 * model.mesh.n_nodes
+    Fs = F[:n_std].reshape(-1, 2)
+    assert abs(Fs[:, 0].sum()) < 1e-6 * np.abs(Fs).max()
+    assert abs(Fs[:, 1].sum()) < 1e-6 * np.abs(Fs).max()
+    y = model.mesh.nodes[:, 1]
+    x = model.mesh.nodes[:, 0]
+    away = np.abs(x - 51.0) > 20.0  # nodes of intact cells
+    assert np.all(Fs[(y == 40.0) & away, 1] < 0.0)
+    assert np.all(Fs[(y == 20.0) & away, 1] > 0.0)
+    mid = (y == 30.0) & away
+    inner = mid & (x > 0.0) & (x < 100.0)
+    assert np.allclose(Fs[inner], 0.0, atol=1e-6 * np.abs(Fs).max())
+    # on the domain's sides the reservoir edge is pulled inwards too
+    assert Fs[mid & (x == 0.0), 0] > 0.0 and Fs[mid & (x == 100.0), 0] < 0.0
+
+
+@pytest.fixture
+def runner():
+    try:
+        return CliRunner(mix_stderr=False)
+    except TypeError:
+        return CliRunner()
+
+
+def test_check_prints_the_new_tables(runner, tmp_path):
+    case = tmp_path / "p.toml"
+    case.write_text(BASE.format(extra=FRACTURE + PORE))
+    result = runner.invoke(cli, ["check", str(case)])
+    assert result.exit_code == 0, result.output
+    assert "pore pressure: initial 3e+07 Pa, change -2e+07 Pa" in result.output
+    assert "reservoir: E = 8e+09 Pa, nu = 0.2 in box(es) [0, 20, 100, 40] m" in (
+        result.output
+    )
+
+
+def test_bad_key_exits_2_with_one_line(runner, tmp_path):
+    case = tmp_path / "bad.toml"
+    case.write_text(BASE.format(extra=PORE.replace("nu = 0.2", "nu = 0.7")))
+    result = runner.invoke(cli, ["run", str(case), "-o", str(tmp_path / "o")])
+    assert result.exit_code == 2
+    lines = result.stderr.strip().splitlines()
+    assert len(lines) == 1 and "bad.toml" in lines[0] and "reservoir.nu" in lines[0]
+    assert not (tmp_path / "o").exists()
+
+
+def test_deplete_without_pore_pressure_exits_2(runner, tmp_path):
+    case = tmp_path / "dry.toml"
+    case.write_text(BASE.format(extra=FRACTURE))
+    result = runner.invoke(cli, ["deplete", str(case), "-o", str(tmp_path / "o")])
+    assert result.exit_code == 2
+    assert "[pore_pressure]" in result.stderr
+    assert not (tmp_path / "o").exists()
+
+
+def test_deplete_writes_tables_and_fields(runner, tmp_path):
+    case = tmp_path / "dep.toml"
+    case.write_text(BASE.format(extra=FRACTURE + PORE))
+    out = tmp_path / "out"
+    result = runner.invoke(
+        cli, ["deplete", str(case), "-o", str(out), "--tolerance", "5e4", "-q"]
+    )
+    assert result.exit_code == 0, result.output + result.stderr
+    assert "critical depletion" in result.output
+    rows = list(csv.DictReader((out / "critical_depletion.csv").open()))
+    assert len(rows) == 1
+    lo, hi = float(rows[0]["dp_lower_Pa"]), float(rows[0]["dp_upper_Pa"])
+    assert -20.0e6 <= hi < lo < 0.0 and lo - hi <= 5.0e4
+    table = list(csv.DictReader((out / "slip_vs_depletion.csv").open()))
+    assert [float(r["dp_Pa"]) for r in table] == [0.0, -10.0e6, -20.0e6]
+    with h5py.File(out / "result.h5", "r") as f:
+        p = f["fields/pore_pressure"][()]
+        assert set(np.round(p / 1e6, 9)) == {10.0, 30.0}
+        eff, tot = f["fields/effective_stress"][()], f["fields/stress"][()]
+        np.testing.assert_allclose(eff[:, :2], tot[:, :2] + p[:, None], rtol=1e-12)
+        g = f["fractures/0"]
+        pf = g["fluid_pressure"][()]
+        np.testing.assert_allclose(
+            g["effective_normal_traction"][()] - pf, g["normal_traction"][()]
+        )
+        assert f["fractures/0/fluid_pressure"].attrs["units"] == "Pa"
+    again = runner.invoke(cli, ["deplete", str(case), "-o", str(out), "-q"])
+    assert again.exit_code == 2  # output exists, no --overwrite
+
+
+def test_plots_and_screen_use_the_effective_stress(runner, tmp_path):
+    """The Mohr figure reads the effective normal traction, and ``screen``
+    defaults to the case's far-field pore pressure (region "all": p0 + dp)."""
+    from xfemslip.plot_data import read_result
+
+    extra = FRACTURE + PORE.replace('region = "reservoir"', 'region = "all"')
+    case = tmp_path / "all.toml"
+    case.write_text(BASE.format(extra=extra))
+    out = tmp_path / "out"
+    assert runner.invoke(cli, ["run", str(case), "-o", str(out), "-q"]).exit_code == 0
+    data = read_result(out / "result.h5")
+    assert data.pore_pressure == 10.0e6
+    with h5py.File(out / "result.h5", "r") as f:
+        eff = f["fractures/0/effective_normal_traction"][()]
+    np.testing.assert_array_equal(data.fractures[0].normal_traction, eff)
+    default = runner.invoke(cli, ["screen", str(case)])
+    given = runner.invoke(cli, ["screen", str(case), "-p", "10.0e6"])
+    assert default.exit_code == 0, default.output
+    assert "pore pressure p = 1e+07" in default.output
+    assert default.output == given.output
+
+
+def test_bisection_trial_falls_back_to_step_cutting(monkeypatch):
+    """A bisection trial whose Newton solve fails is redone by the solver's
+    step cutting from the committed state: same bracket, history untouched."""
+    from xfemslip.depletion import critical_depletion
+    from xfemslip.errors import ConvergenceError
+    from xfemslip.simulation import newton_solver
+
+    def run(fail_call):
+        model = build_model(loads_case(BASE.format(extra=FRACTURE + PORE), "p.toml"))
+        solver = newton_solver(model)
+        real, calls = solver._newton, []
+
+        def newton(*args):
+            calls.append(args)
+            if len(calls) == fail_call:
+                raise ConvergenceError("forced", step=2, iteration=0, residual=1.0)
+            return real(*args)
+
+        monkeypatch.setattr(solver, "_newton", newton)
+        onsets, results = critical_depletion(solver, model, 2, 1.0e4)
+        return onsets[0], results, model.contact, len(calls)
+
+    plain, res_plain, c_plain, n_plain = run(fail_call=0)
+    cut, res_cut, c_cut, n_cut = run(fail_call=3)  # steps 1, 2, then trial 1
+    assert n_cut == n_plain + 1
+    assert (cut.dp_lower, cut.dp_upper) == (plain.dp_lower, plain.dp_upper)
+    assert len(res_cut) == len(res_plain) == 2
+    np.testing.assert_array_equal(c_cut.slip_committed, c_plain.slip_committed)
+
+
+def test_deplete_failure_keeps_the_converged_steps(runner, tmp_path, monkeypatch):
+    """A load step that fails: exit 1, result.h5 of the converged steps with
+    converged = false, and the tables written (like `run`)."""
+    from xfemslip import solver as solver_module
+    from xfemslip.errors import ConvergenceError
+
+    real = solver_module.NewtonSolver._newton
+
+    def newton(self, u, lam, k, steps):
+        if k == 2:
+            raise ConvergenceError(
+                "load step 2 did not converge: forced",
+                step=2,
+                iteration=3,
+                residual=1.0,
+            )
+        return real(self, u, lam, k, steps)
+
+    monkeypatch.setattr(solver_module.NewtonSolver, "_newton", newton)
+    case = tmp_path / "dep.toml"
+    case.write_text(BASE.format(extra=FRACTURE + PORE))
+    out = tmp_path / "out"
+    result = runner.invoke(cli, ["deplete", str(case), "-o", str(out), "-q"])
+    assert result.exit_code == 1
+    assert "load step 2 did not converge" in result.stderr
+    with h5py.File(out / "result.h5", "r") as f:
+        assert not bool(f.attrs["converged"])
+        assert "fields/pore_pressure" in f
+    rows = list(csv.DictReader((out / "slip_vs_depletion.csv").open()))
+    assert [float(r["dp_Pa"]) for r in rows] == [0.0, -10.0e6]

@@ -1,0 +1,226 @@
+"""Poroelastic loading: Biot effective stress in the bulk, Terzaghi on fractures.
+
+Signs: tension positive; the pore pressure p is positive when the fluid pushes.
+
+Bulk (Biot).  The total stress is sigma = sigma' - alpha p I, with the
+effective stress sigma' = sigma0' + D eps(u) (D of the cell's material).  The
+model starts in equilibrium with the in-situ total stress sigma0
+(``loading.initial_stress``) and the initial pore pressure p0 (uniform), so
+sigma0' = sigma0 + alpha p0 I.  A load step changes p by lambda * dp (dp =
+``pore_pressure.change``, < 0 = depletion) where the pressure changes (the
+whole model or the reservoir cells).  Equilibrium of the increment,
+int B^T (D eps - alpha lambda dp m) dOmega = lambda F_boundary with
+m = [1, 1, 0], moves the pressure term to the right-hand side as the body load
+
+    F_body = lambda * int_region B^T m alpha dp dOmega           (1)
+
+Under depletion (dp < 0) F_body pulls every boundary of the depleting region
+inwards: the region contracts.
+
+Uniaxial strain (the check of the sign of (1), README "Depletion"): a layer
+with rollers on its sides (eps_xx = 0) under a constant overburden
+(Delta sigma_yy = 0).  With D of plane strain,
+Delta sigma_yy = (lambda_L + 2 mu) eps_yy - alpha dp = 0, so
+eps_yy = alpha dp / (lambda_L + 2 mu) (< 0 under depletion: compaction) and
+Delta sigma_xx = lambda_L eps_yy - alpha dp = -alpha dp (1 - 2 nu) / (1 - nu),
+which is > 0 under depletion: the total horizontal stress becomes LESS
+compressive by alpha (1 - 2 nu) / (1 - nu) |dp|.  The effective stresses
+change by Delta sigma'_yy = alpha dp (more compressive under depletion) and
+Delta sigma'_xx = lambda_L eps_yy = nu / (1 - nu) alpha dp, so the effective
+horizontal change is nu / (1 - nu) of the vertical one (1/3 at nu = 0.25,
+3/7 at nu = 0.3: the paper's "about 1/3").
+
+Out of plane (plane strain, eps_zz = 0): sigma'_zz = nu (sigma'_xx +
+sigma'_yy) and sigma_zz = sigma'_zz - alpha p, the in-situ sigma0'_zz taken as
+nu (sigma0'_xx + sigma0'_yy) (as without pore pressure).
+
+Fractures (Terzaghi, Biot coefficient 1 on the faces).  The fluid in a
+fracture has the pore pressure around it: p_f = p0 + lambda dp at each
+contact point whose cell is in the region where the pressure changes, p0
+elsewhere (a fracture crossing the reservoir boundary sees the reservoir
+pressure on its reservoir part).  The contact law (penalty + Coulomb) acts on
+the EFFECTIVE normal traction sigma_n' = sigma_n + p_f: its in-situ value is
+(sigma0 + p0 I) . n . n, and |tau| <= c - f sigma_n'.  The faces also carry
+the fluid pressure -p_f n; its change is the load on the enriched dofs
+
+    F_frac = lambda * int_Gamma dp_f [[N]]^T n ds                  (2)
+
+(fluid pressure pushes the faces apart: dp_f > 0 opens).  With alpha = 1 and
+a uniform dp, (1) and (2) cancel on Gamma by the divergence theorem: a
+fracture whose fluid has the surrounding pressure does not perturb a uniform
+depletion up to the penalty compliance (checked in
+tests/verification/test_depletion.py).
+
+Material regions.  A cell belongs to the reservoir when its centre lies in one
+of the ``[reservoir]`` boxes; its stiffness (intact and enriched cells alike),
+its stress and its pore-pressure change are those of the reservoir.  Box
+edges that do not fall on mesh lines are snapped to the cells this way, and
+the run logs a warning naming the edge.
+"""
+
+from __future__ import annotations
+
+import logging
+from dataclasses import dataclass
+
+import numpy as np
+
+from xfemslip.material import elasticity_matrix
+
+logger = logging.getLogger(__name__)
+
+HOST, RESERVOIR = 0, 1
+# A box edge closer than this to a mesh line (relative to the local cell size)
+# lies on it: no warning.
+ALIGN_TOL = 1.0e-9
+
+
+@dataclass(frozen=True)
+class Materials:
+    """Elastic constants per material and the material of every cell."""
+
+    D: np.ndarray  # (k, 3, 3) [Pa]; 0 = host ([material]), 1 = reservoir
+    nu: np.ndarray  # (k,) [-]
+    E: np.ndarray  # (k,) [Pa]
+    cell: np.ndarray  # (n_cells,) int64 material of each cell
+    model: str
+
+
+@dataclass(frozen=True)
+class PorePressure:
+    """Pore pressure of a case: p(lambda) = initial + lambda * change in region."""
+
+    initial: float  # p0 [Pa]
+    change: float  # dp at load factor 1 [Pa]
+    biot: float  # alpha [-]
+    cell_changes: np.ndarray  # (n_cells,) bool: the pressure changes there
+
+    def cell_pressure(self, lam: float) -> np.ndarray:
+        """(n_cells,) pore pressure at load factor lam [Pa]."""
+        return self.initial + lam * self.change * self.cell_changes
+
+
+def in_boxes(xy: np.ndarray, boxes: np.ndarray) -> np.ndarray:
+    """(n,) bool: points strictly inside one of the boxes (k, 4) [x0, y0, x1, y1]."""
+    xy = np.asarray(xy, float)
+    inside = np.zeros(xy.shape[0], bool)
+    for x0, y0, x1, y1 in np.asarray(boxes, float):
+        inside |= (xy[:, 0] > x0) & (xy[:, 0] < x1) & (xy[:, 1] > y0) & (xy[:, 1] < y1)
+    return inside
+
+
+def cell_centres(mesh) -> np.ndarray:
+    """(n_cells, 2) cell centres [m]."""
+    b = mesh.bounds
+    return np.column_stack([0.5 * (b[:, 0] + b[:, 1]), 0.5 * (b[:, 2] + b[:, 3])])
+
+
+def _warn_unaligned(mesh, boxes) -> None:
+    """Log a warning for each box edge inside the domain off the mesh lines."""
+    for i, (x0, y0, x1, y1) in enumerate(np.asarray(boxes, float)):
+        for name, value, axis in (
+            ("x0", x0, mesh.x),
+            ("x1", x1, mesh.x),
+            ("y0", y0, mesh.y),
+            ("y1", y1, mesh.y),
+        ):
+            if value <= axis[0] or value >= axis[-1]:
+                continue
+            h = float(np.min(np.diff(axis)))
+            if np.min(np.abs(axis - value)) > ALIGN_TOL * h:
+                logger.warning(
+                    "reservoir box %d: %s = %g is not on a mesh line; the cells "
+                    "whose centre is inside the box form the reservoir",
+                    i,
+                    name,
+                    value,
+                )
+
+
+def build_materials(spec, mesh) -> Materials:
+    """Host ([material]) and, with [reservoir], reservoir constants per cell."""
+    m = spec.material
+    E, nu = [m.E], [m.nu]
+    cell = np.zeros(mesh.n_cells, np.int64)
+    r = spec.reservoir
+    if r is not None:
+        E.append(r.E)
+        nu.append(r.nu)
+        cell[in_boxes(cell_centres(mesh), r.boxes)] = RESERVOIR
+        _warn_unaligned(mesh, r.boxes)
+    D = np.stack([elasticity_matrix(e, v, m.model) for e, v in zip(E, nu, strict=True)])
+    return Materials(D=D, nu=np.array(nu), E=np.array(E), cell=cell, model=m.model)
+
+
+def build_pore_pressure(spec, materials: Materials) -> PorePressure | None:
+    """The case's pore pressure, or None without [pore_pressure]."""
+    p = spec.pore_pressure
+    if p is None:
+        return None
+    if p.region == "reservoir":
+        changes = materials.cell == RESERVOIR
+    else:
+        changes = np.ones(materials.cell.size, bool)
+    return PorePressure(
+        initial=p.initial, change=p.change, biot=p.biot, cell_changes=changes
+    )
+
+
+def body_load(mesh, bulk, pore: PorePressure) -> np.ndarray:
+    """F_body of eq. (1) at load factor 1, (n_dofs,) [N/m].
+
+    Intact rectangle: int dN_a/dx dOmega = x_a hy / 2, int dN_a/dy = y_a hx / 2
+    (x_a, y_a = -/+1 the corner signs); enriched cell: A * Bbar^T m, Bbar the
+    cell-average strain operator of the sub-cell rule.
+    """
+    F = np.zeros(bulk.dofmap.n_dofs)
+    q = pore.biot * pore.change * pore.cell_changes  # (n_cells,) [Pa]
+    std = bulk.std_cells
+    b = mesh.bounds[std]
+    hx, hy = b[:, 1] - b[:, 0], b[:, 3] - b[:, 2]
+    xa = np.array([-1.0, 1.0, 1.0, -1.0])
+    ya = np.array([-1.0, -1.0, 1.0, 1.0])
+    fx = q[std, None] * xa[None, :] * hy[:, None] / 2.0
+    fy = q[std, None] * ya[None, :] * hx[:, None] / 2.0
+    nodes = mesh.cells[std]
+    np.add.at(F, 2 * nodes, fx)
+    np.add.at(F, 2 * nodes + 1, fy)
+    enr = bulk.enriched_cells
+    if enr.size:
+        be = mesh.bounds[enr]
+        area = (be[:, 1] - be[:, 0]) * (be[:, 3] - be[:, 2])
+        # Bbar^T m = rows exx + eyy of the cell-average operator
+        fe = (q[enr] * area)[:, None] * (bulk.enr_Bbar[:, 0] + bulk.enr_Bbar[:, 1])
+        keep = bulk.enr_dofs >= 0
+        np.add.at(F, bulk.enr_dofs[keep], fe[keep])
+    return F
+
+
+def fracture_load(contact, ip, pore: PorePressure) -> np.ndarray:
+    """F_frac of eq. (2) at load factor 1, (n_dofs,) [N/m].
+
+    Integrated with the interface points' own jump operators:
+    sum_p w_p dp_f(p) coef_pk n_p on the dofs of the point's enrichments.
+    """
+    F = np.zeros(contact.n_dofs)
+    dofs, coef = contact.point_dofs, contact.point_coef
+    if dofs.shape[1] == 0:
+        return F
+    g = ip.weight * pore.change * pore.cell_changes[ip.cell]
+    for c in range(2):
+        d = dofs[:, c::2]
+        v = coef * (g * contact.point_normal[:, c])[:, None]
+        keep = d >= 0
+        np.add.at(F, d[keep], v[keep])
+    return F
+
+
+def make_contact_effective(contact, pore: PorePressure) -> None:
+    """Shift the in-situ normal traction of every patch to the effective one,
+    sigma_n0' = sigma_n0 + p0 (the initial pressure is uniform)."""
+    contact.pn0 = contact.pn0 + pore.initial
+
+
+def fluid_pressure(ip, pore: PorePressure, lam: float) -> np.ndarray:
+    """(n,) fluid pressure in the fractures at the interface points [Pa]."""
+    return pore.initial + lam * pore.change * pore.cell_changes[ip.cell]
