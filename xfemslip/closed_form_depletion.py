@@ -48,6 +48,12 @@ plane strain, homogeneous isotropic elasticity (shear modulus mu, Poisson nu).
    (c < y < b for a < c < b < d) |delta| = alpha |dp| (1 - 2 nu) (c - a) / mu,
    and the side whose reservoir lies lower moves down relative to the other
    (delta < 0 there when the left reservoir is the lower one).
+   (J1) and (J2) were derived here independently; they agree to round-off
+   with the analytical solution GEOS's validations use (GEOS-DEV/GEOS,
+   .../faultMechanics/slippedVerticalFault/generate_analytical.py; Frigo,
+   Castelletto, Cusini et al., J. Comput. Phys. 2026, Sec. 5.1.2, eqs.
+   48-51, for equal thickness b - a = d - c): tested in
+   tests/unit/test_closed_form_depletion.py.
    The released elastic energy -1/2 int sigma_xy delta dy is positive
    (checked in tests/unit/test_closed_form_depletion.py with a numerical
    Cauchy principal value of the slip's stress).  The fault must stay closed

@@ -134,3 +134,43 @@ def test_critical_change_is_on_the_coulomb_line():
 
     assert margin(dp) == pytest.approx(0.0, abs=1e-6)
     assert margin(0.0) < 0.0 and margin(0.999 * dp) < 0.0 < margin(1.001 * dp)
+
+
+def test_forms_agree_with_the_published_geos_benchmark():
+    """(J1) and (J2) against the dislocated-reservoir solution that GEOS's
+    "stableVerticalFault" / "slippedVerticalFault" validations use
+    (GEOS-DEV/GEOS, src/docs/sphinx/advancedExamples/validationStudies/
+    faultMechanics/slippedVerticalFault/generate_analytical.py; Frigo,
+    Castelletto, Cusini et al., J. Comput. Phys. 2026, Sec. 5.1.2, eqs. 48-51),
+    written here in its own notation: left reservoir z in [-b, a], right
+    reservoir z in [-a, b],
+
+        t_T(z) = C/2 ln((z-a)^2 (z+a)^2 / ((z-b)^2 (z+b)^2)),
+        C = (1 - 2 nu) alpha dp / (2 pi (1 - nu)),   A = G / (2 pi (1 - nu)),
+        |g_T| = |C/A| * {b - a on |z| < a, b - |z| on a <= |z| < b, 0 beyond}.
+
+    With the benchmark's own parameters (E = 14.95 GPa, nu = 0.15,
+    K_grain = 71.19 GPa, dp = -25 MPa, a = 75 m, b = 150 m).  The two
+    derivations are independent; they must agree to round-off, up to the
+    sign convention of the traction (GEOS plots minus its fault traction)."""
+    E, nu, k_grain = 14.95e9, 0.15, 7.119047619047619e10
+    dp, a, b = -25.0e6, 75.0, 150.0
+    G = E / (2.0 * (1.0 + nu))
+    alpha = 1.0 - E / (3.0 * (1.0 - 2.0 * nu)) / k_grain
+    z = np.linspace(-260.0, 260.0, 523) + 0.0371  # off the four corners
+    c_geos = (1.0 - 2.0 * nu) * alpha * dp / (2.0 * np.pi * (1.0 - nu))
+    a_geos = G / (2.0 * np.pi * (1.0 - nu))
+    ratio = (z - a) ** 2 * (z + a) ** 2 / ((z - b) ** 2 * (z + b) ** 2)
+    t_geos = c_geos / 2.0 * np.log(ratio)
+    g_geos = np.abs(c_geos / a_geos) * np.clip(b - np.maximum(np.abs(z), a), 0.0, None)
+
+    ours_t = offset_fault_shear(z, -b, a, -a, b, dp, nu, biot=alpha)
+    ours_g = offset_fault_slip(z, -b, a, -a, b, dp, nu, G, biot=alpha)
+    scale = np.max(np.abs(t_geos))
+    sign = np.sign(ours_t[0] * t_geos[0])  # one convention for the whole fault
+    np.testing.assert_allclose(ours_t, sign * t_geos, rtol=1e-10, atol=1e-12 * scale)
+    np.testing.assert_allclose(np.abs(ours_g), g_geos, rtol=1e-12, atol=1e-18)
+    # the benchmark's headline number: maximum slip (b - a) |C/A|
+    assert np.max(np.abs(ours_g)) == pytest.approx(
+        (1.0 - 2.0 * nu) * alpha * abs(dp) * (b - a) / G, rel=1e-12
+    )
