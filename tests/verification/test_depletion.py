@@ -249,11 +249,11 @@ def _fault_run(h, **kw):
     return model, solver.completed[-1].contact, corners, xf
 
 
-def _stuck_fault_errors(h):
+def _stuck_fault_errors(h, **kw):
     """(rms, max) error of the patch shear tractions relative to the patch
     averages of (J1) (its rectangle form, corners at the mesh line x = 0),
     over patches more than 4 h from the four corners."""
-    model, res, (a, b, c, d), _ = _fault_run(h, friction=0.6, cohesion=1.0e9)
+    model, res, (a, b, c, d), _ = _fault_run(h, friction=0.6, cohesion=1.0e9, **kw)
     ip, cs = model.ip, model.contact
     far = float(model.mesh.x[-1])
     rects = [[-far, a, 0.0, b], [0.0, c, far, d]]
@@ -286,8 +286,8 @@ def test_offset_fault_stuck_shear_traction():
     assert rms5 < 0.7 * rms10  # converging
 
 
-def _slip_errors(h):
-    model, res, (a, b, c, d), _ = _fault_run(h)
+def _slip_errors(h, **kw):
+    model, res, (a, b, c, d), _ = _fault_run(h, **kw)
     f = step_fields(model, _Result(res)).fractures[0]
     mu = 10.0e9 / (2.0 * 1.25)
     ref = offset_fault_slip(f.points[:, 1], a, b, c, d, -10.0e6, 0.25, mu)
