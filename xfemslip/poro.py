@@ -85,6 +85,7 @@ import numpy as np
 
 from xfemslip.assembly import enriched_part_bbar
 from xfemslip.material import elasticity_matrix
+from xfemslip.regions import edges, in_region
 
 logger = logging.getLogger(__name__)
 
@@ -128,57 +129,71 @@ class PorePressure:
         return self.initial + lam * self.change * self.cell_fraction
 
 
-def in_boxes(xy: np.ndarray, boxes: np.ndarray) -> np.ndarray:
-    """(n,) bool: points strictly inside one of the boxes (k, 4) [x0, y0, x1, y1]."""
-    xy = np.asarray(xy, float).reshape(-1, 2)
-    inside = np.zeros(xy.shape[0], bool)
-    for x0, y0, x1, y1 in np.asarray(boxes, float):
-        inside |= (xy[:, 0] > x0) & (xy[:, 0] < x1) & (xy[:, 1] > y0) & (xy[:, 1] < y1)
-    return inside
-
-
 def cell_centres(mesh) -> np.ndarray:
     """(n_cells, 2) cell centres [m]."""
     b = mesh.bounds
     return np.column_stack([0.5 * (b[:, 0] + b[:, 1]), 0.5 * (b[:, 2] + b[:, 3])])
 
 
-def _on_fracture(fractures, k, value, lo, hi, tol) -> bool:
-    """Whether one fracture segment lies on the line x_k = value over [lo, hi]."""
+def _on_fracture(fractures, p, q, tol) -> bool:
+    """Whether one fracture segment covers the segment p-q (within tol [m])."""
     for fr in fractures:
         for a, b in zip(fr.points[:-1], fr.points[1:], strict=True):
-            if abs(a[k] - value) <= tol and abs(b[k] - value) <= tol:
-                s0, s1 = sorted((a[1 - k], b[1 - k]))
-                if s0 <= lo + tol and s1 >= hi - tol:
-                    return True
+            L = float(np.hypot(*(b - a)))
+            t = (b - a) / L
+            n = np.array([-t[1], t[0]])
+            off = [abs(float((v - a) @ n)) for v in (p, q)]
+            s = sorted(float((v - a) @ t) for v in (p, q))
+            if max(off) <= tol and s[0] >= -tol and s[1] <= L + tol:
+                return True
     return False
 
 
-def _warn_unaligned(mesh, boxes, fractures=()) -> None:
-    """Log a warning for each box edge inside the domain off the mesh lines,
-    unless a fracture covers it (its cut cells are split per QP)."""
-    for i, (x0, y0, x1, y1) in enumerate(np.asarray(boxes, float)):
-        for name, value, axis, k, span, other in (
-            ("x0", x0, mesh.x, 0, (y0, y1), mesh.y),
-            ("x1", x1, mesh.x, 0, (y0, y1), mesh.y),
-            ("y0", y0, mesh.y, 1, (x0, x1), mesh.x),
-            ("y1", y1, mesh.y, 1, (x0, x1), mesh.x),
-        ):
-            if value <= axis[0] or value >= axis[-1]:
-                continue
+def _on_mesh_line(mesh, p, q) -> bool:
+    """Whether p-q is an axis-parallel segment on a mesh line (or outside the
+    open domain), i.e. needs no snapping."""
+    for k, axis in ((0, mesh.x), (1, mesh.y)):
+        if p[k] == q[k]:
+            v = p[k]
+            if v <= axis[0] or v >= axis[-1]:
+                return True
             h = float(np.min(np.diff(axis)))
-            if np.min(np.abs(axis - value)) <= ALIGN_TOL * h:
-                continue
-            lo, hi = max(span[0], other[0]), min(span[1], other[-1])
-            if _on_fracture(fractures, k, value, lo, hi, ALIGN_TOL * h):
-                continue
-            logger.warning(
-                "reservoir box %d: %s = %g is not on a mesh line; the cells "
-                "whose centre is inside the box form the reservoir",
-                i,
-                name,
-                value,
-            )
+            if np.min(np.abs(axis - v)) <= ALIGN_TOL * h:
+                return True
+    return False
+
+
+def _clip_to_domain(mesh, p, q):
+    """The part of p-q inside the domain's bounding box, or None."""
+    lo = np.array([mesh.x[0], mesh.y[0]])
+    hi = np.array([mesh.x[-1], mesh.y[-1]])
+    t0, t1 = 0.0, 1.0
+    d = q - p
+    for k in range(2):
+        if d[k] == 0.0:
+            if not lo[k] < p[k] < hi[k]:
+                return None
+            continue
+        ta, tb = sorted(((lo[k] - p[k]) / d[k], (hi[k] - p[k]) / d[k]))
+        t0, t1 = max(t0, ta), min(t1, tb)
+    return None if t0 >= t1 else (p + t0 * d, p + t1 * d)
+
+
+def _warn_unaligned(mesh, reservoir, fractures=()) -> None:
+    """Log a warning for each region edge inside the domain off the mesh
+    lines, unless a fracture covers it (its cut cells are split per QP)."""
+    tol = ALIGN_TOL * mesh.h_min
+    for name, p, q in edges(reservoir):
+        if _on_mesh_line(mesh, p, q):
+            continue
+        part = _clip_to_domain(mesh, p, q)
+        if part is None or _on_fracture(fractures, *part, tol):
+            continue
+        logger.warning(
+            "reservoir %s is not on a mesh line; the cells whose centre is "
+            "inside the region form the reservoir",
+            name,
+        )
 
 
 def _area_majority(ec, qp_material, n_materials) -> np.ndarray:
@@ -200,10 +215,10 @@ def build_materials(spec, mesh, ec=None, fractures=()) -> Materials:
     if r is not None:
         E.append(r.E)
         nu.append(r.nu)
-        cell[in_boxes(cell_centres(mesh), r.boxes)] = RESERVOIR
-        _warn_unaligned(mesh, r.boxes, fractures)
+        cell[in_region(cell_centres(mesh), r)] = RESERVOIR
+        _warn_unaligned(mesh, r, fractures)
         if ec is not None and ec.cells.size:
-            qp = np.where(in_boxes(ec.qp_xy, r.boxes), RESERVOIR, HOST)
+            qp = np.where(in_region(ec.qp_xy, r), RESERVOIR, HOST)
             cell[ec.cells] = _area_majority(ec, qp, 2)
     D = np.stack([elasticity_matrix(e, v, m.model) for e, v in zip(E, nu, strict=True)])
     return Materials(
@@ -254,9 +269,8 @@ def _face_mean(spec, ip, eps) -> np.ndarray:
     """(n_ip,) mean over the two faces of c (1 = the pressure changes), eq. (3)."""
     if spec.pore_pressure.region != "reservoir":
         return np.ones(ip.n)
-    boxes = spec.reservoir.boxes
-    plus = in_boxes(ip.xy + eps * ip.normal, boxes)
-    minus = in_boxes(ip.xy - eps * ip.normal, boxes)
+    plus = in_region(ip.xy + eps * ip.normal, spec.reservoir)
+    minus = in_region(ip.xy - eps * ip.normal, spec.reservoir)
     return 0.5 * (plus.astype(float) + minus)
 
 

@@ -434,3 +434,138 @@ def test_enriched_stiffness_takes_the_material_of_each_quadrature_point():
     # the QPs left of the fracture are reservoir, right of it host
     left = ec.qp_xy[:, 0] < 0.5
     assert np.all(mats.qp[left] == 1) and np.all(mats.qp[~left] == 0)
+
+
+# ------------------------------------------------------------ polygon reservoir
+L_BOXES = "boxes = [[0.0, 20.0, 100.0, 40.0], [0.0, 40.0, 30.0, 60.0]]"
+L_POLYGON = (
+    "polygon = [[0.0, 20.0], [100.0, 20.0], [100.0, 40.0], [30.0, 40.0], "
+    "[30.0, 60.0], [0.0, 60.0]]"
+)
+
+
+@pytest.mark.parametrize(
+    "shape, key, words",
+    [
+        ("polygon = [[0.0, 20.0], [100.0, 20.0]]", "reservoir.polygon", "at least 3"),
+        (
+            "polygon = [[0.0, 20.0], [100.0, 20.0, 1.0], [50.0, 40.0]]",
+            "reservoir.polygon[1]",
+            "2 numbers",
+        ),
+        (
+            "polygon = [[0.0, 20.0], [100.0, 40.0], [100.0, 20.0], [0.0, 40.0]]",
+            "reservoir.polygon",
+            "edges 0 and 2 cross",
+        ),
+        (
+            "polygon = [[0.0, 20.0], [50.0, 30.0], [100.0, 40.0]]",
+            "reservoir.polygon",
+            "zero area",
+        ),
+        (
+            "polygon = [[0.0, 20.0], [0.0, 20.0], [50.0, 30.0], [0.0, 40.0]]",
+            "reservoir.polygon",
+            "coincide",
+        ),
+        (
+            "polygon = [[200.0, 0.0], [300.0, 0.0], [300.0, 50.0]]",
+            "reservoir.polygon",
+            "no element centre",
+        ),
+        (
+            "polygon = [[0.0, 20.0], [100.0, 20.0], ['a', 40.0]]",
+            "reservoir.polygon[2][0]",
+            "",
+        ),
+        (L_POLYGON + "\nbox = [0.0, 20.0, 100.0, 40.0]", "reservoir", "exactly one of"),
+    ],
+)
+def test_bad_polygon_names_the_key(shape, key, words):
+    problems = _problems(PORE.replace("box = [0.0, 20.0, 100.0, 40.0]", shape))
+    assert any(k == key and words in m for k, m in problems.items()), problems
+
+
+def test_polygon_equals_the_same_region_as_boxes():
+    """An L-shaped polygon on mesh lines builds the same model as the union of
+    two boxes: cell materials, stiffness, Biot and fracture loads."""
+    models = [
+        build_model(
+            loads_case(
+                BASE.format(
+                    extra=FRACTURE + PORE.replace("box = [0.0, 20.0, 100.0, 40.0]", s)
+                ),
+                "p.toml",
+            )
+        )
+        for s in (L_BOXES, L_POLYGON)
+    ]
+    a, b = models
+    assert np.count_nonzero(a.materials.cell) == 2 * 10 + 2 * 3
+    np.testing.assert_array_equal(a.materials.cell, b.materials.cell)
+    np.testing.assert_array_equal(a.materials.qp, b.materials.qp)
+    assert abs(a.bulk.K - b.bulk.K).max() == 0.0
+    np.testing.assert_array_equal(a.problem.F_unit, b.problem.F_unit)
+    np.testing.assert_array_equal(a.pore.point_changes, b.pore.point_changes)
+
+
+def _clipped_area(bounds, p, n):
+    """Area of the rectangle [x0, x1, y0, y1] on the side (x - p).n < 0."""
+    x0, x1, y0, y1 = bounds
+    poly = [np.array(v) for v in ((x0, y0), (x1, y0), (x1, y1), (x0, y1))]
+    out = []
+    for i, v in enumerate(poly):
+        w = poly[(i + 1) % 4]
+        dv, dw = (v - p) @ n, (w - p) @ n
+        if dv < 0:
+            out.append(v)
+        if (dv < 0) != (dw < 0):
+            out.append(v + dv / (dv - dw) * (w - v))
+    P = np.array(out)
+    return 0.5 * abs(
+        np.sum(P[:, 0] * np.roll(P[:, 1], -1) - np.roll(P[:, 0], -1) * P[:, 1])
+    )
+
+
+def test_polygon_edge_along_an_inclined_fault(caplog):
+    """A trapezoidal reservoir whose slanted edge runs along an inclined fault
+    through the domain: the cut cells' pressure fraction is the exact area of
+    the cell below the fault (half-plane clipping), no warning is logged for
+    that edge, and one is for a slanted edge without a fault."""
+    caplog.set_level("WARNING", logger="xfemslip.poro")
+    model = build_model(loads_case(_trapezoid_case(True), "tri.toml"))
+    assert "polygon edge 0" not in caplog.text
+    b = model.mesh.bounds
+    p, t = np.array([0.0, 7.0]), np.array([100.0, 40.0]) / np.hypot(100.0, 40.0)
+    n = np.array([-t[1], t[0]])
+    cut = np.unique(model.fractures[0].piece_cell)
+    area = (b[cut, 1] - b[cut, 0]) * (b[cut, 3] - b[cut, 2])
+    want = np.array([_clipped_area(b[c], p, n) for c in cut]) / area
+    assert np.all((want > 0.0) & (want < 1.0))
+    np.testing.assert_allclose(model.pore.cell_fraction[cut], want, rtol=1e-10)
+    np.testing.assert_allclose(model.pore.point_changes, 0.5, rtol=0)
+    caplog.clear()
+    build_model(loads_case(_trapezoid_case(False), "tri.toml"))
+    assert "polygon edge 0 is not on a mesh line" in caplog.text
+
+
+def _trapezoid_case(fault):
+    """Trapezoidal reservoir below the line (0, 7)-(100, 47), with or without a
+    fault along that line."""
+    fracture = """
+[[fractures]]
+points = [[0.0, 7.0], [100.0, 47.0]]
+friction = 0.5
+"""
+    return BASE.format(
+        extra=f"""
+[pore_pressure]
+initial = 30.0e6
+change = -20.0e6
+region = "reservoir"
+[reservoir]
+polygon = [[0.0, 7.0], [100.0, 47.0], [100.0, 0.0], [0.0, 0.0]]
+E = 8.0e9
+nu = 0.2
+{fracture if fault else ""}"""
+    )
