@@ -62,14 +62,15 @@ depletion up to the penalty compliance (checked in
 tests/verification/test_depletion.py).
 
 Material regions.  An intact cell belongs to the reservoir when its centre
-lies in one of the ``[reservoir]`` boxes; its stiffness, its stress and its
-pore-pressure change are those of the reservoir.  Box edges that do not fall
-on mesh lines are snapped to the cells this way, and the run logs a warning
-naming the edge.  Enriched cells (cut, tip and blending cells) are classified
+lies in the ``[reservoir]`` region (its boxes or its polygon,
+xfemslip.regions); its stiffness, its stress and its pore-pressure change
+are those of the reservoir.  Region edges that do not fall on mesh lines
+are snapped to the cells this way, and the run logs a warning naming the
+edge.  Enriched cells (cut, tip and blending cells) are classified
 per QUADRATURE POINT of their sub-cell rule instead: the stiffness is
 sum_q B_q^T D(x_q) B_q w_q and the Biot load (1) sum_q B_q^T m alpha dp(x_q)
 w_q (B_q with the enrichment functions' gradients).  The sub-cell rule is
-split along the fracture, so a box edge lying ON a fracture is represented
+split along the fracture, so a region edge lying ON a fracture is represented
 exactly even when it cuts the cells mid-cell (no warning then): the pressure
 and material jump at the fault itself.  An enriched cell reports (stress,
 pore pressure) with the material covering most of its area and the
