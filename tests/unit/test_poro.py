@@ -185,6 +185,27 @@ def test_check_prints_the_new_tables(runner, tmp_path):
     )
 
 
+def test_check_prints_the_polygon_and_refuses_a_bad_one(runner, tmp_path):
+    case = tmp_path / "p.toml"
+    text = BASE.format(
+        extra=FRACTURE + PORE.replace("box = [0.0, 20.0, 100.0, 40.0]", L_POLYGON)
+    )
+    case.write_text(text)
+    result = runner.invoke(cli, ["check", str(case)])
+    assert result.exit_code == 0, result.output
+    assert (
+        "in polygon [0, 20]; [100, 20]; [100, 40]; [30, 40]; [30, 60]; [0, 60] m"
+        in (result.output)
+    )
+    case.write_text(
+        text.replace("[30.0, 60.0], [0.0, 60.0]", "[0.0, 60.0], [30.0, 60.0]")
+    )
+    result = runner.invoke(cli, ["check", str(case)])
+    assert result.exit_code == 2
+    lines = [x for x in result.output.splitlines() if "reservoir.polygon" in x]
+    assert len(lines) == 1 and "edges 3 and 5 cross" in lines[0], result.output
+
+
 def test_bad_key_exits_2_with_one_line(runner, tmp_path):
     case = tmp_path / "bad.toml"
     case.write_text(BASE.format(extra=PORE.replace("nu = 0.2", "nu = 0.7")))
