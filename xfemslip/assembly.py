@@ -63,29 +63,69 @@ def _rect_stiffness_shared(hx, hy, D, material=None):
     return K_u, inverse.ravel()
 
 
-def _enriched_matrices(mesh, ec, D, material):
+def _part_matrices(mesh, ec, rows, qp_w, D):
+    """K_e, Bbar of the enriched cells ``rows`` (indices into ec.cells; None =
+    all) integrated with the weights qp_w (nq,) [m^2] in place of ec.qp_w (0
+    on the QPs left out; every row keeps some weight)."""
+    if rows is None:
+        cells, off, idx = ec.cells, ec.qp_offsets, slice(None)
+        slot_node, slot_fnode = ec.slot_node, ec.slot_fnode
+    else:
+        counts = np.diff(ec.qp_offsets)[rows]
+        off = np.concatenate([[0], np.cumsum(counts)]).astype(np.int64)
+        idx = np.arange(off[-1]) + np.repeat(ec.qp_offsets[rows] - off[:-1], counts)
+        cells, slot_node, slot_fnode = (
+            ec.cells[rows],
+            ec.slot_node[rows],
+            ec.slot_fnode[rows],
+        )
+    return kernels.enriched_cell_matrices(
+        np.ascontiguousarray(mesh.bounds[cells]),
+        off,
+        np.ascontiguousarray(ec.qp_xy[idx]),
+        np.ascontiguousarray(qp_w[idx], dtype=np.float64),
+        np.ascontiguousarray(ec.qp_F[idx]),
+        np.ascontiguousarray(ec.qp_gradF[idx]),
+        np.ascontiguousarray(slot_node),
+        np.ascontiguousarray(slot_fnode),
+        np.ascontiguousarray(D, dtype=np.float64),
+    )
+
+
+def enriched_part_bbar(mesh, ec, rows, qp_w) -> np.ndarray:
+    """(len(rows), 3, 8+2S) average strain operator [1/m] of the enriched cells
+    ``rows`` over the QPs with weight qp_w > 0 (xfemslip.poro's Biot load)."""
+    if len(rows) == 0:
+        return np.zeros((0, 3, 8 + 2 * ec.slot_node.shape[1]))
+    return _part_matrices(mesh, ec, rows, qp_w, np.eye(3))[1]
+
+
+def _enriched_matrices(mesh, ec, D, material, qp_material=None):
     """K_e, Bbar of the enriched cells, each with its own material's D.
 
-    With several materials every material's matrices are computed for all
-    enriched cells and each cell keeps its own (the enriched cells are few).
+    material : (nc,) material index of each cell, or None (D[0] everywhere);
+    qp_material : (nq,) material index of each QP (overrides ``material``):
+    K_e = K_e(D_0) + sum_k sum_{q in k} B_q^T (D_k - D_0) B_q w_q, the second
+    term on the cells holding QPs of material k only.  With several materials
+    by cell every material's matrices are computed for all enriched cells and
+    each cell keeps its own (the enriched cells are few).
     """
     D = np.asarray(D, float).reshape(-1, 3, 3)
+    if qp_material is not None:
+        K, Bbar = _part_matrices(mesh, ec, None, ec.qp_w, D[0])
+        cell_of_qp = np.repeat(np.arange(ec.cells.size), np.diff(ec.qp_offsets))
+        for k in range(1, D.shape[0]):
+            rows = np.unique(cell_of_qp[qp_material == k])
+            if rows.size:
+                w = np.where(qp_material == k, ec.qp_w, 0.0)
+                K[rows] += _part_matrices(mesh, ec, rows, w, D[k] - D[0])[0]
+        return K, Bbar
     out = None
     for k in range(D.shape[0]):
         mine = np.ones(ec.cells.size, bool) if material is None else material == k
         if not mine.any():
             continue
-        K_k, B_k = kernels.enriched_cell_matrices(
-            np.ascontiguousarray(mesh.bounds[ec.cells]),
-            ec.qp_offsets,
-            ec.qp_xy,
-            ec.qp_w,
-            ec.qp_F,
-            ec.qp_gradF,
-            ec.slot_node,
-            ec.slot_fnode,
-            np.ascontiguousarray(D[k]),
-        )
+        K_k, B_k = _part_matrices(mesh, ec, None, ec.qp_w, D[k])
         if out is None:
             out = (K_k, B_k)
         else:
@@ -94,12 +134,19 @@ def _enriched_matrices(mesh, ec, D, material):
 
 
 def assemble_bulk(
-    mesh, D, cand: Candidates, ec: EnrichedCells, ip=None, cell_material=None
+    mesh,
+    D,
+    cand: Candidates,
+    ec: EnrichedCells,
+    ip=None,
+    cell_material=None,
+    qp_material=None,
 ) -> BulkSystem:
     """Assemble the bulk stiffness and choose the kept enrichments (sliver rule).
 
     D : (3, 3) [Pa] for one material, or (k, 3, 3) with ``cell_material``
-    (n_cells,) int64 the material index of every cell (xfemslip.poro).
+    (n_cells,) int64 the material index of every cell (xfemslip.poro) and,
+    optionally, ``qp_material`` (nq,) int64 that of every enriched-cell QP.
     """
     is_enr = np.zeros(mesh.n_cells, bool)
     is_enr[ec.cells] = True
@@ -113,7 +160,11 @@ def assemble_bulk(
 
     if ec.cells.size:
         K_e, Bbar = _enriched_matrices(
-            mesh, ec, D, None if cell_material is None else cell_material[ec.cells]
+            mesh,
+            ec,
+            D,
+            None if cell_material is None else cell_material[ec.cells],
+            qp_material,
         )
     else:
         K_e = np.zeros((0, 8, 8))

@@ -124,12 +124,14 @@ def _describe_pore(spec: CaseSpec) -> list[str]:
         )
     r = spec.reservoir
     if r is not None:
-        boxes = "; ".join(
-            "[" + ", ".join(_fmt(float(v)) for v in b) + "]" for b in r.boxes
+        rows = r.boxes if r.polygon is None else r.polygon
+        where = "box(es)" if r.polygon is None else "polygon"
+        shapes = "; ".join(
+            "[" + ", ".join(_fmt(float(v)) for v in b) + "]" for b in rows
         )
         lines.append(
-            f"reservoir: E = {_fmt(r.E)} Pa, nu = {_fmt(r.nu)} in box(es) "
-            f"{boxes} m (cells whose centre is inside); [material] is the host rock"
+            f"reservoir: E = {_fmt(r.E)} Pa, nu = {_fmt(r.nu)} in {where} "
+            f"{shapes} m (cells whose centre is inside); [material] is the host rock"
         )
     return lines
 

@@ -20,10 +20,11 @@ from xfemslip.case_tables import (
     _show,
     _Table,
 )
+from xfemslip.regions import in_boxes, in_polygon, polygon_problem
 
 PORE_PRESSURE_KEYS = ("initial", "change", "biot", "region")
 PORE_PRESSURE_REGIONS = ("all", "reservoir")
-RESERVOIR_KEYS = ("box", "boxes", "E", "nu")
+RESERVOIR_KEYS = ("box", "boxes", "polygon", "E", "nu")
 
 
 def _read_pore_pressure(root: _Table) -> PorePressureSpec | None:
@@ -77,13 +78,48 @@ def _check_box(value, key: str, problems: list) -> tuple | None:
     return tuple(items)
 
 
+def _read_polygon(table: _Table) -> list | None:
+    """``polygon = [[x, y], ...]``: at least 3 vertices of a simple polygon [m]."""
+    key = table.key("polygon")
+    value = table.data["polygon"]
+    if not isinstance(value, list) or len(value) < 3:
+        table.error(
+            "polygon",
+            f"expected an array of at least 3 vertices [[x, y], ...], got "
+            f"{_show(value)}",
+        )
+        return None
+    vertices = []
+    for i, v in enumerate(value):
+        if not isinstance(v, list) or len(v) != 2:
+            table.problems.append(
+                (
+                    f"{key}[{i}]",
+                    f"expected a vertex [x, y] of 2 numbers, got {_show(v)}",
+                )
+            )
+            return None
+        xy = [
+            _check_number(c, f"{key}[{i}][{j}]", table.problems)
+            for j, c in enumerate(v)
+        ]
+        if any(c is None for c in xy):
+            return None
+        vertices.append(xy)
+    why = polygon_problem(np.array(vertices))
+    if why is not None:
+        table.error("polygon", why)
+        return None
+    return vertices
+
+
 def _read_boxes(table: _Table) -> list | None:
-    """``box = [..]`` or ``boxes = [[..], ..]`` (exactly one of them)."""
+    """``box = [..]`` or ``boxes = [[..], ..]`` (one of them, or a polygon)."""
     if table.has("box") == table.has("boxes"):
         table.error(
             None,
-            "give exactly one of box = [x0, y0, x1, y1] or boxes = [[x0, y0, x1, "
-            "y1], ...]",
+            "give exactly one of box = [x0, y0, x1, y1], boxes = [[x0, y0, x1, "
+            "y1], ...] or polygon = [[x, y], ...]",
         )
         return None
     if table.has("box"):
@@ -101,27 +137,52 @@ def _read_boxes(table: _Table) -> list | None:
 
 
 def _read_reservoir(root: _Table, grid) -> ReservoirSpec | None:
-    """[reservoir]: boxes and the reservoir's E [Pa] and nu [-]."""
+    """[reservoir]: boxes or a polygon, and the reservoir's E [Pa] and nu [-]."""
     table = root.table("reservoir", RESERVOIR_KEYS)
     if table is None or not table.present:
         return None
     start = len(table.problems)
-    boxes = _read_boxes(table)
+    polygon = None
+    if table.has("polygon"):
+        if table.has("box") or table.has("boxes"):
+            table.error(
+                None,
+                "give exactly one of box = [x0, y0, x1, y1], boxes = [[x0, y0, "
+                "x1, y1], ...] or polygon = [[x, y], ...]",
+            )
+        else:
+            polygon = _read_polygon(table)
+        boxes = None if polygon is None else []
+    else:
+        boxes = _read_boxes(table)
     E = table.number("E", rule=_POSITIVE)
     nu = table.number("nu", rule=Range(0.0, 0.5, hi_open=True))
     if boxes is not None and grid is not None:
         x, y = grid.mesh.x, grid.mesh.y
-        cx, cy = 0.5 * (x[1:] + x[:-1]), 0.5 * (y[1:] + y[:-1])
-        if not any(
-            np.any((cx > b[0]) & (cx < b[2])) and np.any((cy > b[1]) & (cy < b[3]))
-            for b in boxes
-        ):
-            key = "box" if table.has("box") else "boxes"
+        cx, cy = np.meshgrid(0.5 * (x[1:] + x[:-1]), 0.5 * (y[1:] + y[:-1]))
+        centres = np.column_stack([cx.ravel(), cy.ravel()])
+        if polygon is not None:
+            inside = in_polygon(centres, np.array(polygon))
+        else:
+            inside = in_boxes(centres, np.array(boxes).reshape(-1, 4))
+        if not np.any(inside):
+            key = (
+                "polygon"
+                if polygon is not None
+                else "box"
+                if table.has("box")
+                else "boxes"
+            )
             table.error(
                 key,
                 "contains no element centre of the mesh (a cell belongs to the "
-                "reservoir when its centre lies inside a box)",
+                "reservoir when its centre lies inside)",
             )
     if len(table.problems) > start:
         return None
-    return ReservoirSpec(boxes=_frozen(boxes), E=E, nu=nu)
+    return ReservoirSpec(
+        boxes=_frozen(np.array(boxes, float).reshape(-1, 4)),
+        E=E,
+        nu=nu,
+        polygon=None if polygon is None else _frozen(polygon),
+    )

@@ -157,16 +157,24 @@ class PorePressureSpec:
 
 @dataclass(frozen=True, kw_only=True)
 class ReservoirSpec:
-    """[reservoir]: a region of boxes with its own elastic constants.
+    """[reservoir]: a region of boxes, or one polygon, with its own elastic
+    constants.
 
-    ``boxes`` (k, 4) float64 [x0, y0, x1, y1] [m]; a cell belongs to the
-    reservoir when its centre lies in one of the boxes.
+    ``boxes`` (k, 4) float64 [x0, y0, x1, y1] [m] ((0, 4) with a polygon);
+    ``polygon`` (k, 2) float64 vertices [m] or None.  An intact cell belongs
+    to the reservoir when its centre lies in the region (xfemslip.poro).
     """
 
     boxes: np.ndarray  # (k, 4) float64 [m]
     E: float  # [Pa]
     nu: float  # [-]
-    UNITS: ClassVar[dict[str, str]] = {"boxes": "m", "E": "Pa", "nu": "-"}
+    polygon: np.ndarray | None = None  # (k, 2) float64 [m]
+    UNITS: ClassVar[dict[str, str]] = {
+        "boxes": "m",
+        "polygon": "m",
+        "E": "Pa",
+        "nu": "-",
+    }
 
 
 @dataclass(frozen=True, kw_only=True)

@@ -41,19 +41,30 @@ filters the oscillation and keeps any variation on the scale of the crack.
 With an initial stress s0 the interaction integral of the uniform s0 (with
 its own face tractions) is zero, so the integral uses D eps(u) and p - p0.
 
+Material.  E, nu (and D) are those of the material at the tip: the
+reservoir's when the tip lies in the ``[reservoir]`` region (xfemslip.poro),
+the host's otherwise.  The integral assumes a homogeneous domain (it has no
+term for a material interface); a domain holding cells or quadrature points
+of the other material is computed with the tip's and logged as a warning.
+
 Assumes the fracture is straight inside the domain r <= r_out of each tip.
 Units SI: K in Pa sqrt(m).
 """
 
 from __future__ import annotations
 
+import logging
 import math
 from dataclasses import dataclass
 
 import numpy as np
 
 from xfemslip.closed_form import kolosov
+from xfemslip.poro import HOST, RESERVOIR
 from xfemslip.post import fracture_fields
+from xfemslip.regions import in_region
+
+logger = logging.getLogger(__name__)
 
 # Gauss rule on intact cells of the domain (the auxiliary field is smooth there,
 # away from the tip; 4 x 4 is exact for degree 7 per direction)
@@ -235,13 +246,14 @@ def _frame(tip):
     return np.array([d, [-d[1], d[0]]])  # rows: x_1, x_2 of the tip frame
 
 
-def _domain_term(model, u, tip, q_nodes, mu, kappa):
-    """Area part of I for the mode-I and mode-II auxiliary fields, (2,)."""
+def _domain_term(model, u, tip, q_nodes, mu, kappa, D):
+    """Area part of I for the mode-I and mode-II auxiliary fields, (2,);
+    D (3, 3) [Pa] the elasticity of the domain."""
     mesh = model.mesh
     cells = _domain_cells(mesh, q_nodes)
     xy, w, own, grad = displacement_gradient(model, u, cells)
     eps = np.column_stack([grad[:, 0, 0], grad[:, 1, 1], grad[:, 0, 1] + grad[:, 1, 0]])
-    sig = _tensor(eps @ model.D.T)
+    sig = _tensor(eps @ np.asarray(D).T)
     _, dN = _q4_gradients(mesh, own, xy)
     dq = np.einsum("na,naj->nj", q_nodes[mesh.cells[own]], dN)
     R = _frame(tip)
@@ -350,6 +362,36 @@ def _face_term(model, contact, fi, tip, q_nodes, r_out, r_in, mu, kappa, tractio
     return out
 
 
+def _tip_material(model, tip, q_nodes):
+    """E [Pa], nu [-] and D (3, 3) [Pa] of the material at the tip; warns when
+    the domain (cells with q > 0) holds the other material."""
+    r = model.spec.reservoir
+    if r is None:
+        return model.spec.material.E, model.spec.material.nu, model.D
+    mats = model.materials
+    k = RESERVOIR if in_region(np.asarray(tip.point)[None], r)[0] else HOST
+    cells = np.nonzero(q_nodes[model.mesh.cells].max(axis=1) > 0.0)[0]
+    ec = model.ec
+    is_enr = np.isin(cells, ec.cells)
+    found = set(mats.cell[cells[~is_enr]].tolist())
+    if mats.qp is not None and is_enr.any():
+        rows = np.nonzero(np.isin(ec.cells, cells))[0]
+        q = np.concatenate(
+            [np.arange(ec.qp_offsets[e], ec.qp_offsets[e + 1]) for e in rows]
+        )
+        found |= set(mats.qp[q].tolist())
+    else:
+        found |= set(mats.cell[cells[is_enr]].tolist())
+    if found != {k}:
+        logger.warning(
+            "J-integral domain around the tip at %s holds both materials; K uses "
+            "the %s's E, nu (the interaction integral assumes one material)",
+            np.asarray(tip.point).tolist(),
+            "reservoir" if k == RESERVOIR else "host",
+        )
+    return float(mats.E[k]), float(mats.nu[k]), mats.D[k]
+
+
 def stress_intensity_factors(
     model,
     u,
@@ -376,11 +418,7 @@ def stress_intensity_factors(
     """
     if traction not in (*FIT_DEGREE, "interp"):
         raise ValueError(f"traction must be one of mean, fit, interp; got {traction!r}")
-    mat = model.spec.material
-    E, nu = mat.E, mat.nu
-    mu = E / (2 * (1 + nu))
-    kappa = kolosov(nu, mat.model)
-    e_prime = E / (1 - nu**2) if mat.model == "plane_strain" else E
+    plane = model.spec.material.model
     mesh = model.mesh
     out = []
     for fi, fr in enumerate(model.fractures):
@@ -396,7 +434,13 @@ def stress_intensity_factors(
                     f"J-integral domain of radius {r_out:g} m around the tip at "
                     f"{tip.point.tolist()} reaches the mesh boundary"
                 )
-            interaction = _domain_term(model, u, tip, q_nodes, mu, kappa) + _face_term(
+            E, nu, D = _tip_material(model, tip, q_nodes)
+            mu = E / (2 * (1 + nu))
+            kappa = kolosov(nu, plane)
+            e_prime = E / (1 - nu**2) if plane == "plane_strain" else E
+            interaction = _domain_term(
+                model, u, tip, q_nodes, mu, kappa, D
+            ) + _face_term(
                 model, contact, fi, tip, q_nodes, r_out, r_in, mu, kappa, traction
             )
             k = 0.5 * e_prime * interaction

@@ -10,6 +10,7 @@ from pathlib import Path
 import numpy as np
 
 from xfemslip.contact import SLIP
+from xfemslip.regions import edges
 
 
 def _pyplot():
@@ -76,8 +77,8 @@ def plot_field(model, result, out_dir: Path, dpi: float = 110.0) -> Path:
         )
         fig.colorbar(im, ax=ax, shrink=0.85)
         if model.spec.reservoir is not None:
-            for x0, y0, x1, y1 in model.spec.reservoir.boxes:
-                ax.plot([x0, x1, x1, x0, x0], [y0, y0, y1, y1, y0], "k--", lw=0.8)
+            for _, p, q in edges(model.spec.reservoir):
+                ax.plot([p[0], q[0]], [p[1], q[1]], "k--", lw=0.8)
         for fr in f.fractures:
             slip = fr.state == SLIP
             ax.plot(fr.points[:, 0], fr.points[:, 1], "-", color="0.3", lw=1.0)

@@ -108,12 +108,14 @@ def build_model(spec) -> Model:
     cand = find_candidates(mesh, fractures)
     ec = build_enriched_cells(mesh, fractures, cand)
     ip = interface_points(fractures, mesh.h_min)
-    materials = build_materials(spec, mesh)
+    materials = build_materials(spec, mesh, ec, fractures)
     if spec.reservoir is None:
         bulk = assemble_bulk(mesh, D, cand, ec, ip)
     else:
-        bulk = assemble_bulk(mesh, materials.D, cand, ec, ip, materials.cell)
-    pore = build_pore_pressure(spec, materials)
+        bulk = assemble_bulk(
+            mesh, materials.D, cand, ec, ip, materials.cell, materials.qp
+        )
+    pore = build_pore_pressure(spec, materials, ec, ip, mesh.h_min)
     contact = build_contact(
         mesh,
         fractures,
@@ -132,7 +134,7 @@ def build_model(spec) -> Model:
     )
     if pore is not None:  # Biot body load and fracture fluid load (xfemslip.poro)
         make_contact_effective(contact, pore)
-        F = F + body_load(mesh, bulk, pore) + fracture_load(contact, ip, pore)
+        F = F + body_load(mesh, bulk, pore, ec) + fracture_load(contact, ip, pore)
     problem = Problem(
         K=bulk.K,
         F_unit=F,

@@ -173,3 +173,63 @@ def test_domain_leaving_the_mesh_is_refused(solved):
         J.stress_intensity_factors(s.model, s.u, s.contact, radius_cells=30.0)
     with pytest.raises(ValueError, match="traction"):
         J.stress_intensity_factors(s.model, s.u, s.contact, traction="raw")
+
+
+RESERVOIR_TIP_CASE = """
+[domain]
+size = [40.0, 40.0]
+[mesh]
+elements = [40, 40]
+[material]
+E = 20.0e9
+nu = 0.25
+[reservoir]
+box = [{x0}, 0.0, 40.0, 40.0]
+E = 5.0e9
+nu = 0.35
+[[fractures]]
+points = [[12.3, 14.1], [27.7, 25.9]]
+friction = 0.5
+[boundary]
+left = {{ ux = 0.0 }}
+bottom = {{ uy = 0.0 }}
+"""
+
+
+def test_tip_in_the_reservoir_uses_the_reservoir_material(monkeypatch, caplog):
+    """A pure Williams field built with the reservoir's E, nu (host: other
+    E, nu) returns its K_I, K_II when the tip's domain lies in the reservoir
+    (with the host's constants K would be off by the E' and mu ratios); a
+    domain across the reservoir edge is refused with a warning."""
+    from xfemslip.case import loads_case
+
+    model = build_model(loads_case(RESERVOIR_TIP_CASE.format(x0=0.0), "r.toml"))
+    tip = model.fractures[0].tips[1]
+    mu_r = 5.0e9 / (2 * 1.35)
+    kappa = cf.kolosov(0.35, "plane_strain")
+    K1, K2 = 2.0e6, -3.0e6
+    R = _tip_frame(tip)
+
+    def field(xy):
+        rel = (xy - tip.point) @ R.T
+        r, th = np.hypot(rel[:, 0], rel[:, 1]), np.arctan2(rel[:, 1], rel[:, 0])
+        g = (
+            K1 * J.williams(r, th, 1, mu_r, kappa)[1]
+            + K2 * J.williams(r, th, 2, mu_r, kappa)[1]
+        )
+        return np.einsum("ki,nkl,lj->nij", R, g, R)
+
+    monkeypatch.setattr(J, "displacement_gradient", _exact_gradient(field))
+    n = model.ip.n
+    zero = _Tractions(np.zeros(n), np.zeros(n))
+    u = np.zeros(model.problem.n_dofs)
+    caplog.set_level("WARNING", logger="xfemslip.jintegral")
+    out = J.stress_intensity_factors(model, u, zero, radius_cells=3.0)
+    k = [t for t in out if t.end == tip.end][0]
+    assert k.k_i == pytest.approx(K1, rel=1e-4)
+    assert k.k_ii == pytest.approx(K2, rel=1e-4)
+    assert "both materials" not in caplog.text
+    # reservoir edge x = 25 through the domain of the tip at (27.7, 25.9)
+    split = build_model(loads_case(RESERVOIR_TIP_CASE.format(x0=25.0), "r.toml"))
+    J.stress_intensity_factors(split, u, zero, radius_cells=3.0)
+    assert "holds both materials" in caplog.text

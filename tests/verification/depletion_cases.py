@@ -42,21 +42,25 @@ def offset_fault_case(
     nu=0.25,
     fault_half_length=300.0,
     steps=1,
+    on_boundary=True,
 ):
     """Vertical fault through an offset reservoir (Jansen & Meulenbroek 2022).
 
     Left reservoir a < y < b for x < 0, right c < y < d for x > 0 (c = a +
     throw); both reach the rollers at x = +-far (laterally infinite).  The
-    mesh line x = 0 bounds the two pressure boxes; the fault runs at x = h / 2
-    (the middle of the first column right of it), so the XFEM cut is
-    mid-cell.  Homogeneous rock; in-situ stress -30 MPa isotropic, p0 = 10 MPa.
-    Returns (text, (a, b, c, d), x_fault).
+    fault runs ON the pressure boundary x = 0, in the middle of a column of
+    cells (mesh lines at x = +-h/2): the XFEM cut is mid-cell and the cut cells
+    are split between the two reservoirs per quadrature point (xfemslip.poro).
+    ``on_boundary=False``: the former set-up, mesh line at x = 0 and the fault
+    half a cell off it at x = h / 2.  Homogeneous rock; in-situ stress -30 MPa
+    isotropic, p0 = 10 MPa.  Returns (text, (a, b, c, d), x_fault).
     """
     a, b = -thickness / 2.0, thickness / 2.0
     c, d = a + throw, b + throw
-    x = graded_axis(-20 * h, 20 * h, h, -far, far)
+    shift = h / 2.0 if on_boundary else 0.0
+    x = graded_axis(-20 * h - shift, 20 * h + shift, h, -far, far)
     y = graded_axis(a - 2.5 * thickness, d + 2.5 * thickness, h, -far, far)
-    xf = h / 2.0
+    xf = 0.0 if on_boundary else h / 2.0
     text = f"""
 [mesh]
 x = {_list(x)}

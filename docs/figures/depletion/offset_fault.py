@@ -1,6 +1,7 @@
 """Figure offset_fault.png of the README (section Depletion): the vertical
 fault through an offset reservoir, FE against the closed forms (J1), (J2) of
-xfemslip.closed_form_depletion, h = 5 m (the verification tests' set-up).
+xfemslip.closed_form_depletion, h = 5 m (the verification tests' set-up: the
+fault ON the pressure boundary x = 0, mid-cell).
 
     PYTHONPATH=. python docs/figures/depletion/offset_fault.py
 """
@@ -77,7 +78,8 @@ def main():
         ax.legend(fontsize=8, loc="lower right")
     fig.suptitle(
         "vertical fault through an offset reservoir (thickness 100 m, throw "
-        "30 m), dp = -10 MPa, E = 10 GPa, nu = 0.25, h = 5 m",
+        "30 m), dp = -10 MPa, E = 10 GPa, nu = 0.25, h = 5 m,\nfault on the "
+        "pressure boundary x = 0 (mid-cell)",
         fontsize=9,
     )
     out = Path(__file__).with_name("offset_fault.png")
