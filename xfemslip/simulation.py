@@ -125,6 +125,7 @@ def build_model(spec) -> Model:
         * mesh.h_min
         / mat.E,
         node_xy=mesh.nodes,
+        load_stress=spec.loading.stress,
     )
     logger.info(
         "model: %d x %d cells, %d fracture(s), %d dofs (%d nodes enriched with %d "
