@@ -237,9 +237,7 @@ def main() -> int:
             for state in xfem:
                 xfem_once(state)
             for h in args.ogs_h:
-                ogs[h].append(
-                    ogs_once(h, i, folder, args.ogs_python, args.ogs_script)
-                )
+                ogs[h].append(ogs_once(h, i, folder, args.ogs_python, args.ogs_script))
         rows = [xfem_result(state) for state in xfem]
         rows += [ogs_result(h, ogs[h]) for h in args.ogs_h]
         for row in rows:

@@ -181,8 +181,10 @@ def table(results) -> str:
         )
         floor = f"{fl:.2f} ({f['solve']:.2f})" if fl else f.get("error", "-")
         floor_rss = f"{f['maxrss_mib']:.0f}" if fl else "-"
+        flag = r["solver"].partition("/")[2]  # "nopred": without the predictor
+        method = r["method"] + (f"/{flag}" if flag else "")
         lines.append(
-            f"| {r['n']} | {r['dofs']:,} | {r['method']}{r['solver'][len(r['solver'].partition('/')[0]):]} | {r['build_cpu']:.2f} | "
+            f"| {r['n']} | {r['dofs']:,} | {method} | {r['build_cpu']:.2f} | "
             f"{r['solve_cpu']:.2f} ({r['solve']:.2f}) | {sum(r['iterations'])} | "
             f"{r['factorizations']} / {r['krylov_iterations']} | "
             f"{r['maxrss_mib']:.0f} | {floor} | {floor_rss} | {ratio} | {ratio_lu} | "

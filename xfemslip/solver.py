@@ -120,9 +120,7 @@ class NewtonSolver:
         # guess the stick/slip set of each step (consistent tangent only: the
         # secant one is not exact within a set, so the guess would not pay)
         self.predictor = (
-            bool(predictor)
-            and tangent == "consistent"
-            and problem.contact.n > 0
+            bool(predictor) and tangent == "consistent" and problem.contact.n > 0
         )
         self.max_cuts = int(max_step_cuts)
         self.tol = tolerance

@@ -32,7 +32,9 @@ PLATE = ROOT / "cases" / "liu_borja_plate.toml"
 
 
 def _reservoir(n=20, angle=45.0, friction=0.1, steps=1):
-    text = RESERVOIR.read_text().replace("elements = [50, 50]", f"elements = [{n}, {n}]")
+    text = RESERVOIR.read_text().replace(
+        "elements = [50, 50]", f"elements = [{n}, {n}]"
+    )
     text = text.replace("angle = 45.0", f"angle = {angle!r}")
     text = text.replace("friction = 0.1", f"friction = {friction!r}")
     text = text.replace("steps = 1", f"steps = {steps}")
@@ -99,6 +101,8 @@ def test_stuck_fracture_takes_one_solve_and_no_guess():
     assert np.all(guess.completed[-1].contact.state == STICK)
     assert _solves(plain) == _solves(guess) == [1]
     assert guess.completed[-1].predicted == 0
+    st = guess.linear.stats  # shortest path: one factorization, no Krylov
+    assert st["factorizations"] == 1 and st["krylov_iterations"] == 0
 
 
 @pytest.mark.parametrize("edge", [0, 1])
@@ -224,7 +228,9 @@ def test_predicted_law_is_the_true_law_on_its_branch():
     fp = law.evaluate(step.u + d, mode, c.pt_committed, c.gt_committed).force
     fm = law.evaluate(step.u - d, mode, c.pt_committed, c.gt_committed).force
     Kd = c.tangent_matrix(forced) @ d
-    np.testing.assert_allclose((fp - fm) / 2.0, Kd, rtol=1e-6, atol=1e-9 * np.abs(Kd).max())
+    np.testing.assert_allclose(
+        (fp - fm) / 2.0, Kd, rtol=1e-6, atol=1e-9 * np.abs(Kd).max()
+    )
 
 
 def test_predict_state_closed_form():
@@ -242,3 +248,23 @@ def test_predict_state_closed_form():
     assert np.all(state == STICK)
     state, _ = predict_state(c, pn0, (1.0e6, 1.0e6, 0.0), 1.0)
     assert np.all(state == 0)  # OPEN
+
+
+def test_no_fracture_is_one_direct_solve():
+    """Without a fracture a run is one factorization and one back-substitution
+    (no Krylov, no band) and equals the direct solution of K u = F."""
+    import scipy.sparse.linalg as spla
+
+    text = RESERVOIR.read_text().replace("elements = [50, 50]", "elements = [16, 16]")
+    start, end = text.index("[[fractures]]"), text.index("[loading]")
+    solver, model = _run(loads_case(text[:start] + text[end:], RESERVOIR), True)
+    st = solver.linear.stats
+    assert _solves(solver) == [1] and st["solves"] == 1
+    assert st["factorizations"] == 1 and st["krylov_iterations"] == 0
+    p = model.problem
+    u = np.zeros(p.n_dofs)
+    u[p.fixed] = p.fixed_values
+    free = solver.free
+    u[free] = spla.spsolve(solver.K_ff.tocsc(), (p.F_unit - p.K @ u)[free])
+    got = solver.completed[-1].u
+    assert np.abs(got - u).max() <= 1e-10 * np.abs(u).max()
