@@ -11,8 +11,8 @@ already uses the branches of the converged state, the step converges in one
 solve followed by a residual check.
 
 The guess: the committed tractions of each contact patch plus the increment
-of the far-field stress (``loading.stress``, when the case has one) resolved
-on the patch,
+of the far-field stress (``loading.stress`` less ``loading.initial_stress``,
+when the case has a ``loading.stress``) resolved on the patch,
 p_N = p_N,committed + d_lambda n.sigma.n and
 p_T = p_T,committed + d_lambda t.sigma.n, put through the return map's
 tests (open if p_N > 0, slip with the sign of p_T if |p_T| > c - f p_N).
@@ -34,12 +34,26 @@ import numpy as np
 from xfemslip.contact import OPEN, SLIP, STICK, ContactSet
 
 
+def stress_increment(loading):
+    """(xx, yy, xy) [Pa] of the far-field stress added from load factor 0 to
+    1: ``loading.stress`` less ``loading.initial_stress`` (the edges carry
+    lambda (sigma - sigma0) . n, boundary.traction_load), or None without a
+    ``loading.stress``."""
+    if loading.stress is None:
+        return None
+    sig = np.array(loading.stress, float)
+    if loading.initial_stress is not None:
+        sig = sig - np.array(loading.initial_stress, float)
+    return tuple(float(v) for v in sig)
+
+
 def predict_state(c: ContactSet, pn_committed, stress, d_lambda):
     """(state, sign) of every patch predicted for a load increment.
 
     c : the contact set (normals, tangents, friction, cohesion, committed p_T);
     pn_committed : (m,) committed normal traction [Pa] (p_N0 before step 1);
-    stress : far-field (xx, yy, xy) at load factor 1 [Pa], or None (no
+    stress : far-field stress added from load factor 0 to 1, (xx, yy, xy)
+        [Pa] (:func:`stress_increment`), or None (no
         increment: the committed state is the guess, which is what a
         displacement-driven step of a monotonic loading needs);
     d_lambda : load-factor increment of the step.

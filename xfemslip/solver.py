@@ -73,8 +73,9 @@ class Problem:
     penalty_ratio: float = 0.0
     # (n_nodes, 2) node coordinates: rigid-body modes of the AMG linear solver
     node_xy: np.ndarray = None
-    # far-field stress (xx, yy, xy) [Pa] at load factor 1 (loading.stress), or
-    # None: only used to guess the stick/slip set of a step (predictor.py)
+    # far-field stress (xx, yy, xy) [Pa] added from load factor 0 to 1
+    # (predictor.stress_increment), or None: only used to guess the stick/slip
+    # set of a step (predictor.py)
     load_stress: tuple = None
 
 

@@ -22,7 +22,7 @@ from xfemslip import kernels
 from xfemslip.case import loads_case
 from xfemslip.closed_form import slip_window
 from xfemslip.contact import SLIP, STICK
-from xfemslip.predictor import predict_state, predicted_law
+from xfemslip.predictor import predict_state, predicted_law, stress_increment
 from xfemslip.simulation import build_model
 from xfemslip.solver import NewtonSolver
 
@@ -268,3 +268,31 @@ def test_no_fracture_is_one_direct_solve():
     u[free] = spla.spsolve(solver.K_ff.tocsc(), (p.F_unit - p.K @ u)[free])
     got = solver.completed[-1].u
     assert np.abs(got - u).max() <= 1e-10 * np.abs(u).max()
+
+
+def test_initial_stress_is_not_a_load():
+    """The edges carry lambda (sigma - sigma0) . n (boundary.traction_load),
+    so the far-field increment that the predictor resolves on the patches is
+    loading.stress less loading.initial_stress; the in-situ traction is in
+    the committed tractions already.  With sigma0 = sigma there is no
+    increment: the step converges at once, without a guess."""
+    base = RESERVOIR.read_text().replace("elements = [50, 50]", "elements = [16, 16]")
+    line = "stress = { xx = -20.0e6, yy = -40.0e6, xy = 0.0 }"
+
+    def with_initial(xx, yy):
+        text = base.replace(
+            line, f"{line}\ninitial_stress = {{ xx = {xx!r}, yy = {yy!r}, xy = 0.0 }}"
+        )
+        return loads_case(text, RESERVOIR)
+
+    spec = with_initial(-10.0e6, -10.0e6)
+    assert stress_increment(spec.loading) == (-10.0e6, -30.0e6, 0.0)
+    assert build_model(spec).problem.load_stress == (-10.0e6, -30.0e6, 0.0)
+    assert stress_increment(_reservoir().loading) == (-20.0e6, -40.0e6, 0.0)
+    spec = with_initial(-20.0e6, -40.0e6)
+    assert stress_increment(spec.loading) == (0.0, 0.0, 0.0)
+    plain, model = _run(spec, False)
+    guess, _ = _run(spec, True)
+    _same_answer(plain, guess, model)
+    assert _solves(guess) == _solves(plain) == [0]
+    assert guess.completed[-1].predicted == 0
