@@ -9,7 +9,10 @@ meaningful reference (eta of the paper with F_ext including reactions).
 
 Tangents: "consistent" uses the exact derivative of the return map (not
 symmetric while slipping), which gives quadratic convergence once the
-stick/slip set has settled; "secant" is the paper's eq. 28 update.  The linear
+stick/slip set has settled; "secant" is the paper's eq. 28 update.  With the
+consistent tangent the first solve of a step uses a predicted stick/slip set
+(xfemslip.predictor): when the guess is right the step converges in one
+solve, when it is wrong Newton goes on from there under the true law.  The linear
 systems go to xfemslip.linsolve (SuperLU with the factorization kept, or
 AMG-preconditioned GMRES), which handles the non-symmetric case.
 """
