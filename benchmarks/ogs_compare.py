@@ -93,26 +93,39 @@ right = "traction"
 """
 
 
-def run_xfem(h, runs, folder: Path) -> dict:
-    import h5py
-
-    from xfemslip.closed_form import relative_l2, slip_profile
-
+def xfem_prepare(h, folder: Path) -> dict:
+    """Write the case and warm the caches; returns the state of its runs."""
     case = folder / f"case_{h:g}.toml"
     case.write_text(xfem_case(h))
     out = folder / f"out_{h:g}"
     cmd = [sys.executable, "-m", "xfemslip", "run", "-q", "--overwrite", str(case)]
     cmd += ["-o", str(out)]
-    subprocess.run(cmd, check=True, capture_output=True)  # warm the Numba cache
-    walls, cpus = [], []
-    for _ in range(runs):
-        before = resource.getrusage(resource.RUSAGE_CHILDREN)
-        start = time.perf_counter()
-        subprocess.run(cmd, check=True, capture_output=True)
-        walls.append(time.perf_counter() - start)
-        after = resource.getrusage(resource.RUSAGE_CHILDREN)
-        cpus.append(after.ru_utime - before.ru_utime + after.ru_stime - before.ru_stime)
-    with h5py.File(out / "result.h5", "r") as f:
+    # Python's bytecode cached as an installed package has it (see
+    # benchmarks/startup.py: PYTHONDONTWRITEBYTECODE=1 recompiles every run)
+    env = dict(os.environ, PYTHONPYCACHEPREFIX=str(folder / "pycache"))
+    env.pop("PYTHONDONTWRITEBYTECODE", None)
+    # warm the Numba and bytecode caches
+    subprocess.run(cmd, check=True, capture_output=True, env=env)
+    return {"h": h, "cmd": cmd, "env": env, "out": out, "walls": [], "cpus": []}
+
+
+def xfem_once(state) -> None:
+    before = resource.getrusage(resource.RUSAGE_CHILDREN)
+    start = time.perf_counter()
+    subprocess.run(state["cmd"], check=True, capture_output=True, env=state["env"])
+    state["walls"].append(time.perf_counter() - start)
+    after = resource.getrusage(resource.RUSAGE_CHILDREN)
+    state["cpus"].append(
+        after.ru_utime - before.ru_utime + after.ru_stime - before.ru_stime
+    )
+
+
+def xfem_result(state) -> dict:
+    import h5py
+
+    from xfemslip.closed_form import relative_l2, slip_profile
+
+    with h5py.File(state["out"] / "result.h5", "r") as f:
         s = f["fractures/0/s"][()]
         slip = f["fractures/0/slip"][()]
         dofs = int(f.attrs["n_dofs"])
@@ -122,30 +135,42 @@ def run_xfem(h, runs, folder: Path) -> dict:
     err = relative_l2(s, sign * slip, exact)
     return {
         "code": "xfemslip",
-        "h": h,
+        "h": state["h"],
         "dofs": dofs,
         "newton": its,
         "err_L2": err,
-        "wall": statistics.median(walls),
-        "walls": walls,
-        "cpu": statistics.median(cpus),
+        "wall": statistics.median(state["walls"]),
+        "walls": state["walls"],
+        "cpu": statistics.median(state["cpus"]),
     }
 
 
-def run_ogs(h, runs, folder: Path, python=OGS_PY, script=OGS_SCRIPT) -> dict:
-    walls, cpus = [], []
-    for i in range(runs):
-        wd = folder / f"ogs_{h:g}_{i}"
-        cmd = [str(python), str(script), "--quads", "--h-frac", str(h)]
-        cmd += ["--workdir", str(wd)]
-        env = {k: v for k, v in os.environ.items() if k != "PYTHONPATH"}
-        subprocess.run(cmd, check=True, capture_output=True, env=env)
-        summary = json.loads((wd / "summary.json").read_text())
-        walls.append(summary["run"]["wall_s"])
-        timev = (wd / "ogs.stderr").read_text()  # /usr/bin/time -v of ogs
-        user = re.search(r"User time \(seconds\): ([0-9.]+)", timev)
-        system = re.search(r"System time \(seconds\): ([0-9.]+)", timev)
-        cpus.append(float(user.group(1)) + float(system.group(1)))
+def run_xfem(h, runs, folder: Path) -> dict:
+    state = xfem_prepare(h, folder)
+    for _ in range(runs):
+        xfem_once(state)
+    return xfem_result(state)
+
+
+def ogs_once(h, i, folder: Path, python=OGS_PY, script=OGS_SCRIPT) -> dict:
+    """One OGS run (its own working directory); returns its summary with the
+    CPU time of the ogs process under "cpu"."""
+    wd = folder / f"ogs_{h:g}_{i}"
+    cmd = [str(python), str(script), "--quads", "--h-frac", str(h)]
+    cmd += ["--workdir", str(wd)]
+    env = {k: v for k, v in os.environ.items() if k != "PYTHONPATH"}
+    subprocess.run(cmd, check=True, capture_output=True, env=env)
+    summary = json.loads((wd / "summary.json").read_text())
+    timev = (wd / "ogs.stderr").read_text()  # /usr/bin/time -v of ogs
+    user = re.search(r"User time \(seconds\): ([0-9.]+)", timev)
+    system = re.search(r"System time \(seconds\): ([0-9.]+)", timev)
+    summary["cpu"] = float(user.group(1)) + float(system.group(1))
+    return summary
+
+
+def ogs_result(h, summaries) -> dict:
+    walls = [x["run"]["wall_s"] for x in summaries]
+    summary = summaries[-1]
     return {
         "code": "OGS",
         "h": h,
@@ -154,8 +179,12 @@ def run_ogs(h, runs, folder: Path, python=OGS_PY, script=OGS_SCRIPT) -> dict:
         "err_L2": summary["result"]["err_L2_rel"],
         "wall": statistics.median(walls),
         "walls": walls,
-        "cpu": statistics.median(cpus),
+        "cpu": statistics.median(x["cpu"] for x in summaries),
     }
+
+
+def run_ogs(h, runs, folder: Path, python=OGS_PY, script=OGS_SCRIPT) -> dict:
+    return ogs_result(h, [ogs_once(h, i, folder, python, script) for i in range(runs)])
 
 
 def at_error(rows, err, key="wall"):
@@ -201,12 +230,18 @@ def main() -> int:
     rows = []
     with tempfile.TemporaryDirectory() as tmp:
         folder = Path(tmp)
-        for h in args.xfem_h:
-            rows.append(run_xfem(h, args.runs, folder))
-            print(json.dumps(rows[-1]), flush=True)
-        for h in args.ogs_h:
-            rows.append(run_ogs(h, args.runs, folder, args.ogs_python, args.ogs_script))
-            print(json.dumps(rows[-1]), flush=True)
+        # runs interleaved: run i of every configuration, then run i + 1
+        xfem = [xfem_prepare(h, folder) for h in args.xfem_h]
+        ogs = {h: [] for h in args.ogs_h}
+        for i in range(args.runs):
+            for state in xfem:
+                xfem_once(state)
+            for h in args.ogs_h:
+                ogs[h].append(ogs_once(h, i, folder, args.ogs_python, args.ogs_script))
+        rows = [xfem_result(state) for state in xfem]
+        rows += [ogs_result(h, ogs[h]) for h in args.ogs_h]
+        for row in rows:
+            print(json.dumps(row), flush=True)
     if args.json:
         args.json.write_text(json.dumps(rows, indent=1))
     report(rows)

@@ -8,6 +8,10 @@ system on the same mesh, measured in the same run.
     python benchmarks/scaling.py --sizes 700 1000 --solvers amg --runs 1 --json b.json
     python benchmarks/scaling.py --merge a.json b.json --plot benchmarks/scaling.png
 
+A solver name with the suffix "/nopred" (e.g. superlu/nopred) runs Newton
+without the stick/slip predictor (xfemslip/predictor.py), against the same
+floor as the plain solver.
+
 Every measurement runs in its own subprocess so that the peak memory
 (resource.getrusage maxrss) belongs to it alone.  For each size and linear
 solver: the cracked run (build = mesh, fractures, enrichment, assembly, contact;
@@ -53,6 +57,7 @@ def one(n: int, solver: str, cracked: bool) -> dict:
     from xfemslip.simulation import build_model
     from xfemslip.solver import NewtonSolver
 
+    solver, _, flag = solver.partition("/")
     spec = loads_case(case_text(n, cracked), CASE)
     t0, c0 = time.perf_counter(), time.process_time()
     model = build_model(spec)
@@ -63,13 +68,15 @@ def one(n: int, solver: str, cracked: bool) -> dict:
         spec.solver.max_iterations,
         spec.solver.tangent,
         solver,
+        predictor=flag != "nopred",
     )
     t2, c2 = time.perf_counter(), time.process_time()
-    out = {"n": n, "solver": solver, "cracked": cracked}
+    out = {"n": n, "solver": solver + (f"/{flag}" if flag else ""), "cracked": cracked}
     if cracked:
         newton.run(spec.loading.steps)
         res = newton.completed[-1]
         out["iterations"] = [r.iterations for r in newton.completed]
+        out["predicted"] = [r.predicted for r in newton.completed]
         out["max_slip"] = float(np.max(np.abs(res.contact.gt)))
         out["contact_dofs"] = int(np.unique(newton.c_dofs[newton.c_dofs >= 0]).size)
     else:
@@ -155,7 +162,7 @@ def table(results) -> str:
     for r in results:
         if not r["cracked"]:
             continue
-        f = floors.get((r["n"], r["solver"]), {})
+        f = floors.get((r["n"], r["solver"].partition("/")[0]), {})
         f_lu = floors.get((r["n"], "superlu"), {})
         if "error" in r:
             lines.append(f"| {r['n']} | | {r['solver']} | {r['error']} |" + " |" * 9)
@@ -174,8 +181,10 @@ def table(results) -> str:
         )
         floor = f"{fl:.2f} ({f['solve']:.2f})" if fl else f.get("error", "-")
         floor_rss = f"{f['maxrss_mib']:.0f}" if fl else "-"
+        flag = r["solver"].partition("/")[2]  # "nopred": without the predictor
+        method = r["method"] + (f"/{flag}" if flag else "")
         lines.append(
-            f"| {r['n']} | {r['dofs']:,} | {r['method']} | {r['build_cpu']:.2f} | "
+            f"| {r['n']} | {r['dofs']:,} | {method} | {r['build_cpu']:.2f} | "
             f"{r['solve_cpu']:.2f} ({r['solve']:.2f}) | {sum(r['iterations'])} | "
             f"{r['factorizations']} / {r['krylov_iterations']} | "
             f"{r['maxrss_mib']:.0f} | {floor} | {floor_rss} | {ratio} | {ratio_lu} | "
@@ -249,7 +258,9 @@ def main() -> int:
     if args.json and args.json.exists():
         results = json.loads(args.json.read_text())
     for n in args.sizes:
-        configs = [(s, c) for s in args.solvers for c in (False, True)]
+        # one floor per linear solver ("x/nopred" shares the floor of "x")
+        bases = dict.fromkeys(s.partition("/")[0] for s in args.solvers)
+        configs = [(s, False) for s in bases] + [(s, True) for s in args.solvers]
         for r in measure(n, configs, args.runs, args.timeout):
             key = (r["n"], r["solver"], r["cracked"])
             results = [x for x in results if (x["n"], x["solver"], x["cracked"]) != key]

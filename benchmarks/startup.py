@@ -7,7 +7,11 @@ by hand together with the machine they were measured on.
     python benchmarks/startup.py [--case cases/reservoir_depletion.toml] [--runs 5]
 
 A cold run gets a fresh, empty NUMBA_CACHE_DIR; warm runs share one that a
-first run has filled.
+first run has filled.  The same holds for Python's bytecode cache
+(PYTHONPYCACHEPREFIX, one per cold run, one shared by the warm runs):
+without it, an environment with PYTHONDONTWRITEBYTECODE=1 (as on the machine
+of benchmarks/RESULTS.md) compiles xfemslip's 39 modules from source in
+every run, 0.05-0.07 s that an installed package does not pay.
 """
 
 from __future__ import annotations
@@ -25,9 +29,16 @@ from pathlib import Path
 CPU: list[float] = []  # CPU time (user + system) of every timed run, in order
 
 
-def timed_run(case: str, cache_dir: str, out: Path) -> float:
-    """Wall time of one `xfemslip run`; its CPU time is appended to CPU."""
-    env = dict(os.environ, NUMBA_CACHE_DIR=cache_dir)
+def timed_run(case: str, cache_dir: str, out: Path, tree: str | None = None) -> float:
+    """Wall time of one `xfemslip run`; its CPU time is appended to CPU.
+    ``tree``: a source tree put first on PYTHONPATH (None: the environment's)."""
+    env = dict(
+        os.environ,
+        **({"PYTHONPATH": tree} if tree else {}),
+        NUMBA_CACHE_DIR=cache_dir,
+        PYTHONPYCACHEPREFIX=str(Path(cache_dir) / "pycache"),
+    )
+    env.pop("PYTHONDONTWRITEBYTECODE", None)
     before = resource.getrusage(resource.RUSAGE_CHILDREN)
     start = time.perf_counter()
     proc = subprocess.run(
@@ -50,7 +61,15 @@ def main() -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--case", default="cases/reservoir_depletion.toml")
     ap.add_argument("--runs", type=int, default=5)
+    ap.add_argument(
+        "--trees",
+        nargs="+",
+        help="only warm runs, of each of these source trees (PYTHONPATH) in turn, "
+        "interleaved run by run",
+    )
     args = ap.parse_args()
+    if args.trees:
+        return compare(args)
     with tempfile.TemporaryDirectory() as tmp:
         out = Path(tmp) / "out"
         cold = []
@@ -76,6 +95,30 @@ def main() -> int:
         f"{statistics.median(cold_cpu):.2f} s, warm run median "
         f"{statistics.median(warm_cpu):.2f} s"
     )
+    return 0
+
+
+def compare(args) -> int:
+    """Warm runs of several source trees, interleaved (each its own caches)."""
+    with tempfile.TemporaryDirectory() as tmp:
+        out = Path(tmp) / "out"
+        caches = {t: str(Path(tmp) / f"warm{i}") for i, t in enumerate(args.trees)}
+        for t in args.trees:
+            timed_run(args.case, caches[t], out, t)  # fill the caches
+        wall = {t: [] for t in args.trees}
+        cpu = {t: [] for t in args.trees}
+        for _ in range(args.runs):
+            for t in args.trees:
+                del CPU[:]
+                wall[t].append(timed_run(args.case, caches[t], out, t))
+                cpu[t].append(CPU[0])
+    print(f"case {args.case}, warm runs, {args.runs} each, interleaved")
+    for t in args.trees:
+        print(
+            f"{t}: wall median {statistics.median(wall[t]):.2f} s "
+            f"(min {min(wall[t]):.2f}, max {max(wall[t]):.2f}); CPU median "
+            f"{statistics.median(cpu[t]):.2f} s (min {min(cpu[t]):.2f})"
+        )
     return 0
 
 

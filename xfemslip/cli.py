@@ -23,7 +23,6 @@ propagates with its traceback.
 from __future__ import annotations
 
 import contextlib
-import importlib.metadata
 import logging
 import platform
 import sys
@@ -270,6 +269,8 @@ def verify(quick, tip, plot, csv_path, penalty, debug) -> None:
 
 def _dist_version(name: str) -> str:
     """Installed version of a distribution, or 'not installed'."""
+    import importlib.metadata  # only here: 0.05 s of imports that a run skips
+
     try:
         return importlib.metadata.version(name)
     except importlib.metadata.PackageNotFoundError:

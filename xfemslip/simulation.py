@@ -37,6 +37,7 @@ from xfemslip.poro import (
 )
 from xfemslip.post import STATE_CODES, bulk_fields, fracture_fields, vis_mesh
 from xfemslip.quadrature import InterfacePoints, interface_points
+from xfemslip.predictor import stress_increment
 from xfemslip.solver import NewtonSolver, Problem, StepResult
 from xfemslip.writers import StepFields
 
@@ -147,6 +148,7 @@ def build_model(spec) -> Model:
         * mesh.h_min
         / mat.E,
         node_xy=mesh.nodes,
+        load_stress=stress_increment(spec.loading),
     )
     logger.info(
         "model: %d x %d cells, %d fracture(s), %d dofs (%d nodes enriched with %d "

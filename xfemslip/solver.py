@@ -9,7 +9,10 @@ meaningful reference (eta of the paper with F_ext including reactions).
 
 Tangents: "consistent" uses the exact derivative of the return map (not
 symmetric while slipping), which gives quadratic convergence once the
-stick/slip set has settled; "secant" is the paper's eq. 28 update.  The linear
+stick/slip set has settled; "secant" is the paper's eq. 28 update.  With the
+consistent tangent the first solve of a step uses a predicted stick/slip set
+(xfemslip.predictor): when the guess is right the step converges in one
+solve, when it is wrong Newton goes on from there under the true law.  The linear
 systems go to xfemslip.linsolve (SuperLU with the factorization kept, or
 AMG-preconditioned GMRES), which handles the non-symmetric case.
 """
@@ -29,6 +32,7 @@ from xfemslip.assembly import coo_block
 from xfemslip.contact import OPEN, SLIP, STICK, ContactResult, ContactSet
 from xfemslip.errors import ConvergenceError
 from xfemslip.linsolve import LinearSolver
+from xfemslip.predictor import predict_state, predicted_law
 
 logger = logging.getLogger(__name__)
 
@@ -72,6 +76,10 @@ class Problem:
     penalty_ratio: float = 0.0
     # (n_nodes, 2) node coordinates: rigid-body modes of the AMG linear solver
     node_xy: np.ndarray = None
+    # far-field stress (xx, yy, xy) [Pa] added from load factor 0 to 1
+    # (predictor.stress_increment), or None: only used to guess the stick/slip
+    # set of a step (predictor.py)
+    load_stress: tuple = None
 
 
 @dataclass
@@ -87,6 +95,8 @@ class StepResult:
     substeps: int = 1  # converged sub-steps that make up this step
     freezes: int = 0  # ping-pong freezes (all sub-steps)
     factors: list = None  # load factors of the converged sub-steps, in order
+    # sub-steps whose first Newton solve used the predicted stick/slip set
+    predicted: int = 0
 
 
 def _regime(state, pt):
@@ -108,8 +118,14 @@ class NewtonSolver:
         linear_solver: str = "auto",
         *,
         max_step_cuts: int = DEFAULT_STEP_CUTS,
+        predictor: bool = True,
     ):
         self.p = problem
+        # guess the stick/slip set of each step (consistent tangent only: the
+        # secant one is not exact within a set, so the guess would not pay)
+        self.predictor = (
+            bool(predictor) and tangent == "consistent" and problem.contact.n > 0
+        )
         self.max_cuts = int(max_step_cuts)
         self.tol = tolerance
         self.max_it = max_iterations
@@ -127,6 +143,9 @@ class NewtonSolver:
         zero = c.evaluate(np.zeros(n), self.mode, c.pt_committed, c.gt_committed)
         self.f_c0 = zero.force
         self.completed: list[StepResult] = []
+        # committed normal traction and load factor (for the predictor)
+        self._pn_committed = c.pn0.copy()
+        self._lam_committed = 0.0
 
     def run(self, steps: int) -> list[StepResult]:
         """Proportional loading in ``steps`` equal load steps."""
@@ -169,7 +188,7 @@ class NewtonSolver:
         """
         units = 1 << self.max_cuts
         done, size = 0, units
-        cuts = substeps = iterations = freezes = 0
+        cuts = substeps = iterations = freezes = predicted = 0
         factors = []  # load factors of the converged sub-steps
         while done < units:
             end = min(done + size, units)
@@ -198,6 +217,8 @@ class NewtonSolver:
                 )
                 continue
             self.p.contact.commit(res)
+            self._pn_committed = res.pn.copy()
+            self._lam_committed = lam
             u = u_new
             done = end
             factors.append(lam)
@@ -206,6 +227,7 @@ class NewtonSolver:
             substeps += 1
             iterations += log.iterations
             freezes += log.freezes
+            predicted += log.predicted
         if cuts:
             logger.info(
                 "step %d/%d converged in %d sub-steps after %d cut(s)",
@@ -227,6 +249,7 @@ class NewtonSolver:
                 substeps=substeps,
                 freezes=freezes,
                 factors=factors,
+                predicted=predicted,
             )
         )
         return u
@@ -331,7 +354,12 @@ class NewtonSolver:
                 history = []
                 res = law.evaluate(u, self.mode, pt_prev, gt_prev)
                 r, eta = self._residual(u, lam, res)
-            du = self._solve(res, r, k, it, eta)
+            guess = self._guess(u, lam, regime) if it == 0 and frozen is None else None
+            if guess is not None:  # first solve with the predicted set
+                log.predicted = 1
+                du = self._solve(guess[0], guess[1], k, it, eta)
+            else:
+                du = self._solve(res, r, k, it, eta)
             pt_prev, gt_prev, prev_regime = res.pt, res.gt, regime
             eta_before = eta
             u, res, r, eta = self._line_search(u, du, lam, eta, pt_prev, gt_prev, law)
@@ -348,6 +376,32 @@ class NewtonSolver:
                 )
                 res = law.evaluate(u, kernels.TANGENT_CONSISTENT, pt_prev, gt_prev)
         raise AssertionError("unreachable")
+
+    def _guess(self, u, lam, regime):
+        """(contact result, residual) at u under the predicted stick/slip set
+        (predictor.py), or None without a prediction or when it is the set
+        of the true law at u already."""
+        if not self.predictor:
+            return None
+        c = self.p.contact
+        state, sign = predict_state(
+            c, self._pn_committed, self.p.load_stress, lam - self._lam_committed
+        )
+        res = predicted_law(c, state, sign).evaluate(
+            u, self.mode, c.pt_committed, c.gt_committed
+        )
+        guess = _regime(res.state, res.pt)
+        if np.array_equal(guess, regime):
+            return None
+        logger.info(
+            "predicted stick/slip set: %d slip, %d stick, %d open (%d differ "
+            "from the state at the start); first solve with it",
+            np.count_nonzero(res.state == SLIP),
+            np.count_nonzero(res.state == STICK),
+            np.count_nonzero(res.state == OPEN),
+            int(np.count_nonzero(guess != regime)),
+        )
+        return res, self._residual(u, lam, res)[0]
 
     def _line_search(self, u, du, lam, eta0, pt_prev, gt_prev, law=None):
         """Backtracking on eta along the Newton direction (Armijo on the norm).
@@ -471,6 +525,7 @@ class _NewtonLog:
     iterations: int = 0
     freezes: int = 0
     fallbacks: int = 0  # secant iterations replaced by a consistent one
+    predicted: int = 0  # 1 if the first solve used the predicted set
     residuals: list = None
     switches: list = None
 

@@ -75,6 +75,7 @@ def solve(text: str, path: Path, tangent="consistent", *, factors=None, **kw):
         kw.get("max_iterations", spec.solver.max_iterations),
         tangent,
         max_step_cuts=kw.get("max_step_cuts", spec.solver.max_step_cuts),
+        predictor=kw.get("predictor", True),
     )
     if factors is None:
         n = spec.loading.steps

@@ -130,9 +130,11 @@ def test_ping_pong_remedy_accepts_only_the_true_law(monkeypatch):
     With the default (three periods) no case of the stress matrix froze."""
     text = reservoir_text(n=20, angle=45.0, friction=0.1)
     monkeypatch.setattr(solver_module, "PINGPONG_PERIODS", 1)
-    frozen = solve(text, RESERVOIR)
+    # without the stick/slip predictor, which lands on the slip set in one
+    # solve and so leaves nothing to freeze
+    frozen = solve(text, RESERVOIR, predictor=False)
     monkeypatch.setattr(solver_module, "PINGPONG_MAX_FREEZES", 0)
-    free = solve(text, RESERVOIR)
+    free = solve(text, RESERVOIR, predictor=False)
     assert frozen.converged and free.converged
     assert frozen.freezes >= 1 and free.freezes == 0
     a, b = frozen.steps[-1], free.steps[-1]
