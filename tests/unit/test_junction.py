@@ -233,3 +233,74 @@ def test_x_wedges_move_independently_only_with_junction_functions():
     for target in (np.ones(len(xy)), h1, h2):
         assert _residual(basis, target) < 1e-10
         assert _residual(two_h, target) < 1e-10
+
+
+# ------------------------------------------------- jumps of junction functions
+
+
+def _case_text(polylines, n=20, tip="ramp", friction=0.0):
+    text = f"""
+[domain]
+size = [1.0, 1.0]
+[mesh]
+elements = [{n}, {n}]
+[material]
+E = 5.0e9
+nu = 0.3
+"""
+    for p in polylines:
+        text += f"""[[fractures]]
+points = {p!r}
+friction = {friction!r}
+kn = 5.0e12
+kt = 5.0e12
+tip = "{tip}"
+"""
+    text += """[loading]
+stress = { xx = -20.0e6, yy = -40.0e6, xy = 5.0e6 }
+[boundary]
+bottom = { uy = 0.0 }
+top = "traction"
+left = "traction"
+right = "traction"
+"""
+    return text
+
+
+def _model(polylines, **kw):
+    from xfemslip.case import loads_case
+    from xfemslip.simulation import build_model
+
+    return build_model(loads_case(_case_text(polylines, **kw), "junction.toml"))
+
+
+@pytest.mark.parametrize("kind", ["X", "T"])
+def test_junction_function_jumps_only_next_to_its_junction(kind):
+    """Only the dofs of one arm's junction function J are non-zero: that arm
+    opens; the other arm of an X does not move at all, and the main fracture
+    jumps only within one cell of the junction (J is constant beyond it)."""
+    from xfemslip.contact import _point_jumps
+
+    sec = [[0.47, 0.2], [0.47, 0.86]] if kind == "X" else [[0.47, 0.53], [0.47, 0.86]]
+    m = _model([MAIN, sec])
+    dm, c, ip = m.bulk.dofmap, m.contact, m.ip
+    cand = find_candidates(m.mesh, m.fractures)
+    arm = -2 if kind == "X" else -1  # the upper arm
+    k = np.nonzero((cand.fracture == 1) & (cand.tip == arm) & (dm.cand_dof >= 0))[0]
+    assert k.size
+    rng = np.random.default_rng(6)
+    u = np.zeros(dm.n_dofs)
+    for d in dm.cand_dof[k]:
+        u[d : d + 2] = rng.uniform(-1.0, 1.0, 2)
+    jump = np.linalg.norm(_point_jumps(u, c.point_dofs, c.point_coef), axis=1)
+    junction = np.array([0.47, 0.53])
+    dist = np.linalg.norm(ip.xy - junction, axis=1)
+    on_sec, on_main = ip.fracture == 1, ip.fracture == 0
+    upper = ip.xy[:, 1] > junction[1]
+    assert jump[on_sec & upper].min() > 0.0
+    assert np.all(jump[on_sec & ~upper] == 0.0)  # the lower arm (X)
+    h = 1.0 / 20
+    assert np.all(jump[on_main & (dist > 2.0 * math.sqrt(2.0) * h)] == 0.0)
+    # J = H(phi_2) above the main, 0 below: it jumps across the main next to
+    # the junction (the fourth wedge of an X)
+    assert jump[on_main & (dist < h)].max() > 0.1
