@@ -429,7 +429,8 @@ def _tip_enrichment(spec, key, tips, length, reach):
 # - an end of a fracture (not on the domain boundary) closer than snap = 0.5 h
 #   to another fracture ENDS ON IT (T): the end is moved onto that fracture,
 #   either back to the crossing point when it overshoots by less than snap
-#   (trimmed), or forward to the nearest point when it stops short (extended).
+#   measured along the fracture (trimmed), or to the nearest point when it
+#   stops short (extended).  An overshoot longer than snap is an X.
 #   A dangling arm shorter than half a cell cannot be resolved by the mesh
 #   (its tip enrichment would sit in the junction cell), so it is not an X;
 # - two ends closer than snap to each other are a shared end point (V): the
@@ -575,12 +576,22 @@ def _pair_junctions(a, b, polylines, free_ends, taken, rank, names, snap, tol):
                         used[k] = True
                 out.append(("V", main, sec, target))
                 continue
-            # an overshoot is trimmed back to the crossing, a gap closed
+            # an overshoot (a crossing on the end segment) is trimmed back to
+            # the crossing if the stub is shorter than snap along the fracture,
+            # else it is an X; a gap is closed at the nearest point
+            seg_len = np.linalg.norm(pf[1] - pf[0] if end == 0 else pf[-1] - pf[-2])
+            over = [
+                (abs(c[arc_k] - end_arc), k)
+                for k, c in enumerate(cross)
+                if abs(c[arc_k] - end_arc) <= seg_len
+            ]
             target = q
-            for k, c in enumerate(cross):
-                if abs(c[arc_k] - end_arc) <= snap:
-                    target = c[2]
-                    used[k] = True
+            if over:
+                along, k = min(over)
+                if along > snap:
+                    continue
+                target = cross[k][2]
+                used[k] = True
             _move_end(pf, end, target.copy())
             taken[f][end] = True
             out.append(("T", g, f, target.copy()))

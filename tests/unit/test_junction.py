@@ -118,6 +118,13 @@ def test_overshoot_beyond_the_snap_distance_is_an_x():
     assert main.junction_s == pytest.approx((0.35,), abs=1e-12)
 
 
+def test_oblique_overshoot_is_measured_along_the_fracture():
+    # the end is 0.3 h from the main but 1.19 h past it along the fracture
+    _, (main, sec) = _build(MAIN, [[0.40, 0.50], [0.9, 0.63]])
+    assert sec.junction_ends == () and len(sec.arms) == 2 and len(sec.tips) == 2
+    np.testing.assert_allclose(sec.points[0], [0.40, 0.50], atol=1e-15)
+
+
 def test_shared_end_point_is_a_v():
     # two fractures from (0.3, 0.3); the longer one keeps its tip at the apex
     long_, short = [[0.3, 0.3], [0.85, 0.4]], [[0.32, 0.31], [0.4, 0.75]]
