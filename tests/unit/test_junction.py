@@ -311,3 +311,29 @@ def test_junction_function_jumps_only_next_to_its_junction(kind):
     # J = H(phi_2) above the main, 0 below: it jumps across the main next to
     # the junction (the fourth wedge of an X)
     assert jump[on_main & (dist < h)].max() > 0.1
+
+
+def test_network_figure_is_written(tmp_path):
+    """plot_results(kinds=["network"]) on a small T-junction run: one PNG,
+    with the slip colour scale running up to the largest |slip| of the run."""
+    from matplotlib.figure import Figure  # noqa: F401  (matplotlib present)
+
+    from xfemslip.case import loads_case
+    from xfemslip.plot import figure_network, plot_results
+    from xfemslip.plot_data import read_result
+    from xfemslip.simulation import run_case
+
+    text = _case_text([MAIN, [[0.47, 0.53], [0.47, 0.86]]], n=16)
+    spec = loads_case(text, tmp_path / "net.toml")
+    run_case(spec, tmp_path / "out")
+    written = plot_results(
+        [tmp_path / "out"], tmp_path / "fig", kinds=["network"], formats=["png"]
+    )
+    assert [p.name for p in written] == ["network.png"]
+    assert written[0].stat().st_size > 10_000
+    data = read_result(tmp_path / "out")
+    fig = figure_network(data)
+    slip_axes = fig.axes[0]
+    top = max(float(np.abs(f.slip).max()) for f in data.fractures)
+    lc = [c for c in slip_axes.collections if c.get_array() is not None]
+    assert len(lc) == 2 and lc[0].norm.vmax == top
