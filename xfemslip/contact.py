@@ -188,16 +188,64 @@ def _cell_size(mesh, cells) -> np.ndarray:
     return np.sqrt((b[:, 1] - b[:, 0]) * (b[:, 3] - b[:, 2]))
 
 
+def _symmetric_groups(lengths, target):
+    """Consecutive items (lengths in cell units) in groups at least ``target``
+    long: greedy from both ends toward the middle, so the reversed list gets
+    the mirrored partition (and a rotated or reflected fracture the same one).
+
+    The two leftovers and an item centred exactly on the middle form a middle
+    group; one shorter than target joins the shorter of its neighbours (on an
+    exact tie the front one: the only case where reversing the list can give
+    another partition).
+    """
+    k = len(lengths)
+    total = float(np.sum(lengths))
+    centre = np.cumsum(lengths) - 0.5 * np.asarray(lengths)
+    tol = 1e-9 * total
+    front = [i for i in range(k) if centre[i] < 0.5 * total - tol]
+    back = [i for i in range(k) if centre[i] > 0.5 * total + tol]
+    mid = [i for i in range(k) if abs(centre[i] - 0.5 * total) <= tol]
+
+    def greedy(items):
+        acc, members, groups = 0.0, [], []
+        for i in items:
+            members.append(i)
+            acc += lengths[i]
+            if acc >= target:
+                groups.append(members)
+                acc, members = 0.0, []
+        return groups, members
+
+    front_groups, front_left = greedy(front)
+    back_groups, back_left = greedy(back[::-1])
+    back_groups = [g[::-1] for g in back_groups[::-1]]
+    middle = front_left + mid + back_left[::-1]
+
+    def size(g):
+        return sum(lengths[i] for i in g)
+
+    if middle and size(middle) < target and (front_groups or back_groups):
+        # too short: it joins the shorter neighbour (the front one on a tie)
+        if front_groups and (
+            not back_groups or size(front_groups[-1]) <= size(back_groups[0])
+        ):
+            middle = front_groups.pop() + middle
+        else:
+            middle = middle + back_groups.pop(0)
+    return front_groups + ([middle] if middle else []) + back_groups
+
+
 def contact_patches(mesh, fractures, ip, length_cells: float) -> np.ndarray:
     """Patch index (n,) of every interface point.
 
     Along each straight segment of each fracture, the pieces of the cut cells
-    (in order along the segment) are gathered greedily into patches at least
+    (in order along the segment) are gathered into patches at least
     ``length_cells`` local cell sizes long (cell size = sqrt of its area, so
-    graded meshes get graded patches); a short remainder joins the last patch.
-    A patch never spans a kink of the polyline, so its normal is one, nor a
-    junction with another fracture (each branch has its own tractions).
-    ``length_cells = 0`` gives one patch per point.
+    graded meshes get graded patches), greedily from both ends of the segment
+    toward its middle (``_symmetric_groups``: the patches do not depend on the
+    fracture's point order).  A patch never spans a kink of the polyline, so
+    its normal is one, nor a junction with another fracture (each branch has
+    its own tractions).  ``length_cells = 0`` gives one patch per point.
     """
     n = ip.n
     if n == 0 or length_cells <= 0.0:
@@ -205,47 +253,29 @@ def contact_patches(mesh, fractures, ip, length_cells: float) -> np.ndarray:
     size = _cell_size(mesh, ip.cell)
     seg = np.zeros(n, np.int64)
     part = np.zeros(n, np.int64)  # stretch between junctions
-    forward = np.ones(n, bool)
     for fi, fr in enumerate(fractures):
         m = ip.fracture == fi
         ends = fr.s_start + fr.length
         seg[m] = np.minimum(np.searchsorted(ends, ip.s[m], side="right"), ends.size - 1)
         part[m] = np.searchsorted(np.asarray(fr.junction_s, float), ip.s[m])
-        t = fr.tangent[seg[m]]
-        forward[m] = (t[:, 0] > 0.0) | ((t[:, 0] == 0.0) & (t[:, 1] > 0.0))
     patch = np.empty(n, np.int64)
     next_id = 0
     order = np.lexsort((ip.s, part, seg, ip.fracture))
     # consecutive runs of one (fracture, segment, junction part); within a
-    # run, pieces by cell, walked in the direction of the segment turned to
-    # t_x > 0 (patches independent of the fracture's point order)
+    # run, pieces by cell
     key = (ip.fracture[order] * (seg.max() + 1) + seg[order]) * (part.max() + 1) + part[
         order
     ]
     runs = np.flatnonzero(np.diff(key)) + 1
     for run in np.split(order, runs):
-        if not forward[run[0]]:
-            run = run[::-1]
         cells, first = np.unique(ip.cell[run], return_index=True)
         cells = cells[np.argsort(first)]  # cells in order along the segment
         piece = {c: [] for c in cells}
         for i in run:
             piece[ip.cell[i]].append(i)
-        acc, members, groups = 0.0, [], []
-        for c in cells:
-            idx = piece[c]
-            members += idx
-            acc += ip.weight[idx].sum() / size[idx[0]]
-            if acc >= length_cells:
-                groups.append(members)
-                acc, members = 0.0, []
-        if members:
-            if groups:
-                groups[-1] += members
-            else:
-                groups.append(members)
-        for g in groups:
-            patch[g] = next_id
+        lengths = [ip.weight[piece[c]].sum() / size[piece[c][0]] for c in cells]
+        for g in _symmetric_groups(lengths, length_cells):
+            patch[[i for c in g for i in piece[cells[c]]]] = next_id
             next_id += 1
     return patch
 
