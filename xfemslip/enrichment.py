@@ -182,24 +182,11 @@ def _cell_lines(fr, b, tol):
     return out
 
 
-def _canonical(lines):
-    """Lines sorted by an order-independent key (normal turned to n_x > 0 or
-    n_x = 0, n_y > 0; then offset): the sub-cells do not depend on the order
-    the fractures are listed in or on their orientation."""
-    keyed = []
-    for point, normal in lines:
-        n = np.asarray(normal, float)
-        if n[0] < 0.0 or (n[0] == 0.0 and n[1] < 0.0):
-            n = -n
-        c = float(n @ point)
-        keyed.append(((round(n[0], 12), round(n[1], 12), round(c, 12)), point, n))
-    keyed.sort(key=lambda r: r[0])
-    out = []
-    for key, point, n in keyed:
-        if out and out[-1][0] == key:  # the same line twice
-            continue
-        out.append((key, point, n))
-    return [(p, n) for _, p, n in out]
+def _listing_free_key(fr):
+    """Key of a fracture that depends neither on its position in the case file
+    nor on its point order: its two end points, sorted."""
+    ends = sorted([tuple(fr.points[0]), tuple(fr.points[-1])])
+    return ends[0] + ends[1]
 
 
 def _candidate_node_values(fractures, mesh, cand, tol):
@@ -222,7 +209,11 @@ def _candidate_node_values(fractures, mesh, cand, tol):
 def _cell_rule(mesh, c, fractures, frs, has_branch, tol):
     """Sub-triangles, quadrature points and weights of one enriched cell."""
     b = mesh.bounds[c]
-    lines = _canonical([ln for fi in frs for ln in _cell_lines(fractures[fi], b, tol)])
+    # the fractures of the cell in a listing-free order, each with its own
+    # lines in its own order: the sub-cells do not depend on the order the
+    # fractures are listed in (and a single fracture's are as before)
+    frs = sorted(frs, key=lambda fi: _listing_free_key(fractures[fi]))
+    lines = [ln for fi in frs for ln in _cell_lines(fractures[fi], b, tol)]
     if not has_branch:
         tris = cell_subtriangles(b, lines, tol)
         return (tris, *triangle_rule(tris))
