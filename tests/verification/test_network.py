@@ -242,3 +242,39 @@ def test_crossing_cracks_converge_richardson():
     assert np.all(err[2] < 0.002), err
     coarse = np.abs(q[0] - q_star)
     np.testing.assert_array_less(np.abs(q_star[:2] + q_star[2:]), 0.01 * coarse[:2])
+
+
+@pytest.mark.parametrize(
+    "polys",
+    [
+        pytest.param(
+            [[[0.25, 0.25], [0.75, 0.75]], [[0.75, 0.25], [0.25, 0.75]]],
+            id="X-on-a-node",
+        ),
+        pytest.param(
+            [[[0.2, 0.5], [0.8, 0.5]], [[0.5, 0.5], [0.7, 0.85]]],
+            id="T-on-a-node-main-on-edges",
+        ),
+        pytest.param(
+            [[[0.2, 0.45], [0.8, 0.45]], [[0.55, 0.45], [0.7, 0.85]]],
+            id="T-inside-an-edge",
+        ),
+    ],
+)
+def test_junction_on_a_node_or_an_edge(polys):
+    """20 x 20 cells (h = 0.05): junctions exactly on a node or an element
+    edge, main fractures along element edges.  The run converges like any
+    other (2 Newton iterations, frictionless); the X's mirror-image cracks
+    slip alike to 0.2 % (measured 0.09 %: with the junction on a node the
+    node's side, H = +1 on the fracture, is not mirror-symmetric); the T's
+    branch slips most at the junction end and least at its tip."""
+    model, res = _solve(polys, 20, stress=SYMMETRIC)
+    assert res.iterations <= 3
+    f0, f1 = _per_fracture(model, res)
+    if len(model.fractures[1].arms) == 2:  # the X
+        a, b = np.abs(f0["slip"]).max(), np.abs(f1["slip"]).max()
+        assert a > 1e-4 and abs(a - b) < 2e-3 * a
+    else:
+        slip = np.abs(f1["slip"])
+        assert model.fractures[1].junction_ends == (0,)
+        assert slip[0] > 0.5 * slip.max() and slip[-1] < 0.5 * slip.max()
