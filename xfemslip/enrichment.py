@@ -11,7 +11,16 @@ the tip cell, where it falls linearly to 0 at the geometric tip (geometry.py):
 the modelled discontinuity ends exactly at the tip, wherever the tip lies.
 A node x_a exactly on the fracture takes H = +1 (eq. 12).
 
-Candidate nodes: every node of a cell that holds a piece of the fracture.
+Junctions (Daux, Moes, Dolbow, Sukumar & Belytschko 2000, IJNME 48): a
+fracture ending on another, or each of the two arms into which the other
+fracture of an X cuts it, is enriched with its own junction function
+J = H(phi) on its side of the main fracture's line and a constant beyond
+(geometry.Cut), one candidate group per arm; nodes enriched by several
+fractures or arms keep independent dofs.  Enriched cells are also cut along
+those lines, so each wedge of a junction cell is integrated on its own.
+
+Candidate nodes: every node of a cell that holds a piece of the fracture (of
+the arm).
 A Heaviside candidate is kept only if its shape function is non-zero somewhere
 on the fracture (``carries_jump``): a node whose support the fracture only
 touches on its boundary is not enriched.
