@@ -9,7 +9,7 @@ Exit codes:
 - 1: the run failed (``ConvergenceError``, ``OutputError``, any other
   ``XfemslipError``);
 - 2: bad input (``CaseError``, ``GeometryError`` and ``MeshError`` -- input
-  that validates key by key but cannot be built, e.g. intersecting fractures --
+  that validates key by key but cannot be built, e.g. overlapping fractures --
   ``xfemslip.errors.UsageError``, a missing case file, bad command-line
   options);
 - 130: interrupted (Ctrl-C, SIGINT); 143: terminated (SIGTERM, see

@@ -17,9 +17,9 @@ import numpy as np
 
 from xfemslip import kernels
 from xfemslip.assembly import coo_block, scatter_vector
-from xfemslip.branch import b1_jump
 from xfemslip.case_specs import AUTO_PENALTY, CONTACT_PATCH_CELLS
-from xfemslip.enrichment import HEAVISIDE
+from xfemslip.enrichment import HEAVISIDE, _group_values
+from xfemslip.geometry import GEOMETRY_TOL
 
 logger = logging.getLogger(__name__)
 
@@ -188,30 +188,84 @@ def _cell_size(mesh, cells) -> np.ndarray:
     return np.sqrt((b[:, 1] - b[:, 0]) * (b[:, 3] - b[:, 2]))
 
 
+def _symmetric_groups(lengths, target):
+    """Consecutive items (lengths in cell units) in groups at least ``target``
+    long: greedy from both ends toward the middle, so the reversed list gets
+    the mirrored partition (and a rotated or reflected fracture the same one).
+
+    The two leftovers and an item centred exactly on the middle form a middle
+    group; one shorter than target joins the shorter of its neighbours (on an
+    exact tie the front one: the only case where reversing the list can give
+    another partition).
+    """
+    k = len(lengths)
+    total = float(np.sum(lengths))
+    centre = np.cumsum(lengths) - 0.5 * np.asarray(lengths)
+    tol = 1e-9 * total
+    front = [i for i in range(k) if centre[i] < 0.5 * total - tol]
+    back = [i for i in range(k) if centre[i] > 0.5 * total + tol]
+    mid = [i for i in range(k) if abs(centre[i] - 0.5 * total) <= tol]
+
+    def greedy(items):
+        acc, members, groups = 0.0, [], []
+        for i in items:
+            members.append(i)
+            acc += lengths[i]
+            if acc >= target:
+                groups.append(members)
+                acc, members = 0.0, []
+        return groups, members
+
+    front_groups, front_left = greedy(front)
+    back_groups, back_left = greedy(back[::-1])
+    back_groups = [g[::-1] for g in back_groups[::-1]]
+    middle = front_left + mid + back_left[::-1]
+
+    def size(g):
+        return sum(lengths[i] for i in g)
+
+    if middle and size(middle) < target and (front_groups or back_groups):
+        # too short: it joins the shorter neighbour (the front one on a tie)
+        if front_groups and (
+            not back_groups or size(front_groups[-1]) <= size(back_groups[0])
+        ):
+            middle = front_groups.pop() + middle
+        else:
+            middle = middle + back_groups.pop(0)
+    return front_groups + ([middle] if middle else []) + back_groups
+
+
 def contact_patches(mesh, fractures, ip, length_cells: float) -> np.ndarray:
     """Patch index (n,) of every interface point.
 
     Along each straight segment of each fracture, the pieces of the cut cells
-    (in order along the segment) are gathered greedily into patches at least
+    (in order along the segment) are gathered into patches at least
     ``length_cells`` local cell sizes long (cell size = sqrt of its area, so
-    graded meshes get graded patches); a short remainder joins the last patch.
-    A patch never spans a kink of the polyline, so its normal is one.
-    ``length_cells = 0`` gives one patch per point.
+    graded meshes get graded patches), greedily from both ends of the segment
+    toward its middle (``_symmetric_groups``: the patches do not depend on the
+    fracture's point order).  A patch never spans a kink of the polyline, so
+    its normal is one, nor a junction with another fracture (each branch has
+    its own tractions).  ``length_cells = 0`` gives one patch per point.
     """
     n = ip.n
     if n == 0 or length_cells <= 0.0:
         return np.arange(n, dtype=np.int64)
     size = _cell_size(mesh, ip.cell)
     seg = np.zeros(n, np.int64)
+    part = np.zeros(n, np.int64)  # stretch between junctions
     for fi, fr in enumerate(fractures):
         m = ip.fracture == fi
-        ends = np.cumsum(fr.length)
+        ends = fr.s_start + fr.length
         seg[m] = np.minimum(np.searchsorted(ends, ip.s[m], side="right"), ends.size - 1)
+        part[m] = np.searchsorted(np.asarray(fr.junction_s, float), ip.s[m])
     patch = np.empty(n, np.int64)
     next_id = 0
-    order = np.lexsort((ip.s, seg, ip.fracture))
-    # consecutive runs of one (fracture, segment); within a run, pieces by cell
-    key = ip.fracture[order] * (seg.max() + 1) + seg[order]
+    order = np.lexsort((ip.s, part, seg, ip.fracture))
+    # consecutive runs of one (fracture, segment, junction part); within a
+    # run, pieces by cell
+    key = (ip.fracture[order] * (seg.max() + 1) + seg[order]) * (part.max() + 1) + part[
+        order
+    ]
     runs = np.flatnonzero(np.diff(key)) + 1
     for run in np.split(order, runs):
         cells, first = np.unique(ip.cell[run], return_index=True)
@@ -219,21 +273,9 @@ def contact_patches(mesh, fractures, ip, length_cells: float) -> np.ndarray:
         piece = {c: [] for c in cells}
         for i in run:
             piece[ip.cell[i]].append(i)
-        acc, members, groups = 0.0, [], []
-        for c in cells:
-            idx = piece[c]
-            members += idx
-            acc += ip.weight[idx].sum() / size[idx[0]]
-            if acc >= length_cells:
-                groups.append(members)
-                acc, members = 0.0, []
-        if members:
-            if groups:
-                groups[-1] += members
-            else:
-                groups.append(members)
-        for g in groups:
-            patch[g] = next_id
+        lengths = [ip.weight[piece[c]].sum() / size[piece[c][0]] for c in cells]
+        for g in _symmetric_groups(lengths, length_cells):
+            patch[[i for c in g for i in piece[cells[c]]]] = next_id
             next_id += 1
     return patch
 
@@ -271,11 +313,23 @@ def _patch_operators(patch, weight, coef, dofs):
     return out_coef, out_dofs, W
 
 
+# Offset of the two probe points x +/- eps n that decide, at an interface
+# point x, the side of every discontinuity of the enrichment functions
+# (relative to the smallest cell size).
+JUMP_PROBE = 1.0e-7
+# |F(x+) - F(x-)| below this is no jump (B2..B4 on their own fracture: cos(pi/2)).
+JUMP_ZERO = 1.0e-10
+
+
 def _jump_operators(mesh, fractures, ip, ec, cand, dofmap):
     """Coefficients (n, J) and dofs (n, 2J) of [[u]] at the interface points.
 
-    Heaviside slot: [[H R]] N_a = 2 R N_a (eq. 14); branch slot B1:
-    [[B1]] N_a = 2 sqrt(r) (n_d . n) N_a; B2..B4 are continuous (no entry).
+    Every enrichment of the point's cell enters with its jump across the
+    point's fracture, [[F]] N_a = (F(x+) - F(x-)) N_a, F evaluated with the
+    sides of x+/- = x +/- eps n: the own Heaviside gives 2 R N_a (eq. 14), the
+    own B1 gives 2 sqrt(r) (n_d . n) N_a (branch.b1_jump), B2..B4 nothing; a
+    junction function of another fracture (Daux et al. 2000) jumps across
+    this fracture next to the junction and is continuous elsewhere.
     """
     n = ip.n
     if n == 0 or ec.slot_cand.shape[1] == 0:
@@ -284,19 +338,27 @@ def _jump_operators(mesh, fractures, ip, ec, cand, dofmap):
     N = mesh.shape_at(ip.cell, ip.xy)  # (n, 4)
     K = ec.slot_cand[pos]  # (n, S) candidate of each slot of the point's cell
     Kc = np.maximum(K, 0)
-    func = cand.func[Kc]
-    valid = (
-        (K >= 0)
-        & (cand.fracture[Kc] == ip.fracture[:, None])
-        & (dofmap.cand_dof[Kc] >= 0)
-        & ((func == HEAVISIDE) | (func == 1))
-    )
-    jump = np.where(func == HEAVISIDE, 2.0 * ip.ramp[:, None], 0.0)
-    for fi, fr in enumerate(fractures):
-        for ti, tip in enumerate(fr.tips):
-            m = valid & (func == 1) & (cand.fracture[Kc] == fi) & (cand.tip[Kc] == ti)
-            rows = np.nonzero(m)[0]
-            jump[m] = b1_jump(tip, ip.xy[rows])
+    live = (K >= 0) & (dofmap.cand_dof[Kc] >= 0)
+    jump = np.zeros(K.shape)
+    eps = JUMP_PROBE * mesh.h_min
+    tol = GEOMETRY_TOL * mesh.h_min
+    group = np.where(live, cand.fracture[Kc] * 100003 + cand.tip[Kc] + 50000, -1)
+    for g in np.unique(group[live]):
+        fi, tip = divmod(int(g), 100003)
+        tip -= 50000
+        fr = fractures[fi]
+        rows, cols = np.nonzero(group == g)
+        pts = ip.xy[rows]
+        off = eps * ip.normal[rows]
+        vals = []
+        for probe in (pts + off, pts - off):
+            side = fr.side(probe)
+            vals.append(_group_values(fractures, fi, tip, pts, side, tol, probe)[0])
+        k = Kc[rows, cols]
+        j = np.where(cand.func[k] == HEAVISIDE, 0, cand.func[k] - 1)
+        d = (vals[0] - vals[1])[np.arange(rows.size), j]
+        jump[rows, cols] = np.where(np.abs(d) > JUMP_ZERO, d, 0.0)
+    valid = live & (jump != 0.0)
     a = np.maximum(ec.slot_node[pos], 0)
     coef_all = np.where(valid, jump * np.take_along_axis(N, a, axis=1), 0.0)
     J = int(valid.sum(axis=1).max())

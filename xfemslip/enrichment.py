@@ -11,7 +11,16 @@ the tip cell, where it falls linearly to 0 at the geometric tip (geometry.py):
 the modelled discontinuity ends exactly at the tip, wherever the tip lies.
 A node x_a exactly on the fracture takes H = +1 (eq. 12).
 
-Candidate nodes: every node of a cell that holds a piece of the fracture.
+Junctions (Daux, Moes, Dolbow, Sukumar & Belytschko 2000, IJNME 48): a
+fracture ending on another, or each of the two arms into which the other
+fracture of an X cuts it, is enriched with its own junction function
+J = H(phi) on its side of the main fracture's line and a constant beyond
+(geometry.Cut), one candidate group per arm; nodes enriched by several
+fractures or arms keep independent dofs.  Enriched cells are also cut along
+those lines, so each wedge of a junction cell is integrated on its own.
+
+Candidate nodes: every node of a cell that holds a piece of the fracture (of
+the arm).
 A Heaviside candidate is kept only if its shape function is non-zero somewhere
 on the fracture (``carries_jump``): a node whose support the fracture only
 touches on its boundary is not enriched.
@@ -76,7 +85,8 @@ class Candidates:
     fracture: np.ndarray  # (k,) int64 fracture position
     node: np.ndarray  # (k,) int64 global node
     func: np.ndarray  # (k,) int64: HEAVISIDE or 1..4 (branch B1..B4)
-    tip: np.ndarray  # (k,) int64 index in fracture.tips for branch functions, else -1
+    tip: np.ndarray  # (k,) int64 index in fracture.tips for branch functions,
+    # else -1 - arm (Heaviside of that arm, geometry.Fracture.arms)
 
 
 @dataclass(frozen=True)
@@ -107,24 +117,48 @@ def find_candidates(mesh, fractures) -> Candidates:
                 near |= set(mesh.cells[fr.piece_cell[k]].tolist())
                 branch |= near
                 rows += [(fi, n, j, ti) for n in sorted(near) for j in (1, 2, 3, 4)]
-        rows += [(fi, int(n), HEAVISIDE, -1) for n in cut_nodes if int(n) not in branch]
+        # one Heaviside per arm (geometry.Fracture.arms): code tip = -1 - arm
+        if len(fr.arms) == 1:
+            arm_nodes = [cut_nodes]
+        else:
+            mid = fr.arc_length(fr.piece_seg, fr.piece_t.mean(axis=1))
+            arm = fr.arm_of(mid)
+            arm_nodes = [
+                np.unique(mesh.cells[np.unique(fr.piece_cell[arm == a])].ravel())
+                for a in range(len(fr.arms))
+            ]
+        for a, nodes in enumerate(arm_nodes):
+            rows += [
+                (fi, int(n), HEAVISIDE, -1 - a) for n in nodes if int(n) not in branch
+            ]
     arr = np.array(rows, dtype=np.int64).reshape(-1, 4)
     return Candidates(*(np.ascontiguousarray(arr[:, i]) for i in range(4)))
 
 
-def candidate_values(fractures, cand, k, pts, side, tol):
-    """F (n,) and grad F (n, 2) of candidate k at points with fracture side (n,)."""
-    F, grad = _group_values(fractures, cand.fracture[k], cand.tip[k], pts, side, tol)
+def candidate_values(fractures, cand, k, pts, side, tol, probe=None):
+    """F (n,) and grad F (n, 2) of candidate k at points with fracture side (n,).
+
+    probe : (n, 2) points deciding the side of junction lines (default pts).
+    """
+    F, grad = _group_values(
+        fractures, cand.fracture[k], cand.tip[k], pts, side, tol, probe
+    )
     j = 0 if cand.func[k] == HEAVISIDE else cand.func[k] - 1
     return F[:, j], grad[:, j]
 
 
-def _group_values(fractures, fi, tip, pts, side, tol):
-    """All functions of one (fracture, tip) group: (n, 1) Heaviside or (n, 4) branch."""
+def _group_values(fractures, fi, tip, pts, side, tol, probe=None):
+    """All functions of one (fracture, tip) group: (n, 1) Heaviside or (n, 4) branch.
+
+    Heaviside of arm a (tip = -1 - a): F = J R with J the junction function of
+    Daux et al. (2000): H(phi) on the arm's side of each junction line, a
+    constant beyond (Fracture.junction_factor, evaluated at probe).
+    """
     fr = fractures[fi]
     if tip < 0:
         R, gR = fr.ramp(pts)
-        return (side * R)[:, None], (side[:, None] * gR)[:, None, :]
+        J = fr.junction_factor(-1 - tip, pts if probe is None else probe, side, tol)
+        return (J * R)[:, None], (J[:, None] * gR)[:, None, :]
     return branch_functions(fr.tips[tip], pts, side, tol)
 
 
@@ -149,7 +183,19 @@ def _cell_lines(fr, b, tol):
             ) @ tip.direction
             if psi.min() < -tol and psi.max() > tol:
                 out.append((point, tip.direction))
+    corners = np.array([[b[0], b[2]], [b[1], b[2]], [b[1], b[3]], [b[0], b[3]]])
+    for point, normal in fr.cut_lines():
+        d = (corners - point) @ normal
+        if d.min() < -tol and d.max() > tol:
+            out.append((point, normal))
     return out
+
+
+def _listing_free_key(fr):
+    """Key of a fracture that depends neither on its position in the case file
+    nor on its point order: its two end points, sorted."""
+    ends = sorted([tuple(fr.points[0]), tuple(fr.points[-1])])
+    return ends[0] + ends[1]
 
 
 def _candidate_node_values(fractures, mesh, cand, tol):
@@ -163,7 +209,7 @@ def _candidate_node_values(fractures, mesh, cand, tol):
             rows = np.nonzero((cand.fracture == fi) & (cand.tip == tip))[0]
             pts = mesh.nodes[cand.node[rows]]
             side = np.where(fr.signed_distance(pts) >= -tol, 1.0, -1.0)
-            F = _group_values(fractures, fi, int(tip), pts, side, tol)[0]
+            F = _group_values(fractures, fi, int(tip), pts, side, tol, pts)[0]
             j = np.where(cand.func[rows] == HEAVISIDE, 0, cand.func[rows] - 1)
             out[rows] = F[np.arange(rows.size), j]
     return out
@@ -172,6 +218,10 @@ def _candidate_node_values(fractures, mesh, cand, tol):
 def _cell_rule(mesh, c, fractures, frs, has_branch, tol):
     """Sub-triangles, quadrature points and weights of one enriched cell."""
     b = mesh.bounds[c]
+    # the fractures of the cell in a listing-free order, each with its own
+    # lines in its own order: the sub-cells do not depend on the order the
+    # fractures are listed in (and a single fracture's are as before)
+    frs = sorted(frs, key=lambda fi: _listing_free_key(fractures[fi]))
     lines = [ln for fi in frs for ln in _cell_lines(fractures[fi], b, tol)]
     if not has_branch:
         tris = cell_subtriangles(b, lines, tol)
@@ -219,10 +269,18 @@ def build_enriched_cells(mesh, fractures, cand: Candidates) -> EnrichedCells:
             slot_fnode[e, s] = cand_fnode[k]
             if (fi, tip) not in cache:
                 st = side_t[fi]
+                cq = np.repeat(centroids, per, axis=0)  # sides from the sub-cell
+                cv = np.repeat(centroids, 3, axis=0)
                 cache[fi, tip] = (
-                    _group_values(fractures, fi, tip, xy, np.repeat(st, per), tol),
+                    _group_values(fractures, fi, tip, xy, np.repeat(st, per), tol, cq),
                     _group_values(
-                        fractures, fi, tip, tris.reshape(-1, 2), np.repeat(st, 3), tol
+                        fractures,
+                        fi,
+                        tip,
+                        tris.reshape(-1, 2),
+                        np.repeat(st, 3),
+                        tol,
+                        cv,
                     )[0],
                 )
             (Fq, gq), Fvert = cache[fi, tip]
@@ -316,8 +374,6 @@ def select_enrichment(
     ref = np.stack([std_diag[2 * cand.node], std_diag[2 * cand.node + 1]], axis=1)
     ratio = (diag / ref).min(axis=1) if k else np.zeros(0)
     keep = ratio >= ENRICHMENT_DIAG_RATIO
-    if jumps is not None:
-        keep &= jumps
     if jumps is not None:
         keep &= jumps
     cand_dof = -np.ones(k, np.int64)

@@ -11,7 +11,7 @@ distance along the outward tip direction d_k (positive ahead of the tip).
 from __future__ import annotations
 
 import logging
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -55,6 +55,33 @@ class Tip:
 
 
 @dataclass(frozen=True)
+class Cut:
+    """A junction's cut of one arm's Heaviside (Daux et al. 2000, eq. 8).
+
+    The arm's function is J = H(phi) on the side ``sign`` of the line through
+    ``point`` with unit normal ``normal`` (the main fracture's segment at the
+    junction), and the constant ``far`` on the other side.
+    """
+
+    point: np.ndarray  # (2,) junction point [m]
+    normal: np.ndarray  # (2,) unit normal of the main fracture's segment
+    sign: float  # +1/-1: side of that line where the arm lies
+    far: float  # value of J beyond the line (0 at T and X; outer side at V)
+
+
+@dataclass(frozen=True)
+class Junction:
+    """Where two fractures meet (positions in the fracture list)."""
+
+    kind: str  # "X" (both continue), "T" (secondary ends on main), "V" (shared end)
+    point: np.ndarray  # (2,) [m]
+    main: int
+    secondary: int
+    s_main: float  # arc length of the junction on the main [m]
+    s_secondary: float  # arc length of the junction on the secondary [m]
+
+
+@dataclass(frozen=True)
 class Fracture:
     index: int  # position in the case file
     points: np.ndarray  # (k, 2) polyline clipped to the domain [m]
@@ -74,6 +101,27 @@ class Fracture:
     kt: float | None
     tip_mode: str = "branch"  # "branch" | "ramp" (enrichment.py)
     tip_radius: float = 0.0  # branch enrichment radius around each tip [m]
+    # junctions (build_fractures): the fracture is cut into arms at the X
+    # crossings where it is the secondary; arm a covers arc lengths between
+    # arm_splits[a-1] and arm_splits[a] and has its own Heaviside enrichment,
+    # cut by the lines in arms[a].  junction_s: arc lengths of all junctions on
+    # the fracture (contact patches and cell pieces are split there).
+    arm_splits: tuple = ()
+    arms: tuple = ((),)
+    junction_s: tuple = ()
+    junction_ends: tuple = ()  # ends (0 first, 1 last) lying on another fracture
+
+    def arm_of(self, s: np.ndarray) -> np.ndarray:
+        """Arm of points at arc lengths s (n,) int64."""
+        return np.searchsorted(np.asarray(self.arm_splits, float), s).astype(np.int64)
+
+    def junction_factor(self, arm, probe, side, tol=0.0) -> np.ndarray:
+        """J / H of an arm at points probe (n, 2) with H = side (n,) (Cut)."""
+        J = np.asarray(side, float).copy()
+        for cut in self.arms[arm]:
+            beyond = cut.sign * ((np.atleast_2d(probe) - cut.point) @ cut.normal) < -tol
+            J[beyond] = cut.far
+        return J
 
     def signed_distance(self, pts: np.ndarray) -> np.ndarray:
         """phi at points (n, 2) [m] (eq. 13)."""
@@ -138,7 +186,12 @@ class Fracture:
         for tip in self.tips:
             lines.append((tip.point, tip.direction))
             lines.append((tip.point - tip.ramp_length * tip.direction, tip.direction))
+        lines += self.cut_lines()
         return lines
+
+    def cut_lines(self) -> list[tuple[np.ndarray, np.ndarray]]:
+        """The junction lines across which an arm's function J jumps."""
+        return [(c.point, c.normal) for arm in self.arms for c in arm]
 
     def arc_length(self, seg: np.ndarray, t: np.ndarray) -> np.ndarray:
         """Arc length [m] of the points at parameter t of segments seg."""
@@ -239,12 +292,23 @@ def _cell_pieces(mesh, points, tol):
     )
 
 
-def build_fracture(mesh, spec, box) -> Fracture:
-    """Fracture from a FractureSpec on a mesh; box = [x0, x1, y0, y1] of the domain."""
+def build_fracture(
+    mesh, spec, box, points=None, s_offset=0.0, junction_ends=(), reach=None
+) -> Fracture:
+    """Fracture from a FractureSpec on a mesh; box = [x0, x1, y0, y1] of the domain.
+
+    points / s_offset : the polyline already clipped (and snapped to its
+    junctions, build_fractures); junction_ends : ends lying on another fracture
+    (no tip there); reach : {end: arc length from that tip to the nearest
+    junction} (the branch functions must not reach past a junction).
+    """
     key = f"fractures[{spec.index}]"
     tol = GEOMETRY_TOL * mesh.h_min
-    raw = np.asarray(spec.points, dtype=float)
-    pts, s_offset = _clip_to_domain(raw, box, tol, key)
+    if points is None:
+        raw = np.asarray(spec.points, dtype=float)
+        pts, s_offset = _clip_to_domain(raw, box, tol, key)
+    else:
+        pts = np.asarray(points, dtype=float)
     if pts.shape[0] < 2:
         raise GeometryError(
             f"{key}: less than {tol:.1e} m of the fracture lies in the domain"
@@ -260,7 +324,7 @@ def build_fracture(mesh, spec, box) -> Fracture:
     tips = []
     for end in (0, 1):
         p = pts[0] if end == 0 else pts[-1]
-        if _on_boundary(p, box, tol):
+        if _on_boundary(p, box, tol) or end in junction_ends:
             continue
         direction = -tangent[0] if end == 0 else tangent[-1]
         k = 0 if end == 0 else -1
@@ -276,7 +340,7 @@ def build_fracture(mesh, spec, box) -> Fracture:
                 sign=1.0 if end == 1 else -1.0,
             )
         )
-    tip_mode, radius = _tip_enrichment(spec, key, tips, length)
+    tip_mode, radius = _tip_enrichment(spec, key, tips, length, reach or {})
     frac = Fracture(
         index=spec.index,
         points=pts,
@@ -294,6 +358,7 @@ def build_fracture(mesh, spec, box) -> Fracture:
         kt=spec.kt,
         tip_mode=tip_mode,
         tip_radius=float(radius),
+        junction_ends=tuple(sorted(junction_ends)),
     )
     logger.debug(
         "%s: %d segment(s), %d tip(s), %d cut cells",
@@ -305,7 +370,7 @@ def build_fracture(mesh, spec, box) -> Fracture:
     return frac
 
 
-def _tip_enrichment(spec, key, tips, length):
+def _tip_enrichment(spec, key, tips, length, reach):
     """Tip mode and branch radius of a fracture, within what its geometry allows.
 
     B1 jumps along the whole straight ray behind its tip, so the supports of
@@ -334,12 +399,12 @@ def _tip_enrichment(spec, key, tips, length):
         seg = length[0] if tip.end == 0 else length[-1]
         diag = np.sqrt(2.0) * tip.cell_size
         limit = min(limit, min(seg, 0.5 * float(length.sum())) - diag)
+        limit = min(limit, reach.get(tip.end, np.inf) - diag)
         if limit < diag:
             logger.warning(
                 '%s: tip = "branch" needs a straight tip segment of at least 2 cell '
-                "diagonals (%.3g m) on each side of a tip; this fracture is too short "
-                "or "
-                'kinked near a tip, so it uses tip = "ramp"',
+                "diagonals (%.3g m) on each side of a tip; this fracture is too short, "
+                'kinked or meets another fracture near a tip, so it uses tip = "ramp"',
                 key,
                 2 * diag,
             )
@@ -358,47 +423,333 @@ def _tip_enrichment(spec, key, tips, length):
     return mode, float(radius)
 
 
-def _segments_cross(a0, a1, b0, b1):
-    """True if closed segments a and b intersect."""
+# ------------------------------------------------------------------ junctions
+#
+# Tolerance rules (JUNCTION_SNAP_CELLS, relative to the smallest cell size h):
+# - an end of a fracture (not on the domain boundary) closer than snap = 0.5 h
+#   to another fracture ENDS ON IT (T): the end is moved onto that fracture,
+#   either back to the crossing point when it overshoots by less than snap
+#   measured along the fracture (trimmed), or to the nearest point when it
+#   stops short (extended).  An overshoot longer than snap is an X.
+#   A dangling arm shorter than half a cell cannot be resolved by the mesh
+#   (its tip enrichment would sit in the junction cell), so it is not an X;
+# - two ends closer than snap to each other are a shared end point (V): the
+#   secondary's end is moved onto the main's;
+# - every other crossing is an X; fractures overlapping along a common line
+#   (parallel and closer than the geometric tolerance) are refused.
+# A junction on a mesh node or edge needs no special case: cell pieces are
+# split at the junction only where it lies strictly inside a piece.
+JUNCTION_SNAP_CELLS = 0.5
 
-    def orient(p, q, r):
-        return (q[0] - p[0]) * (r[1] - p[1]) - (q[1] - p[1]) * (r[0] - p[0])
 
-    o1, o2 = orient(a0, a1, b0), orient(a0, a1, b1)
-    o3, o4 = orient(b0, b1, a0), orient(b0, b1, a1)
-    if o1 * o2 < 0 and o3 * o4 < 0:
-        return True
+def _closest_on_polyline(pts, p):
+    """Distance, segment, parameter and point of the polyline nearest to p."""
+    a = pts[:-1]
+    d = pts[1:] - a
+    t = np.clip(np.einsum("mk,mk->m", p - a, d) / np.einsum("mk,mk->m", d, d), 0, 1)
+    q = a + t[:, None] * d
+    dist = np.linalg.norm(q - p, axis=1)
+    j = int(np.argmin(dist))
+    return float(dist[j]), j, float(t[j]), q[j]
 
-    def on(p, q, r):
-        return min(p[0], q[0]) <= r[0] <= max(p[0], q[0]) and min(p[1], q[1]) <= r[
-            1
-        ] <= max(p[1], q[1])
 
-    return any(
-        o == 0 and on(p, q, r)
-        for o, p, q, r in (
-            (o1, a0, a1, b0),
-            (o2, a0, a1, b1),
-            (o3, b0, b1, a0),
-            (o4, b0, b1, a1),
+def _arc(pts, seg, t):
+    """Arc length from the polyline's first point of (seg, t)."""
+    seg_len = np.linalg.norm(np.diff(pts, axis=0), axis=1)
+    return float(seg_len[:seg].sum() + t * seg_len[seg])
+
+
+def _crossings(pa, pb, tol, names):
+    """Crossing points of two polylines: list of (arc_a, arc_b, point).
+
+    Fractures overlapping along a common line raise GeometryError.
+    """
+    out = []
+    for i in range(len(pa) - 1):
+        d1 = pa[i + 1] - pa[i]
+        l1 = np.linalg.norm(d1)
+        for j in range(len(pb) - 1):
+            d2 = pb[j + 1] - pb[j]
+            l2 = np.linalg.norm(d2)
+            r = pb[j] - pa[i]
+            cross = d1[0] * d2[1] - d1[1] * d2[0]
+            if abs(cross) <= 1e-12 * l1 * l2:
+                # parallel: refuse a collinear overlap
+                off = abs(r[0] * d1[1] - r[1] * d1[0]) / l1
+                if off <= tol:
+                    u0 = (r @ d1) / l1
+                    u1 = ((pb[j + 1] - pa[i]) @ d1) / l1
+                    lo, hi = max(min(u0, u1), 0.0), min(max(u0, u1), l1)
+                    if hi - lo > tol:
+                        raise GeometryError(
+                            f"{names[0]} and {names[1]} overlap along a common line "
+                            f"(segments {i} and {j}); merge them into one fracture "
+                            "or move one"
+                        )
+                continue
+            ta = (r[0] * d2[1] - r[1] * d2[0]) / cross
+            tb = (r[0] * d1[1] - r[1] * d1[0]) / cross
+            ea, eb = tol / l1, tol / l2
+            if -ea <= ta <= 1 + ea and -eb <= tb <= 1 + eb:
+                ta, tb = min(max(ta, 0.0), 1.0), min(max(tb, 0.0), 1.0)
+                x = pa[i] + ta * d1
+                if all(np.linalg.norm(x - q[2]) > tol for q in out):
+                    out.append((_arc(pa, i, ta), _arc(pb, j, tb), x))
+    return out
+
+
+def _rank_key(pts, h):
+    """Order-independent rank of a fracture for the choice of the main one at
+    an X or V: the longer one (to 1e-6 h), then the smaller end point."""
+    length = float(np.linalg.norm(np.diff(pts, axis=0), axis=1).sum())
+    ends = sorted([tuple(pts[0]), tuple(pts[-1])])
+    return (-round(length / (1e-6 * h)), ends[0], ends[1])
+
+
+def find_junctions(polylines, free_ends, names, h, tol):
+    """Junctions between clipped polylines; snaps ends in place (see above).
+
+    polylines : list of (k, 2) arrays (modified in place when an end snaps);
+    free_ends : list of [bool, bool], ends not on the domain boundary.
+    Returns a list of (kind, main, secondary, point).
+    """
+    snap = JUNCTION_SNAP_CELLS * h
+    n = len(polylines)
+    if n < 2:
+        return []
+    lo = np.array([p.min(axis=0) for p in polylines]) - snap
+    hi = np.array([p.max(axis=0) for p in polylines]) + snap
+    rank = [_rank_key(p, h) for p in polylines]
+    taken = [[False, False] for _ in range(n)]  # ends already on a fracture
+    out = []
+    for a in range(n):
+        near = np.nonzero(
+            np.all(lo[a + 1 :] <= hi[a], 1) & np.all(hi[a + 1 :] >= lo[a], 1)
         )
+        for b in (near[0] + a + 1).tolist():
+            out += _pair_junctions(
+                a, b, polylines, free_ends, taken, rank, names, snap, tol
+            )
+    return out
+
+
+def _pair_junctions(a, b, polylines, free_ends, taken, rank, names, snap, tol):
+    pa, pb = polylines[a], polylines[b]
+    cross = _crossings(pa, pb, tol, (names[a], names[b]))
+    la = float(np.linalg.norm(np.diff(pa, axis=0), axis=1).sum())
+    lb = float(np.linalg.norm(np.diff(pb, axis=0), axis=1).sum())
+    used = [False] * len(cross)
+    out = []
+    # ends on the other fracture (T), shared ends (V)
+    for f, g, pf, pg, lf, _lg, arc_k in (
+        (a, b, pa, pb, la, lb, 0),
+        (b, a, pb, pa, lb, la, 1),
+    ):
+        for end in (0, 1):
+            if not free_ends[f][end] or taken[f][end]:
+                continue
+            p = pf[0] if end == 0 else pf[-1]
+            dist, _, _, q = _closest_on_polyline(pg, p)
+            if dist > snap:
+                continue
+            # the other's ends near p: a V
+            v_end = None
+            for e2 in (0, 1):
+                pe = pg[0] if e2 == 0 else pg[-1]
+                if (
+                    free_ends[g][e2]
+                    and not taken[g][e2]
+                    and np.linalg.norm(pe - p) <= snap
+                ):
+                    v_end = e2
+            end_arc = 0.0 if end == 0 else lf
+            if v_end is not None:
+                main, sec = (g, f) if rank[g] <= rank[f] else (f, g)
+                sec_end = end if sec == f else v_end
+                main_end = v_end if sec == f else end
+                pm = polylines[main]
+                target = (pm[0] if main_end == 0 else pm[-1]).copy()
+                _move_end(polylines[sec], sec_end, target)
+                taken[f][end] = taken[g][v_end] = True
+                for k, c in enumerate(cross):  # the crossing at the shared end
+                    if np.linalg.norm(c[2] - target) <= snap:
+                        used[k] = True
+                out.append(("V", main, sec, target))
+                continue
+            # an overshoot (a crossing on the end segment) is trimmed back to
+            # the crossing if the stub is shorter than snap along the fracture,
+            # else it is an X; a gap is closed at the nearest point
+            seg_len = np.linalg.norm(pf[1] - pf[0] if end == 0 else pf[-1] - pf[-2])
+            over = [
+                (abs(c[arc_k] - end_arc), k)
+                for k, c in enumerate(cross)
+                if abs(c[arc_k] - end_arc) <= seg_len
+            ]
+            target = q
+            if over:
+                along, k = min(over)
+                if along > snap:
+                    continue
+                target = cross[k][2]
+                used[k] = True
+            _move_end(pf, end, target.copy())
+            taken[f][end] = True
+            out.append(("T", g, f, target.copy()))
+    for k, c in enumerate(cross):
+        if used[k]:
+            continue
+        main, sec = (a, b) if rank[a] <= rank[b] else (b, a)
+        out.append(("X", main, sec, c[2].copy()))
+    return out
+
+
+def _move_end(pts, end, target):
+    if end == 0:
+        pts[0] = target
+    else:
+        pts[-1] = target
+
+
+def _junction_cut(main, sec, point, direction, far):
+    """Cut of the secondary's arm lying in ``direction`` from the junction."""
+    _, j, _, _ = _closest_on_polyline(main.points, point)
+    nrm = main.normal[j]
+    side = float(np.sign(direction @ nrm))
+    if side == 0.0:
+        raise GeometryError(
+            f"fractures[{sec.index}] meets fractures[{main.index}] tangentially"
+        )
+    return Cut(point=np.asarray(point, float), normal=nrm, sign=side, far=far)
+
+
+def _split_pieces(fr, s_values, tol):
+    """Split the cell pieces of fr at the arc lengths s_values."""
+    cells, segs, ts = (
+        list(fr.piece_cell),
+        list(fr.piece_seg),
+        [tuple(t) for t in fr.piece_t],
+    )
+    for s in s_values:
+        seg = int(
+            np.clip(
+                np.searchsorted(fr.s_start, s, side="right") - 1, 0, fr.length.size - 1
+            )
+        )
+        t = (s - fr.s_start[seg]) / fr.length[seg]
+        e = tol / fr.length[seg]
+        for k in range(len(cells)):
+            ta, tb = ts[k]
+            if segs[k] == seg and ta + e < t < tb - e:
+                cells.insert(k + 1, cells[k])
+                segs.insert(k + 1, seg)
+                ts[k] = (ta, t)
+                ts.insert(k + 1, (t, tb))
+                break
+    return (
+        np.array(cells, np.int64),
+        np.array(segs, np.int64),
+        np.array(ts, float).reshape(-1, 2),
     )
 
 
 def build_fractures(mesh, specs, box) -> tuple[Fracture, ...]:
-    """All fractures of a case; intersecting fractures are refused (no networks yet)."""
-    fracs = tuple(build_fracture(mesh, s, np.asarray(box, float)) for s in specs)
-    for a in range(len(fracs)):
-        for b in range(a + 1, len(fracs)):
-            pa, pb = fracs[a].points, fracs[b].points
-            for i in range(len(pa) - 1):
-                for j in range(len(pb) - 1):
-                    if _segments_cross(pa[i], pa[i + 1], pb[j], pb[j + 1]):
-                        raise GeometryError(
-                            f"fractures[{fracs[a].index}] and "
-                            f"fractures[{fracs[b].index}] "
-                            "intersect: intersecting fractures (networks) are not "
-                            "supported "
-                            "yet; move one so they do not touch"
-                        )
-    return fracs
+    """All fractures of a case, with their junctions (X, T/Y, V)."""
+    box = np.asarray(box, float)
+    tol = GEOMETRY_TOL * mesh.h_min
+    names = [f"fractures[{s.index}]" for s in specs]
+    clipped, offsets, free = [], [], []
+    for spec, key in zip(specs, names, strict=True):
+        pts, s_off = _clip_to_domain(np.asarray(spec.points, float), box, tol, key)
+        clipped.append(pts.copy())
+        offsets.append(s_off)
+        free.append(
+            [not _on_boundary(pts[0], box, tol), not _on_boundary(pts[-1], box, tol)]
+        )
+    before = [p.copy() for p in clipped]
+    found = find_junctions(clipped, free, names, mesh.h_min, tol)
+    for f, (p0, p1) in enumerate(zip(before, clipped, strict=True)):
+        # an end moved along the first segment shifts the arc-length origin
+        t0 = (p0[1] - p0[0]) / np.linalg.norm(p0[1] - p0[0])
+        offsets[f] += float((p1[0] - p0[0]) @ t0)
+        if np.any(np.linalg.norm(np.diff(p1, axis=0), axis=1) <= tol):
+            raise GeometryError(
+                f"{names[f]}: a segment vanishes where the fracture is snapped onto "
+                "a junction; move its end point"
+            )
+    junction_ends = [set() for _ in specs]
+    arcs = [[] for _ in specs]  # junction arc lengths (polyline own, from pts[0])
+    for kind, main, sec, point in found:
+        if kind in ("T", "V"):
+            pts = clipped[sec]
+            junction_ends[sec].add(0 if np.allclose(pts[0], point, atol=tol) else 1)
+        for f in (main, sec):
+            _, j, t, _ = _closest_on_polyline(clipped[f], point)
+            arcs[f].append(_arc(clipped[f], j, t))
+    reach = []
+    for f, pts in enumerate(clipped):
+        total = float(np.linalg.norm(np.diff(pts, axis=0), axis=1).sum())
+        inner = [s for s in arcs[f] if tol < s < total - tol]
+        reach.append(
+            {0: min(inner, default=np.inf), 1: total - max(inner, default=-np.inf)}
+        )
+    fracs = [
+        build_fracture(
+            mesh, spec, box, clipped[f], offsets[f], tuple(junction_ends[f]), reach[f]
+        )
+        for f, spec in enumerate(specs)
+    ]
+    # arms and cuts (Daux et al. 2000): the secondary of an X is cut into two
+    # arms, each ending on the main; a T / V secondary's end arm is cut too
+    splits = [[] for _ in specs]
+    end_cuts = [{} for _ in specs]
+    for kind, main, sec, point in found:
+        fm, fs = fracs[main], fracs[sec]
+        _, j, t, _ = _closest_on_polyline(fs.points, point)
+        s_sec = float(fs.s_start[j] + t * fs.length[j])
+        if kind == "X":
+            splits[sec].append((s_sec, main, point, fs.tangent[j]))
+            continue
+        end = 0 if np.allclose(fs.points[0], point, atol=tol) else 1
+        inward = fs.tangent[0] if end == 0 else -fs.tangent[-1]
+        far = 0.0
+        if kind == "V":
+            # J is the indicator of the wedge between the two: outer value
+            # beyond the main's line (where the main does not continue)
+            mend = 0 if np.allclose(fm.points[0], point, atol=tol) else 1
+            body = fm.tangent[0] if mend == 0 else -fm.tangent[-1]
+            nrm_s = fs.normal[0] if end == 0 else fs.normal[-1]
+            far = -float(np.sign(body @ nrm_s)) or -1.0
+        end_cuts[sec][end] = _junction_cut(fm, fs, point, inward, far)
+    out = []
+    for f, fr in enumerate(fracs):
+        sp = sorted(splits[f], key=lambda r: r[0])
+        arms = [[] for _ in range(len(sp) + 1)]
+        for k, (_, main, point, tan) in enumerate(sp):
+            arms[k].append(_junction_cut(fracs[main], fr, point, -tan, 0.0))
+            arms[k + 1].append(_junction_cut(fracs[main], fr, point, tan, 0.0))
+        if 0 in end_cuts[f]:
+            arms[0].append(end_cuts[f][0])
+        if 1 in end_cuts[f]:
+            arms[-1].append(end_cuts[f][1])
+        s_all = sorted(offsets[f] + s for s in arcs[f])
+        cell, seg, tt = _split_pieces(fr, s_all, tol)
+        out.append(
+            replace(
+                fr,
+                piece_cell=cell,
+                piece_seg=seg,
+                piece_t=tt,
+                arm_splits=tuple(r[0] for r in sp),
+                arms=tuple(tuple(a) for a in arms),
+                junction_s=tuple(s_all),
+            )
+        )
+    if found:
+        kinds = [k for k, *_ in found]
+        logger.info(
+            "junctions: %d X, %d T, %d V",
+            kinds.count("X"),
+            kinds.count("T"),
+            kinds.count("V"),
+        )
+    return tuple(out)

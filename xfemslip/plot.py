@@ -12,7 +12,9 @@ side (one column per result):
   point, every result overlaid (Fig. 12);
 - ``mohr``: the Mohr-Coulomb diagram of the far-field stress with each
   fracture's point, the failure line and the band of orientations that slip
-  (Fig. 13); the contact points of the run are drawn too.
+  (Fig. 13); the contact points of the run are drawn too;
+- ``network`` (only when asked for, first result only): |slip| along every
+  fracture of a network over the deformed split mesh, and the contact state.
 
 Every figure is saved as PNG and PDF.  Only the object-oriented API
 (``matplotlib.figure.Figure``) is used: no pyplot, no GUI backend.
@@ -218,9 +220,9 @@ def figure_slip(results: Sequence[ResultData]) -> Figure:
                 else (f"{data.label}, fracture {fr.index}")
             )
             s = fr.s - fr.s.min() if fr.s.size else fr.s
-            (line,) = ax.plot(
-                s, np.abs(fr.slip), lw=1.4, color=f"C{k % 10}", label=label
-            )
+            # one result with several fractures (a network): one colour each
+            colour = f"C{(k if len(results) > 1 else fr.index) % 10}"
+            (line,) = ax.plot(s, np.abs(fr.slip), lw=1.4, color=colour, label=label)
             in_slip = fr.state == SLIP_CODE
             ax.plot(
                 s[in_slip], np.abs(fr.slip[in_slip]), ".", ms=3, color=line.get_color()
@@ -231,6 +233,80 @@ def figure_slip(results: Sequence[ResultData]) -> Figure:
     ax.ticklabel_format(axis="y", style="sci", scilimits=(-3, 3))
     ax.grid(alpha=0.3)
     ax.legend(fontsize=8)
+    return fig
+
+
+STATE_COLOURS = {0: "0.6", 1: "tab:blue", 2: "tab:red"}  # open, stick, slip
+
+
+def _fracture_segments(fr) -> np.ndarray:
+    """(K-1, 2, 2) segments between consecutive contact points of a fracture,
+    broken where the fracture's polyline is (a gap of more than 3 spacings)."""
+    p = fr.points
+    if len(p) < 2:
+        return np.zeros((0, 2, 2))
+    seg = np.stack([p[:-1], p[1:]], axis=1)
+    gap = np.linalg.norm(p[1:] - p[:-1], axis=1)
+    return seg[gap <= 3.0 * np.median(gap)]
+
+
+def figure_network(data: ResultData, scale: float | None = None) -> Figure:
+    """A fracture network: |slip| along every fracture over the deformed,
+    split mesh (left) and the contact state of every point (right), each
+    fracture numbered as in the case file."""
+    fig, axes = _grid(1, 2)
+    ax_slip, ax_state = axes[0]
+    factor = scale if scale is not None else auto_scale(data)
+    _draw_mesh(ax_slip, data, factor)
+    slips = [np.abs(f.slip) for f in data.fractures if f.slip.size]
+    top = max((float(v.max()) for v in slips), default=0.0) or 1.0
+    norm = Normalize(0.0, top)
+    for fr in data.fractures:
+        seg = _fracture_segments(fr)
+        if not seg.size:
+            continue
+        # drawn where the deformed mesh has moved it (nearest node)
+        near = np.argmin(
+            np.linalg.norm(seg.reshape(-1, 1, 2) - data.points[None], axis=2), axis=1
+        )
+        moved = seg + factor * data.displacement[near].reshape(seg.shape)
+        mid = 0.5 * (np.abs(fr.slip[:-1]) + np.abs(fr.slip[1:]))
+        gap = np.linalg.norm(fr.points[1:] - fr.points[:-1], axis=1)
+        mid = mid[gap <= 3.0 * np.median(gap)]
+        lc = LineCollection(moved, array=mid, cmap="plasma", norm=norm, linewidths=2.2)
+        ax_slip.add_collection(lc)
+        state_seg = seg
+        colours = [STATE_COLOURS.get(int(c), "k") for c in fr.state[:-1]]
+        colours = [
+            c for c, g in zip(colours, gap, strict=True) if g <= 3 * np.median(gap)
+        ]
+        ax_state.add_collection(
+            LineCollection(state_seg, colors=colours, linewidths=2.2)
+        )
+        m = fr.points[len(fr.points) // 3]  # not the middle: Xs cross there
+        ax_state.annotate(
+            str(fr.index), m, fontsize=7, xytext=(3, 3), textcoords="offset points"
+        )
+    fig.colorbar(
+        ax_slip.collections[-1] if ax_slip.collections else None,
+        ax=ax_slip,
+        label="|slip| [m]",
+        shrink=0.8,
+    )
+    ax_slip.autoscale_view()
+    _frame(
+        ax_slip,
+        data,
+        f"{data.label}\n|slip| on the deformed, split mesh (x {factor:.3g})",
+        fractures=False,
+    )
+    b = data.points
+    ax_state.set_xlim(b[:, 0].min(), b[:, 0].max())
+    ax_state.set_ylim(b[:, 1].min(), b[:, 1].max())
+    for code, name in ((2, "slip"), (1, "stick"), (0, "open")):
+        ax_state.plot([], [], color=STATE_COLOURS[code], lw=2.2, label=name)
+    ax_state.legend(fontsize=7, loc="lower right")
+    _frame(ax_state, data, f"{data.label}\ncontact state", fractures=False)
     return fig
 
 
@@ -383,6 +459,8 @@ def plot_results(
         "deformed_mesh": lambda: figure_deformed(results, scale),
         "slip": lambda: figure_slip(results),
         "mohr": lambda: figure_mohr(results),
+        # not in KINDS (asked for by name): one figure per result
+        "network": lambda: figure_network(results[0], scale),
     }
     written = []
     for kind in kinds:

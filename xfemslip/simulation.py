@@ -195,7 +195,7 @@ def floating_parts(mesh, fractures, contact, bc):
     fixed_nodes = np.unique(std // 2)
     out = []
     for fi, fr in enumerate(fractures):
-        if fr.tips:
+        if fr.tips or fr.junction_ends:
             continue
         side = fr.side(mesh.nodes[fixed_nodes]) if fixed_nodes.size else np.zeros(0)
         if not (np.any(side > 0) and np.any(side < 0)):

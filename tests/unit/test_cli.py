@@ -281,9 +281,9 @@ kt = 5.0e12
     [
         (
             _FRACTURE.format(points="[0.2, 0.2], [0.8, 0.8]")
-            + _FRACTURE.format(points="[0.2, 0.8], [0.8, 0.2]"),
+            + _FRACTURE.format(points="[0.5, 0.5], [0.9, 0.9]"),
             "0.0",
-            "fractures[0] and fractures[1] intersect",
+            "fractures[0] and fractures[1] overlap",
         ),
         (
             _FRACTURE.format(points="[0.2, 0.2], [0.8, 0.8]"),
@@ -291,7 +291,7 @@ kt = 5.0e12
             "boundary.bottom and boundary.left prescribe different ux",
         ),
     ],
-    ids=["intersecting-fractures", "corner-conflict"],
+    ids=["overlapping-fractures", "corner-conflict"],
 )
 @pytest.mark.parametrize("command", ["check", "run"])
 def test_geometry_errors_are_bad_input(tmp_path, command, fractures, left_ux, words):

@@ -295,7 +295,7 @@ def test_geometry_of_generated_cases_is_checked(tmp_path):
     # keys all valid, but the second case puts the two fractures on each other
     two = BASE.replace("center = [0.5, 0.5]", "center = [0.5, 0.3]")
     second = two[two.index("[[fractures]]") : two.index("[loading]")]
-    second = second.replace("[0.5, 0.3]", "[0.5, 0.7]").replace("45.0", "0.0")
+    second = second.replace("[0.5, 0.3]", "[0.5, 0.7]")  # parallel to the first
     (tmp_path / "base.toml").write_text(two.replace("[loading]", second + "[loading]"))
     body = (
         'base = "base.toml"\n[vary]\n"fractures[1].center" = [[0.5, 0.7], [0.5, 0.3]]\n'
@@ -304,7 +304,7 @@ def test_geometry_of_generated_cases_is_checked(tmp_path):
         loads_sweep(body, tmp_path / "bad.toml")
     text = _problems(excinfo)
     assert "case 001_center=0.5_0.3 (fractures[1].center = [0.5, 0.3])" in text
-    assert "fractures[0] and fractures[1] intersect" in text
+    assert "fractures[0] and fractures[1] overlap" in text
     assert "case 000" not in text
 
 

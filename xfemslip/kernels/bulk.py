@@ -108,9 +108,16 @@ def enriched_cell_matrices(
     N = np.empty(4)
     dN = np.empty((4, 2))
     B = np.zeros((3, nd))
+    DB = np.zeros((3, nd))
     for e in range(nc):
         x0, x1, y0, y1 = bounds[e, 0], bounds[e, 1], bounds[e, 2], bounds[e, 3]
         area = 0.0
+        # columns in use: slots are filled from 0, so only up to the last
+        # occupied one (networks pad most cells far below S)
+        m = 8
+        for s in range(S):
+            if slot_node[e, s] >= 0:
+                m = 10 + 2 * s
         for q in range(qp_offsets[e], qp_offsets[e + 1]):
             _enriched_B(
                 qp_xy[q, 0],
@@ -128,9 +135,16 @@ def enriched_cell_matrices(
                 B,
             )
             w = qp_w[q]
-            DB = D @ B
-            K[e] += (B.T @ DB) * w
-            Bbar[e] += B * w
+            for k in range(3):
+                for j in range(m):
+                    DB[k, j] = D[k, 0] * B[0, j] + D[k, 1] * B[1, j] + D[k, 2] * B[2, j]
+            for i in range(m):
+                b0, b1, b2 = B[0, i] * w, B[1, i] * w, B[2, i] * w
+                for j in range(m):
+                    K[e, i, j] += b0 * DB[0, j] + b1 * DB[1, j] + b2 * DB[2, j]
+                Bbar[e, 0, i] += b0
+                Bbar[e, 1, i] += b1
+                Bbar[e, 2, i] += b2
             area += w
         Bbar[e] /= area
     return K, Bbar
