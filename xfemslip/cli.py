@@ -284,6 +284,10 @@ cli.add_command(sweep)
 cli.add_command(plot)
 cli.add_command(screen)
 
+from xfemslip.cli_dfn import dfn  # noqa: E402  (random fracture networks)
+
+cli.add_command(dfn)
+
 
 def main() -> None:
     """Console-script entry point (``xfemslip``)."""
