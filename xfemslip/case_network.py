@@ -458,7 +458,7 @@ def _read_count(table: _Table) -> dict | None:
 def _read_generate(table: _Table) -> dfn.DfnParams | None:
     """``[network.generate]`` -> DfnParams (validated, not yet realized)."""
     start = len(table.problems)
-    seed = table.integer("seed", rule=Range(0, 2**63 - 1))
+    seed = table.integer("seed", rule=_NON_NEGATIVE)
     count = _read_count(table)
     region = _read_region(table)
     sets = _read_sets(table)
