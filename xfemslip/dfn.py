@@ -321,7 +321,10 @@ def _fit(p0, p1, params: DfnParams, box):
         return (p0, p1) if (ta == 0.0 and tb == 1.0) else None
     if tb <= ta:
         return None
-    q0, q1 = p0 + ta * (p1 - p0), p0 + tb * (p1 - p0)
+    # p0 + t (p1 - p0) may round a hair outside the box: put it on the edge
+    lo, hi = np.array(box[0::2]), np.array(box[1::2])
+    q0 = np.clip(p0 + ta * (p1 - p0), lo, hi)
+    q1 = np.clip(p0 + tb * (p1 - p0), lo, hi)
     if math.hypot(*(q1 - q0)) <= params.min_length:
         return None
     return q0, q1

@@ -135,12 +135,13 @@ CSV_ERRORS = [
     ),
     (
         "fracture,x0,y0,x1,y1\na,0.1,0.1,0.5,0.5\na,0.6,0.5,0.9,0.5\n",
-        "seg.csv line 3: fracture 'a' continues at (0.6, 0.5) but its segment on line 2 "
-        "ends at (0.5, 0.5)",
+        "seg.csv line 3: fracture 'a' continues at (0.6, 0.5) but its segment on "
+        "line 2 ends at (0.5, 0.5)",
     ),
     (
         "fracture,x0,y0,x1,y1,friction\na,0.1,0.1,0.5,0.5,0.3\na,0.5,0.5,0.9,0.5,0.4\n",
-        "seg.csv lines 2 and 3: fracture 'a' has friction 0.3 and 0.4; its rows must agree",
+        "seg.csv lines 2 and 3: fracture 'a' has friction 0.3 and 0.4; "
+        "its rows must agree",
     ),
     (
         "fracture,x0,y0,x1,y1\na,0.1,0.1,0.5,0.5\na,0.5,0.5,0.5,0.1\na,0.5,0.1,0.1,0.5\n",
@@ -171,8 +172,8 @@ def test_missing_file_and_friction(tmp_path):
         tmp_path, '[network]\nfile = "seg.csv"\n', "x0,y0,x1,y1\n0.1,0.1,0.5,0.5\n"
     )
     assert (
-        "seg.csv line 2: no friction: give it in a friction column or as network.friction"
-        in message
+        "seg.csv line 2: no friction: give it in a friction column or as "
+        "network.friction" in message
     )
 
 
