@@ -293,3 +293,25 @@ def test_cli_dfn_exports_a_network_that_reads_back(tmp_path):
     for f, g in zip(spec.fractures, again.fractures, strict=True):
         np.testing.assert_array_equal(f.points, g.points)
         assert f.friction == g.friction
+
+
+def test_two_hundred_generated_fractures_build(tmp_path, monkeypatch):
+    """Hundreds of fractures: the case and its geometry (not solved) build;
+    the time is measured in benchmarks/dfn_build.py, not asserted here."""
+    from pathlib import Path
+
+    monkeypatch.syspath_prepend(Path(__file__).resolve().parents[2] / "benchmarks")
+    from dfn_build import case_text
+
+    from xfemslip.dfn import intersecting_pairs
+    from xfemslip.simulation import check_geometry
+
+    path = tmp_path / "dfn200.toml"
+    path.write_text(case_text(200, 100))
+    spec = load_case(path)
+    assert [f.index for f in spec.fractures] == list(range(200))
+    segments = np.array([f.points for f in spec.fractures])
+    assert segments.shape == (200, 2, 2)
+    assert segments.min() >= 0.0 and segments.max() <= 1.0  # outside = "reject"
+    assert intersecting_pairs(segments, 0.012) == []  # min_spacing = 1.2 cells
+    check_geometry(spec)  # the geometry refuses any crossing pair
