@@ -112,7 +112,9 @@ def test_three_realizations_end_to_end(tmp_path):
         slipping = [r for r in refs if r[0]]
         counts.append(len(slipping))
         assert int(row["slipping_fractures"]) == len(slipping)
-        assert float(row["slipping_fraction"]) == pytest.approx(len(slipping) / 6, rel=1e-5)
+        assert float(row["slipping_fraction"]) == pytest.approx(
+            len(slipping) / 6, rel=1e-5
+        )
         assert float(row["max_abs_slip_m"]) == pytest.approx(
             max(r[1] for r in refs), rel=1e-5
         )
