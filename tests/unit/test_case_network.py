@@ -315,3 +315,21 @@ def test_two_hundred_generated_fractures_build(tmp_path, monkeypatch):
     assert segments.min() >= 0.0 and segments.max() <= 1.0  # outside = "reject"
     assert intersecting_pairs(segments, 0.012) == []  # min_spacing = 1.2 cells
     check_geometry(spec)  # the geometry refuses any crossing pair
+
+
+def test_allow_network_that_crosses_is_refused_by_the_geometry_for_now(tmp_path):
+    """Until crossing fractures are supported (the network mechanics branch),
+    an "allow" network with a crossing pair is exit 2 naming the pair.  After
+    that merge this test should expect exit 0 instead."""
+    from xfemslip.dfn import intersecting_pairs
+
+    network = GENERATE.replace('intersections = "avoid"', 'intersections = "allow"')
+    network = network.replace("count = 5", "count = 40")
+    path = _case(tmp_path, network, inline="")
+    spec = load_case(path)
+    pairs = intersecting_pairs(np.array([f.points for f in spec.fractures]))
+    assert pairs  # 40 random 0.2 m fractures on 2 m^2 do cross
+    result = CliRunner().invoke(cli, ["check", str(path)])
+    assert result.exit_code == 2
+    i, j = pairs[0]
+    assert f"fractures[{i}] and fractures[{j}] intersect" in result.output
