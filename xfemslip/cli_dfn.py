@@ -13,7 +13,7 @@ from pathlib import Path
 import click
 
 from xfemslip.cli import _case_argument, _debug_option, _load, _reported_errors
-from xfemslip.errors import OutputError
+from xfemslip.errors import OutputError, UsageError
 
 
 def _write_text(path: Path, text: str) -> None:
@@ -75,6 +75,11 @@ def dfn(case, csv_path, include_inline, plot, result, summary, debug) -> None:
             f"P21 = {stats['p21']:.4g} m/m^2, length {stats['min_length']:.4g} .. "
             f"{stats['max_length']:.4g} m (mean {stats['mean_length']:.4g} m)"
         )
+        if csv_path is not None and not chosen:
+            raise UsageError(
+                f"{case}: no [network] fractures to export (--all exports the "
+                "[[fractures]] too)"
+            )
         if csv_path is not None:
             _write_text(csv_path, segments_csv_text(chosen))
             click.echo(f"{len(chosen)} fractures -> {csv_path}")

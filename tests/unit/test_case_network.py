@@ -333,3 +333,25 @@ def test_allow_network_that_crosses_is_refused_by_the_geometry_for_now(tmp_path)
     assert result.exit_code == 2
     i, j = pairs[0]
     assert f"fractures[{i}] and fractures[{j}] intersect" in result.output
+
+
+def test_cli_dfn_without_network_fractures_and_plot(tmp_path):
+    runner = CliRunner()
+    path = _case(tmp_path, "", inline=INLINE)
+    result = runner.invoke(cli, ["dfn", str(path), "--csv", str(tmp_path / "o.csv")])
+    assert result.exit_code == 2 and "no [network] fractures to export" in result.output
+    assert not (tmp_path / "o.csv").exists()
+    result = runner.invoke(
+        cli, ["dfn", str(path), "--all", "--csv", str(tmp_path / "o.csv")]
+    )
+    assert result.exit_code == 0
+    # P21 of the one inline fracture: its length over the 2 m^2 domain
+    length = float(np.hypot(0.4, 0.1))
+    assert f"P21 = {length / 2.0:.4g} m/m^2" in result.output
+    figure = tmp_path / "net.png"
+    network = GENERATE.replace("[network]\n", '[network]\nfile = "o.csv"\n')
+    # o.csv repeats the inline fracture: "avoid" keeps the generated ones off it
+    path = _case(tmp_path, network, inline="")
+    result = runner.invoke(cli, ["dfn", str(path), "--plot", str(figure)])
+    assert result.exit_code == 0, result.output
+    assert figure.stat().st_size > 10_000
