@@ -31,7 +31,8 @@ public name is re-exported here): ``case_specs`` (the spec dataclasses),
 ``case_tables`` (typed TOML-table reader, value checks, message helpers),
 ``case_grid`` (``[domain]`` and ``[mesh]``), ``case_fractures`` and
 ``case_polyline`` (``[[fractures]]`` and its polyline checks),
-``case_network`` (``[network]``: a CSV file of segments, random networks),
+``case_network``, ``case_segments`` and ``case_generate`` (``[network]``: a
+CSV file of segments, random networks),
 ``case_boundary`` and ``case_csv`` (``[boundary]`` and its CSV files) and
 ``case_describe`` (``describe``).  This module keeps the other constants,
 ``SOLVER_OPTIONS``, the readers of ``name``, ``[material]``, ``[loading]``,

@@ -355,3 +355,31 @@ def test_cli_dfn_without_network_fractures_and_plot(tmp_path):
     result = runner.invoke(cli, ["dfn", str(path), "--plot", str(figure)])
     assert result.exit_code == 0, result.output
     assert figure.stat().st_size > 10_000
+
+
+def test_result_numbering_inline_then_file(tmp_path):
+    """/fractures/<i> of result.h5: 0 the inline fracture, 1 and 2 the CSV
+    ones in order of their first row (checked by where the points lie)."""
+    import h5py
+
+    from xfemslip.simulation import run_case
+
+    csv = "fracture,x0,y0,x1,y1\nb,1.2,0.2,1.7,0.3\na,0.3,0.2,0.8,0.5\n"
+    path = _case(tmp_path, FILE + 'tip = "ramp"\n', csv)
+    spec = load_case(path)
+    run_case(spec, tmp_path / "out")
+    lines = {
+        0: ((0.2, 0.8), (0.6, 0.9)),
+        1: ((1.2, 0.2), (1.7, 0.3)),
+        2: ((0.3, 0.2), (0.8, 0.5)),
+    }
+    with h5py.File(tmp_path / "out" / "result.h5") as f:
+        assert sorted(f["fractures"].keys()) == ["0", "1", "2"]
+        for i, (a, b) in lines.items():
+            p = f[f"fractures/{i}/points"][()]
+            a, b = np.array(a), np.array(b)
+            t = b - a
+            cross = (p[:, 0] - a[0]) * t[1] - (p[:, 1] - a[1]) * t[0]
+            np.testing.assert_allclose(cross / np.linalg.norm(t), 0.0, atol=1e-12)
+            along = (p - a) @ t / (t @ t)
+            assert along.min() >= 0.0 and along.max() <= 1.0
