@@ -39,6 +39,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import ClassVar
 
 import numpy as np
 
@@ -61,6 +62,7 @@ class Orientation:
     mean: float = 0.0  # [deg]
     kappa: float = 0.0  # von Mises concentration [-]
     std: float = 0.0  # normal spread [deg]
+    UNITS: ClassVar[dict[str, str]] = {"mean": "deg", "kappa": "-", "std": "deg"}
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -74,6 +76,14 @@ class LengthLaw:
     lmax: float | None = None  # [m]
     median: float = 0.0  # lognormal median exp(mu) [m]
     sigma: float = 0.0  # lognormal std of ln(l) [-]
+    UNITS: ClassVar[dict[str, str]] = {
+        "value": "m",
+        "exponent": "-",
+        "lmin": "m",
+        "lmax": "m",
+        "median": "m",
+        "sigma": "-",
+    }
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -97,6 +107,15 @@ class DfnParams:
     min_spacing: float = 0.0  # [m], with intersections = "avoid"
     outside: str = "clip"
     min_length: float = 0.0  # [m] shortest clipped piece kept
+    UNITS: ClassVar[dict[str, str]] = {
+        "seed": "-",
+        "count": "-",
+        "p20": "1/m^2",
+        "p21": "m/m^2",
+        "region": "m",
+        "min_spacing": "m",
+        "min_length": "m",
+    }
 
 
 @dataclass(frozen=True)

@@ -128,3 +128,31 @@ def test_three_realizations_end_to_end(tmp_path):
     assert float(slip["mean"]) == pytest.approx(np.mean(counts), rel=1e-5)
     assert float(slip["std"]) == pytest.approx(np.std(counts, ddof=1), rel=1e-5)
     assert float(slip["min"]) == min(counts) and float(slip["max"]) == max(counts)
+
+
+def test_aggregate_leaves_failed_cases_out():
+    from xfemslip.sweep_dfn import AGGREGATED, aggregate, is_dfn_sweep
+    from xfemslip.sweep_run import CaseRow
+
+    rng = np.random.default_rng(2)
+    rows = []
+    for k in range(5):
+        metrics = {m: float(rng.random()) for m in AGGREGATED}
+        rows.append(
+            CaseRow(f"{k:03d}", status="skipped" if k == 1 else "ok", metrics=metrics)
+        )
+    rows.append(CaseRow("005", status="failed", metrics={}, error="boom"))
+    table = {r["metric"]: r for r in aggregate(rows)}
+    for metric in AGGREGATED:
+        values = [r.metrics[metric] for r in rows[:5]]
+        row = table[metric]
+        assert row["realizations"] == 5 and row["failed"] == 1
+        assert row["mean"] == pytest.approx(np.mean(values), rel=1e-12)
+        assert row["std"] == pytest.approx(np.std(values, ddof=1), rel=1e-12)
+        assert (row["min"], row["median"], row["max"]) == (
+            min(values),
+            pytest.approx(np.median(values)),
+            max(values),
+        )
+    assert is_dfn_sweep(["material.E", "network.generate.seed"])
+    assert not is_dfn_sweep(["fractures[0].angle", "networkx"])
