@@ -31,6 +31,8 @@ public name is re-exported here): ``case_specs`` (the spec dataclasses),
 ``case_tables`` (typed TOML-table reader, value checks, message helpers),
 ``case_grid`` (``[domain]`` and ``[mesh]``), ``case_fractures`` and
 ``case_polyline`` (``[[fractures]]`` and its polyline checks),
+``case_network``, ``case_segments`` and ``case_generate`` (``[network]``: a
+CSV file of segments, random networks),
 ``case_boundary`` and ``case_csv`` (``[boundary]`` and its CSV files) and
 ``case_describe`` (``describe``).  This module keeps the other constants,
 ``SOLVER_OPTIONS``, the readers of ``name``, ``[material]``, ``[loading]``,
@@ -57,6 +59,7 @@ from xfemslip.case_grid import (
     MAX_ELEMENTS,
     _read_grid,
 )
+from xfemslip.case_network import _read_network
 from xfemslip.case_pore import (
     PORE_PRESSURE_KEYS,
     PORE_PRESSURE_REGIONS,
@@ -144,6 +147,7 @@ TOP_KEYS = (
     "mesh",
     "material",
     "fractures",
+    "network",
     "loading",
     "boundary",
     "solver",
@@ -320,6 +324,14 @@ def _read_formats(table: _Table) -> tuple[str, ...] | None:
     return tuple(formats)
 
 
+def _with_network(root: _Table, grid, folder: Path, fractures):
+    """The inline [[fractures]] followed by those of [network] (case_network)."""
+    network = _read_network(root, grid, folder, fractures or ())
+    if fractures is None or network is None:
+        return None
+    return fractures + network
+
+
 def _read_output(root: _Table, name: str | None) -> OutputSpec | None:
     """[output]: directory (default out/<name>, relative to the cwd) and formats."""
     table = root.table("output", ("directory", "formats"))
@@ -389,6 +401,7 @@ def loads_case(text: str, path: str | Path = "<string>") -> CaseSpec:
     grid = _read_grid(root)
     material = _read_material(root)
     fractures = _read_fractures(root, grid)
+    fractures = _with_network(root, grid, path.parent, fractures)
     boundary, needs_stress = _read_boundary(root, grid, path.parent)
     loading = _read_loading(root, needs_stress)
     solver = _read_solver(root)

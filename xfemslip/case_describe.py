@@ -43,8 +43,29 @@ def _describe_axis(coords: np.ndarray, label: str) -> str:
     )
 
 
+def _describe_network_fracture(spec: FractureSpec) -> list[str]:
+    """One line per [network] fracture: where from, ends, length, parameters."""
+    p, units = spec.points, FractureSpec.UNITS
+    length = float(np.hypot(*np.diff(p, axis=0).T).sum())
+    params = ", ".join(
+        f"{k} {_fmt(getattr(spec, k))}" if getattr(spec, k) is not None else f"{k} auto"
+        for k in ("friction", "cohesion", "kn", "kt")
+    )
+    ends = (
+        f"({_fmt(float(p[0, 0]))}, {_fmt(float(p[0, 1]))}) -> "
+        + (f"{len(p) - 2} more -> " if len(p) > 2 else "")
+        + f"({_fmt(float(p[-1, 0]))}, {_fmt(float(p[-1, 1]))})"
+    )
+    return [
+        f"  [{spec.index}] {ends}, length {_with_unit(length, units['points'])}; "
+        f"{params}; {spec.source}"
+    ]
+
+
 def _describe_fracture(spec: FractureSpec) -> list[str]:
     """Points, length, segment angles and contact parameters of one fracture."""
+    if spec.source:
+        return _describe_network_fracture(spec)
     p = spec.points
     seg = np.diff(p, axis=0)
     angles = np.degrees(np.arctan2(seg[:, 1], seg[:, 0]))
@@ -135,6 +156,17 @@ def _describe_pore(spec: CaseSpec) -> list[str]:
         )
     return lines
 
+def _network_count(spec: CaseSpec) -> str:
+    """`` ([[fractures]] 1, network.file 3, network.generate 40)`` or ""."""
+    sources = [
+        f.source.split(" ", 1)[0] if f.source else "[[fractures]]"
+        for f in spec.fractures
+    ]
+    if all(s == "[[fractures]]" for s in sources):
+        return ""
+    counts = {s: sources.count(s) for s in dict.fromkeys(sources)}
+    return " (" + ", ".join(f"{s} {n}" for s, n in counts.items()) + ")"
+
 
 def describe(spec: CaseSpec) -> str:
     """Human-readable summary of a resolved case (SI units, tension positive).
@@ -156,7 +188,7 @@ def describe(spec: CaseSpec) -> str:
         f"{_describe_axis(spec.mesh.x, 'x')}; {_describe_axis(spec.mesh.y, 'y')}",
         f"material: E = {_with_unit(m.E, MaterialSpec.UNITS['E'])}, nu = {_fmt(m.nu)}, "
         f"{m.model}",
-        f"fractures: {len(spec.fractures)}",
+        f"fractures: {len(spec.fractures)}{_network_count(spec)}",
     ]
     for fracture in spec.fractures:
         lines += _describe_fracture(fracture)

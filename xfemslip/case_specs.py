@@ -52,7 +52,7 @@ CONTACT_PATCH_CELLS = 1.5
 
 @dataclass(frozen=True, kw_only=True)
 class FractureSpec:
-    index: int  # position in the case file's [[fractures]] array
+    index: int  # [[fractures]] position; [network] ones follow (case_network)
     points: np.ndarray  # (k, 2) float64 polyline vertices, k >= 2 [m]
     friction: float  # Coulomb coefficient f [-]
     cohesion: float  # c_f [Pa]
@@ -60,6 +60,7 @@ class FractureSpec:
     kt: float | None  # tangential penalty [Pa/m]; None = AUTO_PENALTY * E / h
     tip: str = "branch"  # crack-tip treatment: "branch" | "ramp"
     tip_radius: float | None = None  # branch enrichment radius [m]; None = automatic
+    source: str = ""  # "" = [[fractures]]; else where [network] took it from
     UNITS: ClassVar[dict[str, str]] = {
         "points": "m",
         "tip_radius": "m",

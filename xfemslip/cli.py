@@ -290,6 +290,10 @@ from xfemslip.cli_deplete import deplete  # noqa: E402
 
 cli.add_command(deplete)
 
+from xfemslip.cli_dfn import dfn  # noqa: E402  (random fracture networks)
+
+cli.add_command(dfn)
+
 
 def main() -> None:
     """Console-script entry point (``xfemslip``)."""

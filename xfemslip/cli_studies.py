@@ -97,6 +97,7 @@ def sweep(sweep_file, output, jobs, scheduler, force, verbose, debug) -> None:
                 progress=lambda row: bar.update(1),
             )
         click.echo(format_table(spec.keys, rows))
+        _print_dfn_aggregate(spec.keys, rows)
         failed = [r for r in rows if r.status == "failed"]
         skipped = sum(r.status == "skipped" for r in rows)
         click.echo(
@@ -107,6 +108,15 @@ def sweep(sweep_file, output, jobs, scheduler, force, verbose, debug) -> None:
         )
         if failed:
             raise click.exceptions.Exit(EXIT_FAILURE)
+
+
+def _print_dfn_aggregate(keys, rows) -> None:
+    """Over network realizations: the aggregate table of dfn_summary.csv."""
+    from xfemslip.sweep_dfn import aggregate, format_aggregate, is_dfn_sweep
+
+    if is_dfn_sweep(keys):
+        click.echo("\nover the realizations (dfn_summary.csv):")
+        click.echo(format_aggregate(aggregate(rows)))
 
 
 # --------------------------------------------------------------------------- #

@@ -36,8 +36,8 @@ from xfemslip.poro import (
     make_contact_effective,
 )
 from xfemslip.post import STATE_CODES, bulk_fields, fracture_fields, vis_mesh
-from xfemslip.quadrature import InterfacePoints, interface_points
 from xfemslip.predictor import stress_increment
+from xfemslip.quadrature import InterfacePoints, interface_points
 from xfemslip.solver import NewtonSolver, Problem, StepResult
 from xfemslip.writers import StepFields
 

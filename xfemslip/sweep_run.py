@@ -15,7 +15,10 @@ case text is skipped (results are written atomically, so an existing file is
 complete); any other case runs (again).  A failed case is reported in its row
 and the others go on.  ``summary.csv`` has one row per case: the parameters,
 max |slip| [m], slipping length [m], share of contact points in slip,
-converged, Newton iterations, wall time [s], status and error.
+converged, Newton iterations, wall time [s], the number of fractures, how
+many have a point in slip, that fraction, the mean over those of their
+length-weighted mean |slip| [m], status and error.  A sweep that varies a
+``network.*`` key also gets ``dfn_summary.csv`` (:mod:`xfemslip.sweep_dfn`).
 """
 
 from __future__ import annotations
@@ -34,6 +37,7 @@ import h5py
 import numpy as np
 
 from xfemslip.errors import OutputError, UsageError, XfemslipError
+from xfemslip.sweep_dfn import DFN_SUMMARY, is_dfn_sweep, write_dfn_summary
 from xfemslip.writers.atomic import atomic_path
 
 logger = logging.getLogger(__name__)
@@ -46,6 +50,11 @@ METRICS = (
     "slip_share",
     "newton_iterations",
     "wall_time_s",
+    # per fracture (networks, README "Random fracture networks"):
+    "fractures",
+    "slipping_fractures",
+    "slipping_fraction",
+    "mean_slip_m",
 )
 SUMMARY = "summary.csv"
 
@@ -92,15 +101,21 @@ def arc_extent(points: np.ndarray, box: tuple) -> tuple[float, float]:
     return lo, hi
 
 
+def point_stretches(s, s_lo: float, s_hi: float) -> np.ndarray:
+    """Length [m] each contact point stands for: the stretch between the
+    midpoints to its neighbours (the ends reach s_lo and s_hi)."""
+    s = np.asarray(s, dtype=float)
+    if s.size == 0:
+        return np.zeros(0)
+    mid = 0.5 * (s[1:] + s[:-1])
+    return np.diff(np.concatenate([[min(s_lo, s[0])], mid, [max(s_hi, s[-1])]]))
+
+
 def slipping_length(s, state, s_lo: float, s_hi: float) -> float:
     """Length [m] of fracture in slip: each point stands for the stretch between
     the midpoints to its neighbours (the ends reach s_lo and s_hi)."""
-    s = np.asarray(s, dtype=float)
-    if s.size == 0:
-        return 0.0
-    mid = 0.5 * (s[1:] + s[:-1])
-    edges = np.concatenate([[min(s_lo, s[0])], mid, [max(s_hi, s[-1])]])
-    return float(np.sum(np.diff(edges)[np.asarray(state) == SLIP_CODE]))
+    stretch = point_stretches(s, s_lo, s_hi)
+    return float(np.sum(stretch[np.asarray(state) == SLIP_CODE]))
 
 
 def result_metrics(h5_path: Path, spec) -> dict:
@@ -113,6 +128,7 @@ def result_metrics(h5_path: Path, spec) -> dict:
         spec.origin[1] + spec.size[1],
     )
     slip_max, length, n_slip, n_points = 0.0, 0.0, 0, 0
+    slipping_means = []  # mean |slip| of each fracture with a point in slip
     with h5py.File(h5_path, "r") as f:
         attrs = dict(f.attrs)
         for i, fracture in enumerate(spec.fractures):
@@ -122,9 +138,15 @@ def result_metrics(h5_path: Path, spec) -> dict:
             s, slip, state = (group[k][()] for k in ("s", "slip", "state"))
             if slip.size:
                 slip_max = max(slip_max, float(np.max(np.abs(slip))))
-            length += slipping_length(s, state, *arc_extent(fracture.points, box))
+            stretch = point_stretches(s, *arc_extent(fracture.points, box))
+            length += float(np.sum(stretch[state == SLIP_CODE]))
+            if np.any(state == SLIP_CODE):
+                slipping_means.append(
+                    float(np.sum(stretch * np.abs(slip)) / np.sum(stretch))
+                )
             n_slip += int(np.sum(state == SLIP_CODE))
             n_points += int(state.size)
+    n_fractures = len(spec.fractures)
     return {
         "converged": bool(attrs.get("converged", False)),
         "max_abs_slip_m": slip_max,
@@ -132,6 +154,10 @@ def result_metrics(h5_path: Path, spec) -> dict:
         "slip_share": n_slip / n_points if n_points else 0.0,
         "newton_iterations": int(attrs.get("newton_iterations", 0)),
         "wall_time_s": float(attrs.get("wall_time_s", math.nan)),
+        "fractures": n_fractures,
+        "slipping_fractures": len(slipping_means),
+        "slipping_fraction": len(slipping_means) / n_fractures if n_fractures else 0.0,
+        "mean_slip_m": float(np.mean(slipping_means)) if slipping_means else 0.0,
     }
 
 
@@ -299,6 +325,8 @@ def run_sweep(
     order = {case.case_id: case.index for case in sweep.cases}
     rows.sort(key=lambda r: order[r.case_id])
     write_summary(directory / SUMMARY, sweep.keys, rows)
+    if is_dfn_sweep(sweep.keys):  # realizations of a random network
+        write_dfn_summary(directory / DFN_SUMMARY, rows)
     return rows
 
 

@@ -324,7 +324,17 @@ def test_cli_bad_sweep_is_exit_2_one_line_and_writes_nothing(tmp_path, base, run
 def test_paper_sweep_files_are_valid():
     root = Path(__file__).resolve().parents[2] / "cases" / "sweeps"
     found = {p.stem: load_sweep(p) for p in sorted(root.glob("*.toml"))}
-    assert set(found) == {"young_modulus", "fracture_angle", "friction"}
+    assert set(found) == {
+        "young_modulus",
+        "fracture_angle",
+        "friction",
+        "dfn_realizations",
+    }
+    realizations = found["dfn_realizations"].cases  # README, random networks
+    assert [dict(c.params)["network.generate.seed"] for c in realizations] == list(
+        range(1, 21)
+    )
+    assert {len(c.spec.fractures) for c in realizations} == {30}
     assert [c.spec.material.E for c in found["young_modulus"].cases] == [
         5e9,
         20e9,

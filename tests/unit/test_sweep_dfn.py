@@ -1,0 +1,158 @@
+"""A sweep over 3 realizations of a random network, end to end: the summary's
+per-fracture columns and dfn_summary.csv against the result.h5 files."""
+
+from __future__ import annotations
+
+import csv
+
+import h5py
+import numpy as np
+import pytest
+from click.testing import CliRunner
+
+from xfemslip.case import loads_case
+from xfemslip.cli import cli
+
+# Reservoir stress state, friction 0.3: fractures near 45-60 degrees from
+# sigma_1 (vertical) slip, the others stick.  "avoid" + "reject" while
+# crossing fractures are refused by the geometry; switch to "allow" after the
+# network mechanics is merged.
+SWEEP = """
+name = "dfn3"
+[vary]
+"network.generate.seed" = { start = 4, stop = 6, step = 1 }
+[base]
+[base.domain]
+size = [1.0, 1.0]
+[base.mesh]
+elements = [20, 20]
+[base.material]
+E = 5.0e9
+nu = 0.3
+[base.network]
+friction = 0.3
+tip = "ramp"
+[base.network.generate]
+seed = 1
+count = 6
+intersections = "avoid"
+min_spacing = 0.08
+outside = "reject"
+orientation = { distribution = "uniform" }
+length = { distribution = "power_law", exponent = 2.0, min = 0.25, max = 0.45 }
+[base.loading]
+stress = { xx = -20.0e6, yy = -40.0e6, xy = 0.0 }
+[base.boundary]
+bottom = { uy = 0.0 }
+top = "traction"
+left = "traction"
+right = "traction"
+"""
+OLD_COLUMNS = [
+    "case",
+    "network.generate.seed",
+    "converged",
+    "max_abs_slip_m",
+    "slip_length_m",
+    "slip_share",
+    "newton_iterations",
+    "wall_time_s",
+]
+
+
+def _rows(path):
+    with open(path, newline="") as fh:
+        return list(csv.DictReader(fh))
+
+
+def _fracture_reference(group, length):
+    """(slips?, max |slip|, trapezoid-weighted mean |slip|) of one fracture.
+
+    Independent of sweep_run: weights from the gaps between the points, each
+    split half and half, the end points reaching s = 0 and s = length (the
+    fracture lies wholly in the domain with outside = "reject")."""
+    s, slip, state = (group[k][()] for k in ("s", "slip", "state"))
+    gaps = np.diff(np.concatenate([[0.0], s, [length]]))
+    weight = 0.5 * (gaps[:-1] + gaps[1:])
+    weight[0] += 0.5 * gaps[0]
+    weight[-1] += 0.5 * gaps[-1]
+    assert weight.sum() == pytest.approx(length)
+    mean = float(np.sum(weight * np.abs(slip)) / length)
+    return bool(np.any(state == 2)), float(np.abs(slip).max()), mean
+
+
+def test_three_realizations_end_to_end(tmp_path):
+    path = tmp_path / "dfn3.toml"
+    path.write_text(SWEEP)
+    out = tmp_path / "out"
+    result = CliRunner().invoke(cli, ["sweep", str(path), "-o", str(out), "-j", "1"])
+    assert result.exit_code == 0, result.output
+    assert "over the realizations (dfn_summary.csv):" in result.output
+    summary = _rows(out / "summary.csv")
+    with open(out / "summary.csv") as fh:
+        header = fh.readline().strip().split(",")
+    assert header[: len(OLD_COLUMNS)] == OLD_COLUMNS  # existing columns kept
+    assert header[-2:] == ["status", "error"]
+    assert [r["network.generate.seed"] for r in summary] == ["4", "5", "6"]
+    counts = []
+    for row in summary:
+        folder = out / row["case"]
+        spec = loads_case((folder / "case.toml").read_text(), folder / "case.toml")
+        assert row["status"] == "ok" and row["converged"] == "true"
+        assert int(row["fractures"]) == len(spec.fractures) == 6
+        with h5py.File(folder / "result.h5") as f:
+            assert sorted(f["fractures"].keys(), key=int) == [str(i) for i in range(6)]
+            refs = [
+                _fracture_reference(
+                    f[f"fractures/{i}"],
+                    float(np.hypot(*np.diff(spec.fractures[i].points, axis=0).T).sum()),
+                )
+                for i in range(6)
+            ]
+        slipping = [r for r in refs if r[0]]
+        counts.append(len(slipping))
+        assert int(row["slipping_fractures"]) == len(slipping)
+        assert float(row["slipping_fraction"]) == pytest.approx(
+            len(slipping) / 6, rel=1e-5
+        )
+        assert float(row["max_abs_slip_m"]) == pytest.approx(
+            max(r[1] for r in refs), rel=1e-5
+        )
+        expected = np.mean([r[2] for r in slipping]) if slipping else 0.0
+        assert float(row["mean_slip_m"]) == pytest.approx(expected, rel=1e-5)
+    # the realizations differ, and some but not all fractures slip
+    assert 0 < sum(counts) < 18 and len(set(counts)) > 1
+    aggregate = {r["metric"]: r for r in _rows(out / "dfn_summary.csv")}
+    slip = aggregate["slipping_fractures"]
+    assert int(slip["realizations"]) == 3 and slip["failed"] == "0"
+    assert float(slip["mean"]) == pytest.approx(np.mean(counts), rel=1e-5)
+    assert float(slip["std"]) == pytest.approx(np.std(counts, ddof=1), rel=1e-5)
+    assert float(slip["min"]) == min(counts) and float(slip["max"]) == max(counts)
+
+
+def test_aggregate_leaves_failed_cases_out():
+    from xfemslip.sweep_dfn import AGGREGATED, aggregate, is_dfn_sweep
+    from xfemslip.sweep_run import CaseRow
+
+    rng = np.random.default_rng(2)
+    rows = []
+    for k in range(5):
+        metrics = {m: float(rng.random()) for m in AGGREGATED}
+        rows.append(
+            CaseRow(f"{k:03d}", status="skipped" if k == 1 else "ok", metrics=metrics)
+        )
+    rows.append(CaseRow("005", status="failed", metrics={}, error="boom"))
+    table = {r["metric"]: r for r in aggregate(rows)}
+    for metric in AGGREGATED:
+        values = [r.metrics[metric] for r in rows[:5]]
+        row = table[metric]
+        assert row["realizations"] == 5 and row["failed"] == 1
+        assert row["mean"] == pytest.approx(np.mean(values), rel=1e-12)
+        assert row["std"] == pytest.approx(np.std(values, ddof=1), rel=1e-12)
+        assert (row["min"], row["median"], row["max"]) == (
+            min(values),
+            pytest.approx(np.median(values)),
+            max(values),
+        )
+    assert is_dfn_sweep(["material.E", "network.generate.seed"])
+    assert not is_dfn_sweep(["fractures[0].angle", "networkx"])

@@ -1,0 +1,279 @@
+"""``[network.generate]``: the random-network table -> ``dfn.DfnParams``,
+and its realization in the domain (read by :mod:`xfemslip.case_network`).
+
+Private helper of :mod:`xfemslip.case`, which stays the ONLY entry point for
+validating user input (house style: case.py is the only place user input is
+validated); import the public names from ``xfemslip.case``, not from here.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from xfemslip import dfn
+from xfemslip.case_grid import _Grid
+from xfemslip.case_segments import MAX_NETWORK_FRACTURES
+from xfemslip.case_tables import (
+    _NON_NEGATIVE,
+    _POSITIVE,
+    Range,
+    _fmt,
+    _show,
+    _Table,
+)
+
+GENERATE_KEYS = (
+    "seed",
+    "count",
+    "p20",
+    "p21",
+    "region",
+    "orientation",
+    "length",
+    "sets",
+    "intersections",
+    "min_spacing",
+    "outside",
+    "min_length",
+)
+SET_KEYS = ("weight", "orientation", "length")
+ORIENTATION_KEYS = ("distribution", "mean", "kappa", "std")
+LENGTH_KEYS = ("distribution", "value", "exponent", "min", "max", "median", "sigma")
+# A truncated lognormal keeping less than this share of its mass would make
+# the resampling loop spin: refused.
+MIN_LOGNORMAL_MASS = 1e-4
+
+
+def _only_with(table: _Table, kind: str, used: tuple[str, ...]) -> None:
+    """Keys of the law's table that this distribution does not use."""
+    for name in table.data:
+        if name != "distribution" and name not in used:
+            table.error(name, f'not used with distribution = "{kind}"')
+
+
+def _read_orientation(parent: _Table) -> dfn.Orientation | None:
+    """``orientation = { distribution = .., mean = .., kappa | std = .. }`` [deg]."""
+    table = parent.table("orientation", ORIENTATION_KEYS, required=True)
+    if table is None:
+        return None
+    start = len(table.problems)
+    kind = table.choice("distribution", dfn.ORIENTATIONS)
+    if kind is None:
+        return None
+    used = {"uniform": (), "von_mises": ("mean", "kappa"), "normal": ("mean", "std")}
+    _only_with(table, kind, used[kind])
+    values = {}
+    if kind != "uniform":
+        values["mean"] = table.number("mean")
+    if kind == "von_mises":
+        values["kappa"] = table.number("kappa", rule=Range(0.0, 1.0e6))
+    if kind == "normal":
+        values["std"] = table.number("std", rule=Range(0.0, 360.0))
+    if len(table.problems) > start:
+        return None
+    return dfn.Orientation(kind=kind, **values)
+
+
+def _read_length(parent: _Table) -> dfn.LengthLaw | None:
+    """``length = { distribution = .., ... }`` [m]."""
+    table = parent.table("length", LENGTH_KEYS, required=True)
+    if table is None:
+        return None
+    start = len(table.problems)
+    kind = table.choice("distribution", dfn.LENGTHS)
+    if kind is None:
+        return None
+    used = {
+        "constant": ("value",),
+        "power_law": ("exponent", "min", "max"),
+        "lognormal": ("median", "sigma", "min", "max"),
+    }
+    _only_with(table, kind, used[kind])
+    if kind == "constant":
+        value = table.number("value", rule=_POSITIVE)
+        return None if value is None else dfn.LengthLaw(kind=kind, value=value)
+    if kind == "power_law":  # min and max required; optional truncation otherwise
+        lmin, lmax = (
+            table.number("min", rule=_POSITIVE),
+            table.number("max", rule=_POSITIVE),
+        )
+    else:
+        lmin, lmax = (
+            table.number("min", None, _POSITIVE),
+            table.number("max", None, _POSITIVE),
+        )
+    if lmin is not None and lmax is not None and lmax <= lmin:
+        table.error("max", f"must be > min = {_fmt(lmin)}, got {lmax!r}")
+    if kind == "power_law":
+        exponent = table.number("exponent", rule=Range(-10.0, 10.0))
+        if len(table.problems) > start:
+            return None
+        return dfn.LengthLaw(kind=kind, exponent=exponent, lmin=lmin, lmax=lmax)
+    median = table.number("median", rule=_POSITIVE)
+    sigma = table.number("sigma", rule=Range(0.0, 10.0, lo_open=True))
+    if len(table.problems) > start:
+        return None
+    law = dfn.LengthLaw(kind=kind, median=median, sigma=sigma, lmin=lmin, lmax=lmax)
+    mass = _lognormal_mass(law)
+    if mass < MIN_LOGNORMAL_MASS:
+        table.error(
+            None,
+            f"[min, max] holds only {mass:.2g} of the lognormal's probability; "
+            f"at least {MIN_LOGNORMAL_MASS:g} is needed",
+        )
+        return None
+    return law
+
+
+def _lognormal_mass(law: dfn.LengthLaw) -> float:
+    """P(min <= L <= max) of a lognormal law."""
+
+    def cdf(x):
+        return 0.5 * (
+            1.0 + math.erf((math.log(x / law.median)) / (law.sigma * math.sqrt(2)))
+        )
+
+    hi = cdf(law.lmax) if law.lmax is not None else 1.0
+    lo = cdf(law.lmin) if law.lmin is not None else 0.0
+    return hi - lo
+
+
+def _read_sets(table: _Table) -> tuple[dfn.FractureSet, ...] | None:
+    """``orientation`` + ``length`` (one set), or ``sets = [{weight, orientation,
+    length}, ...]``."""
+    single = [k for k in ("orientation", "length") if table.has(k)]
+    if table.has("sets"):
+        if single:
+            table.error("sets", f"give either sets or {' and '.join(single)}, not both")
+            return None
+        value = table.data["sets"]
+        if not isinstance(value, list) or not value:
+            table.error(
+                "sets", f"expected a non-empty array of tables, got {_show(value)}"
+            )
+            return None
+        out = []
+        for i, item in enumerate(value):
+            if not isinstance(item, dict):
+                table.error(f"sets[{i}]", f"expected a table, got {_show(item)}")
+                out.append(None)
+                continue
+            sub = _Table(item, table.key(f"sets[{i}]"), table.problems, SET_KEYS)
+            weight = sub.number("weight", rule=_POSITIVE)
+            orientation, length = _read_orientation(sub), _read_length(sub)
+            ok = None not in (weight, orientation, length)
+            out.append(
+                dfn.FractureSet(weight=weight, orientation=orientation, length=length)
+                if ok
+                else None
+            )
+        return None if any(s is None for s in out) else tuple(out)
+    orientation, length = _read_orientation(table), _read_length(table)
+    if orientation is None or length is None:
+        return None
+    return (dfn.FractureSet(weight=1.0, orientation=orientation, length=length),)
+
+
+def _read_region(table: _Table) -> tuple[float, float, float, float] | None | bool:
+    """``region = [[x0, y0], [x1, y1]]`` (lower-left, upper-right) -> (x0, x1, y0, y1);
+    None when not given, False when invalid."""
+    if not table.has("region"):
+        return None
+    value = table.data["region"]
+    corners = value if isinstance(value, list) and len(value) == 2 else None
+    if corners is None or not all(
+        isinstance(c, list)
+        and len(c) == 2
+        and all(
+            isinstance(v, int | float) and not isinstance(v, bool) and math.isfinite(v)
+            for v in c
+        )
+        for c in corners
+    ):
+        table.error(
+            "region",
+            f"expected [[x0, y0], [x1, y1]] (lower-left and upper-right corners, m), "
+            f"got {_show(value)}",
+        )
+        return False
+    (x0, y0), (x1, y1) = corners
+    if not (x1 > x0 and y1 > y0):
+        table.error(
+            "region",
+            f"upper-right corner must be above and right of lower-left, got {value}",
+        )
+        return False
+    return (float(x0), float(x1), float(y0), float(y1))
+
+
+def _read_count(table: _Table) -> dict | None:
+    """Exactly one of count, p20 [1/m^2], p21 [m/m^2]."""
+    given = [k for k in ("count", "p20", "p21") if table.has(k)]
+    if len(given) != 1:
+        table.error(
+            None if given else "count",
+            "give exactly one of count, p20 (fractures per m^2) or p21 "
+            f"(fracture length per m^2), got {', '.join(given) if given else 'none'}",
+        )
+        return None
+    name = given[0]
+    if name == "count":
+        value = table.integer("count", rule=Range(0, MAX_NETWORK_FRACTURES))
+    else:
+        value = table.number(name, rule=_POSITIVE)
+    return None if value is None else {name: value}
+
+
+def _read_generate(table: _Table) -> dfn.DfnParams | None:
+    """``[network.generate]`` -> DfnParams (validated, not yet realized)."""
+    start = len(table.problems)
+    seed = table.integer("seed", rule=_NON_NEGATIVE)
+    count = _read_count(table)
+    region = _read_region(table)
+    sets = _read_sets(table)
+    intersections = table.choice("intersections", dfn.INTERSECTIONS, "allow")
+    spacing = table.number("min_spacing", 0.0, _NON_NEGATIVE)
+    if spacing and intersections != "avoid":
+        table.error("min_spacing", 'only used with intersections = "avoid"')
+    outside = table.choice("outside", dfn.OUTSIDE, "clip")
+    min_length = table.number("min_length", 0.0, _NON_NEGATIVE)
+    if len(table.problems) > start or region is False:
+        return None
+    return dfn.DfnParams(
+        seed=seed,
+        region=region,
+        sets=sets,
+        intersections=intersections,
+        min_spacing=spacing,
+        outside=outside,
+        min_length=min_length,
+        **count,
+    )
+
+
+def _realize(
+    table: _Table, params: dfn.DfnParams, grid: _Grid, existing: np.ndarray
+) -> dfn.Network | None:
+    """The network of ``params`` in the domain; a problem if it does not fit."""
+    (x0, y0), (w, h) = grid.origin, grid.size
+    box = (x0, x0 + w, y0, y0 + h)
+    wanted = dfn.resolve_count(params, box)
+    if wanted > MAX_NETWORK_FRACTURES:
+        table.error(
+            None, f"asks for {wanted} fractures, more than {MAX_NETWORK_FRACTURES}"
+        )
+        return None
+    network = dfn.generate(params, box, existing)
+    if network.placed < network.requested:
+        table.error(
+            None,
+            f"placed only {network.placed} of {network.requested} fractures in "
+            f"{network.candidates} random draws (intersections = "
+            f'"{params.intersections}", min_spacing = {_fmt(params.min_spacing)} m, '
+            f'outside = "{params.outside}", min_length = {_fmt(params.min_length)} m); '
+            "ask for fewer or shorter fractures, or relax these rules",
+        )
+        return None
+    return network

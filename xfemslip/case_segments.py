@@ -1,0 +1,232 @@
+"""``network.file``: a CSV file of fracture segments -> polylines with their
+contact parameters (read by :mod:`xfemslip.case_network`).
+
+Private helper of :mod:`xfemslip.case`, which stays the ONLY entry point for
+validating user input (house style: case.py is the only place user input is
+validated); import the public names from ``xfemslip.case``, not from here.
+"""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+import numpy as np
+
+from xfemslip.case_csv import CSV_TOLERANCE, _add_capped
+from xfemslip.case_grid import _Grid
+from xfemslip.case_polyline import _segment_meets_box, _self_intersection
+from xfemslip.case_tables import (
+    _NON_NEGATIVE,
+    _POSITIVE,
+    _exact,
+    _fmt,
+    _range_problem,
+    _suggest,
+    _Table,
+)
+
+PROPERTY_RULES = {
+    "friction": _NON_NEGATIVE,
+    "cohesion": _NON_NEGATIVE,
+    "kn": _POSITIVE,
+    "kt": _POSITIVE,
+}
+SEGMENT_COLUMNS = ("x0", "y0", "x1", "y1")
+OPTIONAL_COLUMNS = ("fracture", *PROPERTY_RULES)
+MAX_NETWORK_FRACTURES = 5_000  # per source (file rows, generated count)
+
+
+def _csv_header(line: str | None, file: Path) -> tuple[list[str], list[str]]:
+    """(columns, problems) of the header line."""
+    if line is None:
+        return [], [f"{file} line 1: empty file, expected the header x0,y0,x1,y1"]
+    columns = [c.strip().lower() for c in line.split(",")]
+    allowed = SEGMENT_COLUMNS + OPTIONAL_COLUMNS
+    bad = [
+        f"{file} line 1: unknown column {c!r}{_suggest(c, allowed)}"
+        for c in columns
+        if c not in allowed
+    ]
+    bad += [
+        f"{file} line 1: column {c!r} appears twice"
+        for c in sorted({c for c in columns if columns.count(c) > 1})
+    ]
+    missing = [c for c in SEGMENT_COLUMNS if c not in columns]
+    if missing:
+        bad.append(
+            f"{file} line 1: missing column(s) {', '.join(missing)}; the header "
+            "needs x0,y0,x1,y1 (optional: " + ", ".join(OPTIONAL_COLUMNS) + ")"
+        )
+    return columns, bad
+
+
+def _csv_cell(name: str, text: str) -> tuple[object, str | None]:
+    """(value, problem) of one cell; empty optional cells are None."""
+    text = text.strip()
+    if name == "fracture":
+        return (text or None), None
+    if not text:
+        if name in SEGMENT_COLUMNS:
+            return None, f"{name} is empty"
+        return None, None
+    try:
+        value = float(text)
+    except ValueError:
+        return None, f"{name} is not a number: {text!r}"
+    if not math.isfinite(value):
+        return None, f"{name} must be finite, got {text!r}"
+    message = _range_problem(value, PROPERTY_RULES.get(name), name)
+    return value, (f"{name} {message}" if message else None)
+
+
+def _csv_rows(lines: list[str], columns: list[str], file: Path):
+    """[(line number, {column: value})] and problems; blank and # lines skipped."""
+    rows, bad = [], []
+    for number, line in enumerate(lines[1:], start=2):
+        if not line.strip() or line.lstrip().startswith("#"):
+            continue
+        fields = line.split(",")
+        if len(fields) != len(columns):
+            bad.append(
+                f"{file} line {number}: expected {len(columns)} values "
+                f"({','.join(columns)}), got {len(fields)}: {line.strip()!r}"
+            )
+            continue
+        row, problems = {}, []
+        for name, text in zip(columns, fields, strict=True):
+            row[name], problem = _csv_cell(name, text)
+            if problem:
+                problems.append(problem)
+        p0, p1 = (row.get("x0"), row.get("y0")), (row.get("x1"), row.get("y1"))
+        if not problems and p0 == p1:
+            problems.append(
+                f"zero-length segment: (x0, y0) = (x1, y1) = "
+                f"({_exact(p0[0])}, {_exact(p0[1])})"
+            )
+        bad += [f"{file} line {number}: {p}" for p in problems]
+        if not problems:
+            rows.append((number, row))
+    return rows, bad
+
+
+def _group_rows(rows: list) -> list[tuple[str, list]]:
+    """Rows grouped by the ``fracture`` column in order of first appearance; a
+    row without a fracture id is a fracture of its own."""
+    groups: dict[object, list] = {}
+    for number, row in rows:
+        fid = row.get("fracture")
+        groups.setdefault(fid if fid is not None else ("row", number), []).append(
+            (number, row)
+        )
+    return [(k if isinstance(k, str) else None, g) for k, g in groups.items()]
+
+
+def _lines_text(group: list) -> str:
+    """``line 4`` or ``lines 4, 5, 9``."""
+    numbers = [str(n) for n, _ in group]
+    return f"line{'s' if len(numbers) > 1 else ''} {', '.join(numbers)}"
+
+
+def _chain(group: list, fid, file: Path, tol: float) -> tuple[np.ndarray | None, list]:
+    """Polyline of one fracture's segments, each starting where the last ended."""
+    first = group[0][1]
+    points = [(first["x0"], first["y0"]), (first["x1"], first["y1"])]
+    bad = []
+    for (prev, _), (number, row) in zip(group[:-1], group[1:], strict=True):
+        start = (row["x0"], row["y0"])
+        if math.dist(start, points[-1]) > tol:
+            bad.append(
+                f"{file} line {number}: fracture {fid!r} continues at "
+                f"({_exact(start[0])}, {_exact(start[1])}) but its segment on line "
+                f"{prev} ends at ({_exact(points[-1][0])}, {_exact(points[-1][1])}); "
+                "the rows of a fracture must chain end to start"
+            )
+        points.append((row["x1"], row["y1"]))
+    return (None if bad else np.array(points, dtype=np.float64)), bad
+
+
+def _group_properties(group: list, fid, file: Path, defaults: dict):
+    """(properties, problems): per-row values (equal across a fracture's rows),
+    else the [network] defaults; friction must come from one or the other."""
+    props, bad = {}, []
+    for name in PROPERTY_RULES:
+        given = [(n, r[name]) for n, r in group if r.get(name) is not None]
+        values = {v for _, v in given}
+        if len(values) > 1:
+            (n1, v1), (n2, v2) = given[0], next(g for g in given if g[1] != given[0][1])
+            bad.append(
+                f"{file} lines {n1} and {n2}: fracture {fid!r} has {name} "
+                f"{_fmt(v1)} and {_fmt(v2)}; its rows must agree"
+            )
+        props[name] = given[0][1] if given else defaults.get(name)
+    if props["friction"] is None and not bad:
+        bad.append(
+            f"{file} {_lines_text(group)}: no friction: give it in a friction "
+            "column or as network.friction"
+        )
+    return props, bad
+
+
+def _read_segments_file(
+    table: _Table, grid: _Grid | None, folder: Path, defaults: dict
+) -> list[tuple[np.ndarray, dict, str]] | None:
+    """``network.file``: [(points, properties, source)] per fracture, or None."""
+    name = table.string("file")
+    if name is None:
+        return None
+    file, key = folder / name, table.key("file")
+    try:
+        lines = file.read_text(encoding="utf-8-sig").splitlines()
+    except (OSError, UnicodeDecodeError) as exc:
+        table.error(
+            "file", f"cannot read {file}: {getattr(exc, 'strerror', None) or exc}"
+        )
+        return None
+    columns, bad = _csv_header(lines[0] if lines else None, file)
+    if bad:
+        _add_capped(table.problems, key, bad)
+        return None
+    rows, bad = _csv_rows(lines, columns, file)
+    tol = CSV_TOLERANCE * max(grid.size) if grid is not None else 0.0
+    out = []
+    for fid, group in _group_rows(rows):
+        points, chain_bad = _chain(group, fid, file, tol)
+        props, prop_bad = _group_properties(group, fid, file, defaults)
+        bad += chain_bad + prop_bad
+        if points is None or prop_bad:
+            continue
+        where = f"{file} {_lines_text(group)}"
+        shape = _shape_problem(points, grid)
+        if shape:
+            bad.append(f"{where}: {shape}")
+            continue
+        label = f"fracture {fid!r}, " if fid is not None else ""
+        out.append((points, props, f"network.file {name}: {label}{_lines_text(group)}"))
+    if not rows and not bad:
+        bad.append(f"{file}: no segment rows after the header")
+    if len(out) > MAX_NETWORK_FRACTURES:
+        bad.append(f"{file}: {len(out)} fractures, more than {MAX_NETWORK_FRACTURES}")
+    _add_capped(table.problems, key, bad)
+    return None if bad else out
+
+
+def _shape_problem(points: np.ndarray, grid: _Grid | None) -> str | None:
+    """Self-intersection, or a fracture wholly outside the domain."""
+    pair = _self_intersection(points)
+    if pair is not None:
+        i, j = pair
+        return f"self-intersecting polyline: segments {i} and {j} touch or cross"
+    if grid is None:
+        return None
+    lo = grid.origin
+    hi = (lo[0] + grid.size[0], lo[1] + grid.size[1])
+    if not any(
+        _segment_meets_box(a, b, lo, hi)
+        for a, b in zip(points[:-1], points[1:], strict=True)
+    ):
+        return (
+            f"lies outside the domain [{_fmt(lo[0])}, {_fmt(hi[0])}] x "
+            f"[{_fmt(lo[1])}, {_fmt(hi[1])}]"
+        )
+    return None

@@ -1,0 +1,137 @@
+"""Figures of fracture networks (matplotlib, imported only here and only when
+a figure is drawn; ``matplotlib.figure.Figure``, no pyplot, no GUI backend).
+
+``figure_network``: the fractures of a case in its domain, coloured by
+``|slip|`` at the contact points when a ``result.h5`` is given (slipping
+fractures drawn thicker), else by origin; with a sweep's ``summary.csv`` a
+second panel shows how many fractures slip over the realizations.
+"""
+
+from __future__ import annotations
+
+import csv
+from pathlib import Path
+
+import h5py
+import numpy as np
+from matplotlib.collections import LineCollection
+from matplotlib.colors import Normalize
+from matplotlib.figure import Figure
+
+from xfemslip.errors import OutputError, UsageError
+
+SLIP_CODE = 2  # output-format.md: 0 open, 1 stick, 2 slip
+PANEL = 4.2  # inches
+
+
+def _domain_frame(ax, spec) -> None:
+    (x0, y0), (w, h) = spec.origin, spec.size
+    ax.plot([x0, x0 + w, x0 + w, x0, x0], [y0, y0, y0 + h, y0 + h, y0], "k-", lw=0.8)
+    ax.set_aspect("equal")
+    ax.set_xlim(x0 - 0.02 * w, x0 + 1.02 * w)
+    ax.set_ylim(y0 - 0.02 * h, y0 + 1.02 * h)
+    ax.set_xlabel("x (m)")
+    ax.set_ylabel("y (m)")
+
+
+def read_result_slip(result: Path, n_fractures: int) -> list[tuple]:
+    """[(points (K, 2), slip (K,), state (K,))] per fracture of a result.h5."""
+    try:
+        with h5py.File(result, "r") as f:
+            out = []
+            for i in range(n_fractures):
+                group = f.get(f"fractures/{i}")
+                if group is None:
+                    raise UsageError(
+                        f"{result}: no /fractures/{i}: not a result of this case "
+                        f"({n_fractures} fractures)"
+                    )
+                out.append(tuple(group[k][()] for k in ("points", "slip", "state")))
+            return out
+    except OSError as exc:
+        raise UsageError(f"{result}: cannot read the result: {exc}") from None
+
+
+def _draw_slip(fig, ax, fields) -> None:
+    """Contact-point polylines coloured by |slip|; slipping fractures thicker."""
+    top = max((float(np.abs(s).max()) for _, s, _ in fields if s.size), default=0.0)
+    norm = Normalize(0.0, top if top > 0 else 1.0)
+    collection = None
+    for points, slip, state in fields:
+        if len(points) < 2:
+            continue
+        pieces = np.stack([points[:-1], points[1:]], axis=1)
+        value = 0.5 * (np.abs(slip[:-1]) + np.abs(slip[1:]))
+        width = 2.6 if np.any(state == SLIP_CODE) else 1.0
+        collection = LineCollection(pieces, cmap="viridis", norm=norm, linewidths=width)
+        collection.set_array(value)
+        ax.add_collection(collection)
+    if collection is not None:
+        fig.colorbar(collection, ax=ax, label="|slip| (m)", shrink=0.8)
+
+
+def _draw_plain(ax, spec) -> None:
+    """Fractures coloured by where they come from (inline, file, generated)."""
+    colours = {"": "tab:red", "network.file": "tab:blue", "network.generate": "k"}
+    for fracture in spec.fractures:
+        kind = fracture.source.split(" ", 1)[0] if fracture.source else ""
+        p = fracture.points
+        ax.plot(p[:, 0], p[:, 1], "-", color=colours.get(kind, "k"), lw=1.2)
+
+
+def read_slipping_counts(summary: Path) -> tuple[np.ndarray, np.ndarray]:
+    """(slipping_fractures, fractures) of the ok/skipped rows of a summary.csv."""
+    try:
+        with open(summary, newline="", encoding="utf-8") as fh:
+            rows = list(csv.DictReader(fh))
+    except OSError as exc:
+        raise UsageError(f"{summary}: cannot read: {exc.strerror or exc}") from None
+    if rows and "slipping_fractures" not in rows[0]:
+        raise UsageError(f"{summary}: no slipping_fractures column (an older sweep?)")
+    rows = [r for r in rows if r["status"] in ("ok", "skipped")]
+    return (
+        np.array([int(r["slipping_fractures"]) for r in rows]),
+        np.array([int(r["fractures"]) for r in rows]),
+    )
+
+
+def _draw_counts(ax, counts: np.ndarray, totals: np.ndarray) -> None:
+    """Histogram of the slipping count over the realizations."""
+    bins = np.arange(counts.min(), counts.max() + 2) - 0.5 if counts.size else 1
+    ax.hist(counts, bins=bins, color="tab:blue", edgecolor="k")
+    total = f"{int(totals[0])}" if totals.size and np.ptp(totals) == 0 else "varies"
+    ax.set_xlabel(f"slipping fractures (of {total})")
+    ax.set_ylabel("realizations")
+    if counts.size:
+        ax.set_title(
+            f"{counts.size} realizations: mean {counts.mean():.1f}, "
+            f"std {counts.std(ddof=1) if counts.size > 1 else 0.0:.1f}",
+            fontsize=9,
+        )
+
+
+def figure_network(spec, result: Path | None = None, summary: Path | None = None):
+    """The network of ``spec`` (slip from ``result``), plus the slipping-count
+    histogram of a sweep ``summary`` when given."""
+    n = 2 if summary is not None else 1
+    fig = Figure(figsize=(PANEL * n + 1.0 * (result is not None), PANEL))
+    axes = fig.subplots(1, n, squeeze=False)[0]
+    _domain_frame(axes[0], spec)
+    if result is not None:
+        _draw_slip(fig, axes[0], read_result_slip(result, len(spec.fractures)))
+        axes[0].set_title(f"{spec.name}: |slip| (thick: slipping)", fontsize=9)
+    else:
+        _draw_plain(axes[0], spec)
+        axes[0].set_title(f"{spec.name}: {len(spec.fractures)} fractures", fontsize=9)
+    if summary is not None:
+        _draw_counts(axes[1], *read_slipping_counts(summary))
+    fig.tight_layout()
+    return fig
+
+
+def save(fig, path: Path, dpi: int = 110) -> None:
+    """Write the figure; OutputError if the file cannot be written."""
+    try:
+        fig.savefig(path, dpi=dpi, bbox_inches="tight")
+    except (OSError, ValueError) as exc:
+        raise OutputError(f"{path}: cannot write the figure: {exc}") from None
