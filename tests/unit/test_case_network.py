@@ -317,22 +317,31 @@ def test_two_hundred_generated_fractures_build(tmp_path, monkeypatch):
     check_geometry(spec)  # the geometry refuses any crossing pair
 
 
-def test_allow_network_that_crosses_is_refused_by_the_geometry_for_now(tmp_path):
-    """Until crossing fractures are supported (the network mechanics branch),
-    an "allow" network with a crossing pair is exit 2 naming the pair.  After
-    that merge this test should expect exit 0 instead."""
+def test_allow_network_that_crosses_is_built_with_a_junction_per_crossing(tmp_path):
+    """An "allow" network whose fractures cross is accepted (exit 0) and every
+    crossing found by the generator's own segment test (dfn.intersecting_pairs,
+    independent of the geometry code) becomes a junction of the model."""
     from xfemslip.dfn import intersecting_pairs
+    from xfemslip.geometry import GEOMETRY_TOL, find_junctions
+    from xfemslip.mesh import build_mesh
 
     network = GENERATE.replace('intersections = "avoid"', 'intersections = "allow"')
     network = network.replace("count = 5", "count = 40")
     path = _case(tmp_path, network, inline="")
     spec = load_case(path)
     pairs = intersecting_pairs(np.array([f.points for f in spec.fractures]))
-    assert pairs  # 40 random 0.2 m fractures on 2 m^2 do cross
+    assert len(pairs) >= 3  # 40 random 0.2 m fractures on 2 m^2 do cross
     result = CliRunner().invoke(cli, ["check", str(path)])
-    assert result.exit_code == 2
-    i, j = pairs[0]
-    assert f"fractures[{i}] and fractures[{j}] intersect" in result.output
+    assert result.exit_code == 0, result.output
+    mesh = build_mesh(spec.mesh.x, spec.mesh.y)
+    polylines = [np.array(f.points, float) for f in spec.fractures]
+    free = [[True, True] for _ in polylines]
+    names = [f"fractures[{f.index}]" for f in spec.fractures]
+    found = find_junctions(
+        polylines, free, names, mesh.h_min, GEOMETRY_TOL * mesh.h_min
+    )
+    met = {tuple(sorted((main, sec))) for _, main, sec, _ in found}
+    assert {tuple(sorted(p)) for p in pairs} <= met
 
 
 def test_cli_dfn_without_network_fractures_and_plot(tmp_path):

@@ -280,9 +280,11 @@ def test_offset_fault_stuck_shear_traction():
     ON the pressure boundary x = 0, mid-cell (the cut cells are split per
     quadrature point, xfemslip.poro), so the four reservoir corners, where
     (J1) has log singularities, lie on the fault itself.  Measured (rms / max
-    relative error over patches > 4 h from the corners): h = 10 m 4.3 % /
-    6.5 %; h = 5 m 2.9 % / 2.7 %; h = 2.5 m 1.6 % / 2.9 %; h = 1.25 m
-    0.87 % / 1.5 % (rms order 0.6, 0.8, 0.9).  Larger than with the fault
+    relative error over patches > 4 h from the corners): h = 10 m 3.6 % /
+    5.2 %; h = 5 m 2.9 % / 2.7 %; h = 2.5 m 1.6 % / 2.9 % (rms order 0.3,
+    0.8; with the contact patches built before the network merge, which
+    walked each segment from its first point, h = 10 m gave 4.3 % / 6.5 %
+    and h = 1.25 m 0.87 % / 1.5 %).  Larger than with the fault
     half a cell off the boundary (2.3 / 1.3 / 0.64 % rms there): the patches
     kept are 4 h from singularities now on the fault, not h / 2 beside it;
     away from the corners both set-ups agree (e.g. 0.25 % at y = 15 m,
@@ -290,9 +292,9 @@ def test_offset_fault_stuck_shear_traction():
     """
     rms10, max10 = _stuck_fault_errors(10.0)
     rms5, max5 = _stuck_fault_errors(5.0)
-    assert rms10 < 0.05 and max10 < 0.075
+    assert rms10 < 0.045 and max10 < 0.065
     assert rms5 < 0.034 and max5 < 0.033
-    assert rms5 < 0.75 * rms10  # converging
+    assert rms5 < 0.9 * rms10  # converging (slowly: corners on the fault)
 
 
 @pytest.mark.slow
