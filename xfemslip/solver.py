@@ -360,6 +360,24 @@ class NewtonSolver:
                 du = self._solve(guess[0], guess[1], k, it, eta)
             else:
                 du = self._solve(res, r, k, it, eta)
+                flipped = self._reversals(u, du, regime, law, pt_prev, gt_prev)
+                if flipped is not None:
+                    frozen = flipped if frozen is None else (frozen | flipped)
+                    law = _frozen_law(c, frozen)
+                    log.reversals += 1
+                    logger.info(
+                        "step %d/%d iteration %d: the Newton step reverses the "
+                        "slip of %d contact patch(es) (forward <-> backward); "
+                        "holding them in stick, the state between the two",
+                        k,
+                        steps,
+                        it,
+                        int(flipped.sum()),
+                    )
+                    res = law.evaluate(u, self.mode, pt_prev, gt_prev)
+                    r, eta = self._residual(u, lam, res)
+                    regime = _regime(res.state, res.pt)
+                    du = self._solve(res, r, k, it, eta)
             pt_prev, gt_prev, prev_regime = res.pt, res.gt, regime
             eta_before = eta
             u, res, r, eta = self._line_search(u, du, lam, eta, pt_prev, gt_prev, law)
@@ -402,6 +420,31 @@ class NewtonSolver:
             int(np.count_nonzero(guess != regime)),
         )
         return res, self._residual(u, lam, res)[0]
+
+    def _reversals(self, u, du, regime, law, pt_prev, gt_prev):
+        """Patches whose slip the full Newton step reverses, or None.
+
+        A patch slipping forward at u and backward at u - du (or the other way
+        round) jumps over its stick band, |g_T - g_T^p| <= (c - f p_N) / k_T,
+        which is narrow (about 1e-6 m with stiff penalties) however long the
+        step.  Next to fracture junctions the next step often reverses it
+        back (the slip tangent has no tangential stiffness, d p_T / d g_T = 0,
+        so nothing in the linearization holds the patch), and the line search
+        then only shortens steps that keep cycling.  The continuous path
+        between the two slip branches passes through stick: those patches are
+        held in stick (_frozen_law) until Newton converges, then the true law
+        is restored and checked, as for ping-pong.  Consistent tangent only.
+        """
+        if self.mode != kernels.TANGENT_CONSISTENT:
+            return None
+        trial = u.copy()
+        trial[self.free] -= du
+        res = law.evaluate(trial, self.mode, pt_prev, gt_prev)
+        new = _regime(res.state, res.pt)
+        mask = ((regime == SLIP) & (new == SLIP + 1)) | (
+            (regime == SLIP + 1) & (new == SLIP)
+        )
+        return mask if mask.any() else None
 
     def _line_search(self, u, du, lam, eta0, pt_prev, gt_prev, law=None):
         """Backtracking on eta along the Newton direction (Armijo on the norm).
@@ -525,6 +568,7 @@ class _NewtonLog:
     iterations: int = 0
     freezes: int = 0
     fallbacks: int = 0  # secant iterations replaced by a consistent one
+    reversals: int = 0  # Newton steps that held reversing patches in stick
     predicted: int = 0  # 1 if the first solve used the predicted set
     residuals: list = None
     switches: list = None
