@@ -97,6 +97,9 @@ class StepResult:
     factors: list = None  # load factors of the converged sub-steps, in order
     # sub-steps whose first Newton solve used the predicted stick/slip set
     predicted: int = 0
+    # Newton steps re-solved with slip-reversing patches held in stick (each
+    # one extra linear solve; NewtonSolver._reversals), all sub-steps
+    reversals: int = 0
 
 
 def _regime(state, pt):
@@ -188,7 +191,7 @@ class NewtonSolver:
         """
         units = 1 << self.max_cuts
         done, size = 0, units
-        cuts = substeps = iterations = freezes = predicted = 0
+        cuts = substeps = iterations = freezes = predicted = reversals = 0
         factors = []  # load factors of the converged sub-steps
         while done < units:
             end = min(done + size, units)
@@ -228,6 +231,7 @@ class NewtonSolver:
             iterations += log.iterations
             freezes += log.freezes
             predicted += log.predicted
+            reversals += log.reversals
         if cuts:
             logger.info(
                 "step %d/%d converged in %d sub-steps after %d cut(s)",
@@ -250,6 +254,7 @@ class NewtonSolver:
                 freezes=freezes,
                 factors=factors,
                 predicted=predicted,
+                reversals=reversals,
             )
         )
         return u
