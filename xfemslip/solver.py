@@ -52,10 +52,10 @@ PINGPONG_MAX_FREEZES = 2
 PINGPONG_PERIODS = 3
 # Slip-reversal remedy (NewtonSolver._reversals): times a patch may be held
 # in stick within one Newton solve.  Once (a patch that reverses again after
-# the release is let through) left allow-DFN seed 1 failing with the predictor
-# on and five others without it; without a limit a patch can be held and
-# released forever (seed 1, predictor off); 2 and 3 converge on all 20 seeds
-# both ways (benchmarks/RESULTS.md, "Newton on fracture networks").
+# the release is let through) left 5 of the 20 allow-DFN seeds failing with
+# the predictor on; without a limit a patch can be held and released
+# forever (seed 1, predictor off); 2 and 3 converge on all 20 seeds both
+# ways (benchmarks/RESULTS.md, "Newton on fracture networks").
 REVERSAL_HOLDS = 2
 # Load-step bisection: a load step that does not converge is cut in halves, at
 # most this many times by default ([solver] max_step_cuts), so the smallest
