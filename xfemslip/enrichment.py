@@ -243,19 +243,25 @@ def build_enriched_cells(mesh, fractures, cand: Candidates) -> EnrichedCells:
     """
     tol = GEOMETRY_TOL * mesh.h_min
     cand_fnode = _candidate_node_values(fractures, mesh, cand, tol)
-    slots_of = {}
+    # (candidate, cell) pairs of every cell around each candidate's node,
+    # grouped by cell, candidates in increasing order within a cell
+    k_all = c_all = np.zeros(0, np.int64)
     if cand.node.size:
-        node_cells = _node_cells(mesh)
-        for k, node in enumerate(cand.node):
-            for c in node_cells[node]:
-                slots_of.setdefault(int(c), []).append(k)
-    cand_cells = np.array(sorted(slots_of), dtype=np.int64)
+        order = np.argsort(mesh.cells.ravel(), kind="stable")
+        split = np.searchsorted(mesh.cells.ravel()[order], np.arange(mesh.n_nodes + 1))
+        count = np.diff(split)[cand.node]
+        k_all = np.repeat(np.arange(cand.node.size), count)
+        c_all = order[_ranges(split[cand.node], count)] // 4
+    pair = np.lexsort((k_all, c_all))
+    k_all, c_all = k_all[pair], c_all[pair]
+    cand_cells, first, n_slots = np.unique(c_all, return_index=True, return_counts=True)
+    cand_cells = cand_cells.astype(np.int64)
     nc = cand_cells.size
-    S = max((len(v) for v in slots_of.values()), default=0)
+    S = int(n_slots.max(initial=0))
     slot_cand = -np.ones((nc, S), np.int64)
-    for e, c in enumerate(cand_cells):
-        ks = slots_of[int(c)]
-        slot_cand[e, : len(ks)] = ks
+    slot_cand[
+        np.repeat(np.arange(nc), n_slots), _ranges(np.zeros(nc, np.int64), n_slots)
+    ] = k_all
     used = slot_cand >= 0
     k_used = slot_cand[used]
     slot_node = -np.ones((nc, S), np.int64)
@@ -270,10 +276,11 @@ def build_enriched_cells(mesh, fractures, cand: Candidates) -> EnrichedCells:
     # pass 1: sub-cells and quadrature of each cell
     parts = {key: [] for key in ("xy", "w", "tris")}
     per_tri = []  # quadrature points of each sub-triangle
-    for c in cand_cells:
-        ks = slots_of[int(c)]
-        frs = sorted({int(cand.fracture[k]) for k in ks})
-        has_branch = any(cand.func[k] != HEAVISIDE for k in ks)
+    frac_of, func_of = cand.fracture.tolist(), cand.func.tolist()
+    for e, c in enumerate(cand_cells):
+        ks = slot_cand[e, : n_slots[e]].tolist()
+        frs = sorted({frac_of[k] for k in ks})
+        has_branch = any(func_of[k] != HEAVISIDE for k in ks)
         tris, xy, w = _cell_rule(mesh, c, fractures, frs, has_branch, tol)
         parts["xy"].append(xy)
         parts["w"].append(w)
@@ -368,15 +375,6 @@ def _ranges(starts, counts):
         return np.zeros(0, np.int64)
     first = np.cumsum(counts) - counts
     return np.repeat(starts - first, counts) + np.arange(total, dtype=np.int64)
-
-
-def _node_cells(mesh):
-    """Cells around each node (list of arrays)."""
-    order = np.argsort(mesh.cells.ravel(), kind="stable")
-    nodes_sorted = mesh.cells.ravel()[order]
-    cells_sorted = order // 4
-    split = np.searchsorted(nodes_sorted, np.arange(mesh.n_nodes + 1))
-    return [cells_sorted[split[i] : split[i + 1]] for i in range(mesh.n_nodes)]
 
 
 def carries_jump(mesh, cand: Candidates, ip) -> np.ndarray:
