@@ -101,7 +101,7 @@ def main() -> int:
         f"{'newton':>6s} {'facts':>5s} {'krylov':>6s} {'build':>7s} "
         f"{'factor':>7s} {'solve':>7s}"
     )
-    for (tip, solver), rs in runs.items():
+    for (tip, _solver), rs in runs.items():
         r0 = rs[0]
 
         def med(key, rs=rs):
