@@ -187,14 +187,16 @@ def assemble_bulk(
         enr_dofs[:, 8 + 2 * s] = np.where(base >= 0, base, -1)
         enr_dofs[:, 9 + 2 * s] = np.where(base >= 0, base + 1, -1)
 
-    enr_rows, enr_cols = _pairs(enr_dofs)
+    # standard cells (every dof >= 0), then the enriched cells' entries
+    # without their empty slots (kernels.block_triplets: same order as
+    # expanding the padded blocks and masking, so the same CSR to the bit)
+    enr_rows, enr_cols, enr_vals = _triplets(enr_dofs, K_e)
     rows = [np.repeat(std_dofs, 8, axis=1).ravel(), enr_rows]
     cols = [np.tile(std_dofs, (1, 8)).ravel(), enr_cols]
-    vals = [K_u[which].ravel(), K_e.ravel()]
+    vals = [K_u[which].ravel(), enr_vals]
     rows, cols, vals = (np.concatenate(v) for v in (rows, cols, vals))
-    keep = (rows >= 0) & (cols >= 0)
     n = dofmap.n_dofs
-    K = sp.coo_matrix((vals[keep], (rows[keep], cols[keep])), shape=(n, n)).tocsr()
+    K = sp.coo_matrix((vals, (rows, cols)), shape=(n, n)).tocsr()
     logger.info(
         "bulk: %d cells (%d enriched), %d dofs (%d enriched)",
         mesh.n_cells,
@@ -212,18 +214,19 @@ def assemble_bulk(
     )
 
 
-def _pairs(dofs):
-    """Row and column index arrays of every (i, j) entry of per-cell blocks."""
-    nd = dofs.shape[1]
-    return np.repeat(dofs, nd, axis=1).ravel(), np.tile(dofs, (1, nd)).ravel()
+def _triplets(dofs, blocks):
+    """Rows, columns and values of the entries of per-item blocks (m, k, k)
+    whose dofs (m, k) are both >= 0 (kernels.block_triplets)."""
+    return kernels.block_triplets(
+        np.ascontiguousarray(dofs, dtype=np.int64),
+        np.ascontiguousarray(blocks, dtype=np.float64),
+    )
 
 
 def coo_block(dofs: np.ndarray, blocks: np.ndarray, n: int) -> sp.csr_matrix:
     """Sum of per-item blocks (m, k, k) on dofs (m, k) (-1 ignored) as CSR (n, n)."""
-    r, c = _pairs(dofs)
-    v = blocks.ravel()
-    keep = (r >= 0) & (c >= 0)
-    return sp.coo_matrix((v[keep], (r[keep], c[keep])), shape=(n, n)).tocsr()
+    r, c, v = _triplets(dofs, blocks)
+    return sp.coo_matrix((v, (r, c)), shape=(n, n)).tocsr()
 
 
 def scatter_vector(dofs: np.ndarray, values: np.ndarray, n: int) -> np.ndarray:

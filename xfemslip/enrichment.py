@@ -232,95 +232,149 @@ def _cell_rule(mesh, c, fractures, frs, has_branch, tol):
 
 
 def build_enriched_cells(mesh, fractures, cand: Candidates) -> EnrichedCells:
-    """Slots, sub-cell quadrature and enrichment values of every enriched cell."""
+    """Slots, sub-cell quadrature and enrichment values of every enriched cell.
+
+    Two passes: the sub-cells of each cell (its own cut lines), then the
+    enrichment functions of each (fracture, tip or arm) group evaluated once
+    on the quadrature points and sub-triangle vertices of all the cells the
+    group reaches (the functions are point-wise, so the values are those of a
+    cell-by-cell evaluation; measured in benchmarks/RESULTS.md, "Network
+    speed").  The fracture side of a point is that of its sub-cell's centroid.
+    """
     tol = GEOMETRY_TOL * mesh.h_min
     cand_fnode = _candidate_node_values(fractures, mesh, cand, tol)
-    slots_of = {}
+    # (candidate, cell) pairs of every cell around each candidate's node,
+    # grouped by cell, candidates in increasing order within a cell
+    k_all = c_all = np.zeros(0, np.int64)
     if cand.node.size:
-        node_cells = _node_cells(mesh)
-        for k, node in enumerate(cand.node):
-            for c in node_cells[node]:
-                slots_of.setdefault(int(c), []).append(k)
-    cand_cells = np.array(sorted(slots_of), dtype=np.int64)
+        order = np.argsort(mesh.cells.ravel(), kind="stable")
+        split = np.searchsorted(mesh.cells.ravel()[order], np.arange(mesh.n_nodes + 1))
+        count = np.diff(split)[cand.node]
+        k_all = np.repeat(np.arange(cand.node.size), count)
+        c_all = order[_ranges(split[cand.node], count)] // 4
+    pair = np.lexsort((k_all, c_all))
+    k_all, c_all = k_all[pair], c_all[pair]
+    cand_cells, first, n_slots = np.unique(c_all, return_index=True, return_counts=True)
+    cand_cells = cand_cells.astype(np.int64)
     nc = cand_cells.size
-    S = max((len(v) for v in slots_of.values()), default=0)
+    S = int(n_slots.max(initial=0))
     slot_cand = -np.ones((nc, S), np.int64)
+    slot_cand[
+        np.repeat(np.arange(nc), n_slots), _ranges(np.zeros(nc, np.int64), n_slots)
+    ] = k_all
+    used = slot_cand >= 0
+    k_used = slot_cand[used]
     slot_node = -np.ones((nc, S), np.int64)
     slot_fnode = np.zeros((nc, S))
-    parts = {key: [] for key in ("xy", "w", "F", "gF", "tris", "Fv")}
-    qp_off, tri_off = [0], [0]
+    local = (
+        mesh.cells[np.repeat(cand_cells, used.sum(axis=1))]
+        == (cand.node[k_used][:, None])
+    )
+    slot_node[used] = np.argmax(local, axis=1)
+    slot_fnode[used] = cand_fnode[k_used]
+
+    # pass 1: sub-cells and quadrature of each cell
+    parts = {key: [] for key in ("xy", "w", "tris")}
+    per_tri = []  # quadrature points of each sub-triangle
+    frac_of, func_of = cand.fracture.tolist(), cand.func.tolist()
     for e, c in enumerate(cand_cells):
-        ks = slots_of[int(c)]
-        frs = sorted({int(cand.fracture[k]) for k in ks})
-        has_branch = any(cand.func[k] != HEAVISIDE for k in ks)
+        ks = slot_cand[e, : n_slots[e]].tolist()
+        frs = sorted({frac_of[k] for k in ks})
+        has_branch = any(func_of[k] != HEAVISIDE for k in ks)
         tris, xy, w = _cell_rule(mesh, c, fractures, frs, has_branch, tol)
-        per = xy.shape[0] // tris.shape[0]
-        centroids = tris.mean(axis=1)
-        side_t = {fi: fractures[fi].side(centroids) for fi in frs}
-        F = np.zeros((xy.shape[0], S))
-        gF = np.zeros((xy.shape[0], S, 2))
-        Fv = np.zeros((tris.shape[0], 3, S))
-        cache = {}
-        for s, k in enumerate(ks):
-            node = cand.node[k]
-            fi, tip = int(cand.fracture[k]), int(cand.tip[k])
-            slot_cand[e, s] = k
-            slot_node[e, s] = int(np.nonzero(mesh.cells[c] == node)[0][0])
-            slot_fnode[e, s] = cand_fnode[k]
-            if (fi, tip) not in cache:
-                st = side_t[fi]
-                cq = np.repeat(centroids, per, axis=0)  # sides from the sub-cell
-                cv = np.repeat(centroids, 3, axis=0)
-                cache[fi, tip] = (
-                    _group_values(fractures, fi, tip, xy, np.repeat(st, per), tol, cq),
-                    _group_values(
-                        fractures,
-                        fi,
-                        tip,
-                        tris.reshape(-1, 2),
-                        np.repeat(st, 3),
-                        tol,
-                        cv,
-                    )[0],
-                )
-            (Fq, gq), Fvert = cache[fi, tip]
-            j = 0 if cand.func[k] == HEAVISIDE else cand.func[k] - 1
-            F[:, s], gF[:, s] = Fq[:, j], gq[:, j]
-            Fv[:, :, s] = Fvert[:, j].reshape(-1, 3)
-        for key, val in zip(
-            ("xy", "w", "F", "gF", "tris", "Fv"), (xy, w, F, gF, tris, Fv), strict=True
-        ):
-            parts[key].append(val)
-        qp_off.append(qp_off[-1] + xy.shape[0])
-        tri_off.append(tri_off[-1] + tris.shape[0])
+        parts["xy"].append(xy)
+        parts["w"].append(w)
+        parts["tris"].append(tris)
+        per_tri.append(np.full(tris.shape[0], xy.shape[0] // tris.shape[0]))
 
     def cat(key, shape):
         p = parts[key]
         return np.ascontiguousarray(np.concatenate(p)) if p else np.zeros(shape)
+
+    qp_xy, qp_w, tris = cat("xy", (0, 2)), cat("w", (0,)), cat("tris", (0, 3, 2))
+    qp_off = np.zeros(nc + 1, np.int64)
+    tri_off = np.zeros(nc + 1, np.int64)
+    qp_off[1:] = np.cumsum([x.shape[0] for x in parts["xy"]])
+    tri_off[1:] = np.cumsum([t.shape[0] for t in parts["tris"]])
+    per_tri = np.concatenate(per_tri) if per_tri else np.zeros(0, np.int64)
+    centroids = tris.mean(axis=1)
+
+    # pass 2: each enrichment group on every cell it reaches
+    F = np.zeros((qp_xy.shape[0], S))
+    gF = np.zeros((qp_xy.shape[0], S, 2))
+    Fv = np.zeros((tris.shape[0], 3, S))
+    e_used, s_used = np.nonzero(used)
+    group = cand.fracture[k_used] * (1 << 32) + (cand.tip[k_used] + (1 << 31))
+    for g in np.unique(group):
+        mine = group == g
+        k0 = k_used[mine][0]
+        fi, tip = int(cand.fracture[k0]), int(cand.tip[k0])
+        cells = np.unique(e_used[mine])  # rows of the cells the group reaches
+        ti = _ranges(tri_off[cells], np.diff(tri_off)[cells])
+        qi = _ranges(qp_off[cells], np.diff(qp_off)[cells])
+        st = fractures[fi].side(centroids[ti])
+        Fq, gq = _group_values(
+            fractures,
+            fi,
+            tip,
+            qp_xy[qi],
+            np.repeat(st, per_tri[ti]),
+            tol,
+            np.repeat(centroids[ti], per_tri[ti], axis=0),
+        )
+        Fvert = _group_values(
+            fractures,
+            fi,
+            tip,
+            tris[ti].reshape(-1, 2),
+            np.repeat(st, 3),
+            tol,
+            np.repeat(centroids[ti], 3, axis=0),
+        )[0].reshape(ti.size, 3, -1)
+        # every slot of the group: its cell's rows in the group's arrays
+        es, ss = e_used[mine], s_used[mine]
+        func = cand.func[slot_cand[es, ss]]
+        js = np.where(func == HEAVISIDE, 0, func - 1)
+        pos = np.searchsorted(cells, es)
+        g_qp = np.concatenate([[0], np.cumsum(np.diff(qp_off)[cells])])
+        g_tri = np.concatenate([[0], np.cumsum(np.diff(tri_off)[cells])])
+        nq_s = np.diff(qp_off)[es]
+        rows_q = _ranges(qp_off[es], nq_s)
+        rows_g = _ranges(g_qp[pos], nq_s)
+        cols = np.repeat(ss, nq_s)
+        jj = np.repeat(js, nq_s)
+        F[rows_q, cols] = Fq[rows_g, jj]
+        gF[rows_q, cols] = gq[rows_g, jj]
+        nt_s = np.diff(tri_off)[es]
+        rows_t = _ranges(tri_off[es], nt_s)
+        rows_gt = _ranges(g_tri[pos], nt_s)
+        Fv[rows_t, :, np.repeat(ss, nt_s)] = Fvert[rows_gt, :, np.repeat(js, nt_s)]
 
     return EnrichedCells(
         cells=cand_cells,
         slot_cand=slot_cand,
         slot_node=slot_node,
         slot_fnode=slot_fnode,
-        qp_offsets=np.array(qp_off, np.int64),
-        qp_xy=cat("xy", (0, 2)),
-        qp_w=cat("w", (0,)),
-        qp_F=cat("F", (0, S)),
-        qp_gradF=cat("gF", (0, S, 2)),
-        tri_offsets=np.array(tri_off, np.int64),
-        tris=cat("tris", (0, 3, 2)),
-        tri_F=cat("Fv", (0, 3, S)),
+        qp_offsets=qp_off,
+        qp_xy=qp_xy,
+        qp_w=qp_w,
+        qp_F=F,
+        qp_gradF=gF,
+        tri_offsets=tri_off,
+        tris=tris,
+        tri_F=Fv,
     )
 
 
-def _node_cells(mesh):
-    """Cells around each node (list of arrays)."""
-    order = np.argsort(mesh.cells.ravel(), kind="stable")
-    nodes_sorted = mesh.cells.ravel()[order]
-    cells_sorted = order // 4
-    split = np.searchsorted(nodes_sorted, np.arange(mesh.n_nodes + 1))
-    return [cells_sorted[split[i] : split[i + 1]] for i in range(mesh.n_nodes)]
+def _ranges(starts, counts):
+    """Concatenation of arange(s, s + n) for each (s, n), int64."""
+    starts = np.asarray(starts, np.int64)
+    counts = np.asarray(counts, np.int64)
+    total = int(counts.sum())
+    if total == 0:
+        return np.zeros(0, np.int64)
+    first = np.cumsum(counts) - counts
+    return np.repeat(starts - first, counts) + np.arange(total, dtype=np.int64)
 
 
 def carries_jump(mesh, cand: Candidates, ip) -> np.ndarray:

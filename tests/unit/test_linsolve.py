@@ -188,3 +188,45 @@ def test_default_solver_at_the_amg_size_agrees_with_superlu():
     assert st_s["factorizations"] == 1 and st_s["krylov_iterations"] == 0
     assert it_a == it_s == 1
     assert np.max(np.abs(gt_a - gt_s)) <= 1e-8 * np.max(np.abs(gt_s))
+
+
+def test_backward_error_closed_form():
+    # r = A x - b = (0, -0.5): 0.5 / (||A|| ||x|| + ||b||) = 0.5 / (2 * 1 + 2)
+    A = sp.csr_matrix(np.array([[2.0, 0.0], [0.0, 1.0]]))
+    x, b = np.array([1.0, 1.0]), np.array([2.0, 1.5])
+    assert linsolve.backward_error(A, x, b) == pytest.approx(0.125, rel=1e-15)
+    assert linsolve.backward_error(A, np.array([np.nan, 1.0]), b) == np.inf
+
+
+class _Inexact:
+    """A factorization whose solves are off by a relative `error` (or zero)."""
+
+    def __init__(self, A, error):
+        self.A, self.error = A.toarray(), error
+
+    def solve(self, b):
+        if self.error is None:
+            return np.zeros_like(b)
+        return np.linalg.solve(self.A, b) * (1.0 + self.error)
+
+
+@pytest.mark.parametrize(
+    ("error", "refined", "fallen_back"), [(1e-6, 1, 0), (None, 1, 1)]
+)
+def test_refinement_then_fallback(monkeypatch, error, refined, fallen_back):
+    """A slightly wrong fast solve is fixed by one refinement step (no new
+    factorization); a useless one goes to the safe settings."""
+    real = linsolve._splu
+
+    def fake(A, settings):
+        return _Inexact(A, error) if settings is linsolve.LU_FAST else real(A, settings)
+
+    monkeypatch.setattr(linsolve, "_splu", fake)
+    rng = np.random.default_rng(3)
+    M = rng.standard_normal((30, 30)) + 30.0 * np.eye(30)
+    b = rng.standard_normal(30)
+    stats = {}
+    x = linsolve.lu_factor(sp.csc_matrix(M), stats)[1](b)
+    np.testing.assert_allclose(x, np.linalg.solve(M, b), rtol=1e-11)
+    assert stats.get("refinements", 0) == refined
+    assert stats.get("fallbacks", 0) == fallen_back

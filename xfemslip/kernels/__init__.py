@@ -13,6 +13,7 @@ from xfemslip.kernels.contact import (
     contact_response,
     coulomb_return_map,
 )
+from xfemslip.kernels.scatter import block_triplets
 
 __all__ = [
     "OPEN",
@@ -20,6 +21,7 @@ __all__ = [
     "STICK",
     "TANGENT_CONSISTENT",
     "TANGENT_SECANT",
+    "block_triplets",
     "contact_response",
     "coulomb_return_map",
     "enriched_cell_matrices",
