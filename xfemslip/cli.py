@@ -146,21 +146,38 @@ def cli() -> None:
     """XFEM frictional contact on 2D fractures, driven by TOML case files."""
 
 
+def _solve_options(command):
+    """-o/--output, --overwrite, -v/--verbose and -q/--quiet: the options of
+    every command that solves a case and writes its results (run, deplete)."""
+    for option in reversed(
+        [
+            click.option(
+                "-o",
+                "--output",
+                "output",
+                type=click.Path(file_okay=False, path_type=Path),
+                default=None,
+                help="Output directory [default: output.directory of the case, "
+                "else out/<name>].",
+            ),
+            click.option(
+                "--overwrite",
+                is_flag=True,
+                help="Replace the results of an earlier run.",
+            ),
+            click.option("-v", "--verbose", is_flag=True, help="Log debug messages."),
+            click.option(
+                "-q", "--quiet", is_flag=True, help="Log warnings and errors only."
+            ),
+        ]
+    ):
+        command = option(command)
+    return command
+
+
 @cli.command()
 @_case_argument
-@click.option(
-    "-o",
-    "--output",
-    "output",
-    type=click.Path(file_okay=False, path_type=Path),
-    default=None,
-    help="Output directory [default: output.directory of the case, else out/<name>].",
-)
-@click.option(
-    "--overwrite", is_flag=True, help="Replace the results of an earlier run."
-)
-@click.option("-v", "--verbose", is_flag=True, help="Log debug messages.")
-@click.option("-q", "--quiet", is_flag=True, help="Log warnings and errors only.")
+@_solve_options
 @click.option(
     "--plot", is_flag=True, help="Also draw the figures into <output>/figures."
 )

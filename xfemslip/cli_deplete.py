@@ -9,18 +9,18 @@ from pathlib import Path
 
 import click
 
-from xfemslip.cli import _configure_logging, _debug_option, _load, _reported_errors
+from xfemslip.cli import (
+    _configure_logging,
+    _debug_option,
+    _load,
+    _reported_errors,
+    _solve_options,
+)
 
 
 @click.command()
 @click.argument("case", type=click.Path(path_type=Path))
-@click.option(
-    "-o",
-    "--output",
-    type=click.Path(file_okay=False, path_type=Path),
-    default=None,
-    help="Output directory [default: output.directory of the case, else out/<name>].",
-)
+@_solve_options
 @click.option(
     "--tolerance",
     type=click.FloatRange(min=0.0, min_open=True),
@@ -33,11 +33,6 @@ from xfemslip.cli import _configure_logging, _debug_option, _load, _reported_err
     is_flag=True,
     help="Also draw slip_vs_depletion.png and depletion_field.png.",
 )
-@click.option(
-    "--overwrite", is_flag=True, help="Replace the results of an earlier run."
-)
-@click.option("-v", "--verbose", is_flag=True, help="Log debug messages.")
-@click.option("-q", "--quiet", is_flag=True, help="Log warnings and errors only.")
 @_debug_option
 def deplete(case, output, tolerance, plot, overwrite, verbose, quiet, debug) -> None:
     """Critical depletion of every fracture of CASE: the pore-pressure change
