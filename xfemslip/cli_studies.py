@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import csv
 import os
+import sys
 from pathlib import Path
 
 import click
@@ -86,7 +87,7 @@ def sweep(sweep_file, output, jobs, scheduler, force, verbose, debug) -> None:
         with click.progressbar(
             length=len(spec.cases),
             label=spec.name,
-            file=click.get_text_stream("stderr"),
+            file=sys.stderr,  # click.get_text_stream is deprecated (Click 8.2)
         ) as bar:
             rows = run_sweep(
                 spec,
