@@ -35,12 +35,7 @@ import numpy as np
 
 from xfemslip.contact import SLIP
 from xfemslip.errors import ConvergenceError, UsageError
-from xfemslip.simulation import (
-    _check_out_dir,
-    build_model,
-    newton_solver,
-    write_output,
-)
+from xfemslip.simulation import solve_and_write
 
 logger = logging.getLogger(__name__)
 
@@ -306,26 +301,22 @@ def deplete(spec, out_dir=None, *, tolerance=None, plot=False, overwrite=False):
         tolerance = DEFAULT_REL_TOLERANCE * abs(change)
     if not tolerance > 0.0:
         raise UsageError(f"--tolerance must be > 0 Pa, got {tolerance!r}")
-    out_dir = Path(out_dir) if out_dir is not None else Path(spec.output.directory)
-    _check_out_dir(out_dir, overwrite)
-    model = build_model(spec)
-    solver = newton_solver(model)
-    failure = None
-    try:
-        onsets, results = critical_depletion(
-            solver, model, spec.loading.steps, tolerance
-        )
-    except ConvergenceError as exc:  # keep what converged, as `run` does
-        failure, onsets, results = exc, exc.onsets, solver.completed
-    iters = [r.iterations for r in results]
-    write_output(
-        model,
-        results,
+    done = solve_and_write(
+        spec,
         out_dir,
-        converged=failure is None,
-        wall=time.perf_counter() - start,
-        iterations=iters,
+        overwrite,
+        lambda solver, model: critical_depletion(
+            solver, model, spec.loading.steps, tolerance
+        )[0],
     )
+    model, results, failure, out_dir = (
+        done.model,
+        done.results,
+        done.failure,
+        done.out_dir,
+    )
+    # a failed step keeps what converged, as `run` does
+    onsets = done.value if failure is None else failure.onsets
     report = DepletionReport(
         onsets=onsets,
         rows=_table_rows(model, results, change),

@@ -264,33 +264,60 @@ def run_case(
     step fails, UsageError when the output exists and overwrite is False.
     """
     start = time.perf_counter()
-    out_dir = Path(out_dir) if out_dir is not None else Path(spec.output.directory)
-    _check_out_dir(out_dir, overwrite)
-    model = build_model(spec)
-    solver = newton_solver(model)
-    failure = None
-    try:
-        solver.run(spec.loading.steps)
-    except ConvergenceError as exc:
-        failure = exc
-    results = solver.completed
-    iters = [r.iterations for r in results]
-    wall = time.perf_counter() - start
-    write_output(
-        model, results, out_dir, converged=failure is None, wall=wall, iterations=iters
+    done = solve_and_write(
+        spec, out_dir, overwrite, lambda solver, _: solver.run(spec.loading.steps)
     )
-    if failure is not None:
-        raise failure
+    if done.failure is not None:
+        raise done.failure
+    iters = [r.iterations for r in done.results]
     logger.info("Newton iterations per load step: %s", iters)
     return RunSummary(
-        out_dir=out_dir,
+        out_dir=done.out_dir,
         converged=True,
         load_steps=spec.loading.steps,
         newton_iterations=int(sum(iters)),
         iterations_per_step=iters,
         wall_time_s=time.perf_counter() - start,
-        n_dofs=model.problem.n_dofs,
+        n_dofs=done.model.problem.n_dofs,
     )
+
+
+@dataclass
+class Written:
+    """What solve_and_write built, solved and wrote."""
+
+    out_dir: Path
+    model: Model
+    results: list  # the converged StepResults (solver.completed)
+    value: object  # what ``drive`` returned (None after a failure)
+    failure: ConvergenceError | None
+
+
+def solve_and_write(spec, out_dir, overwrite, drive) -> Written:
+    """The frame of every command that solves a case: check the output folder,
+    build the model and its Newton solver, run ``drive(solver, model)``, and
+    write the converged steps (also after a ConvergenceError, which is
+    returned, not raised, with converged = False in result.h5)."""
+    start = time.perf_counter()
+    out_dir = Path(out_dir) if out_dir is not None else Path(spec.output.directory)
+    _check_out_dir(out_dir, overwrite)
+    model = build_model(spec)
+    solver = newton_solver(model)
+    value = failure = None
+    try:
+        value = drive(solver, model)
+    except ConvergenceError as exc:
+        failure = exc
+    results = solver.completed
+    write_output(
+        model,
+        results,
+        out_dir,
+        converged=failure is None,
+        wall=time.perf_counter() - start,
+        iterations=[r.iterations for r in results],
+    )
+    return Written(out_dir, model, results, value, failure)
 
 
 def write_output(model: Model, results, out_dir: Path, *, converged, wall, iterations):

@@ -27,7 +27,6 @@ orientation farther than 2 degrees from the window's edges.
 from __future__ import annotations
 
 import contextlib
-import csv
 import logging
 import math
 import tempfile
@@ -109,10 +108,19 @@ PROBLEMS = (
 QUICK_PROBLEMS = ("inclined-30", "stress-30", "frictionless-30", "stick-80")
 
 
-def case_text(n: int, prob: Problem, tip: str | None, penalty: float | None) -> str:
+def case_text(
+    n: int,
+    prob: Problem,
+    tip: str | None,
+    penalty: float | None,
+    *,
+    steps: int = 1,
+    solver: str = "",
+) -> str:
     """TOML of the problem on an n x n mesh of the box (edges from CSV files).
 
     penalty : kn h / E (= kt h / E), or None to leave kn and kt out.
+    steps : load steps; solver : lines of a [solver] table ("" = none).
     """
     a = HALF_LENGTH
     p = math.radians(prob.psi)
@@ -145,7 +153,7 @@ friction = {prob.friction!r}
 cohesion = {prob.cohesion!r}
 {penalty_lines}{tip_line}
 [loading]
-steps = 1
+steps = {steps}
 
 [boundary]
 bottom = {{ file = "bottom.csv" }}
@@ -155,7 +163,7 @@ right = {{ file = "right.csv" }}
 
 [output]
 formats = ["h5"]
-"""
+""" + (f"\n[solver]\n{solver}" if solver else "")
 
 
 def exact_kwargs(prob: Problem) -> dict:
@@ -172,28 +180,46 @@ def exact_kwargs(prob: Problem) -> dict:
     )
 
 
-def write_case(
-    folder: Path, n: int, prob: Problem, tip: str | None, penalty: float
-) -> Path:
-    """Write case.toml and the four edge CSV files (8 points per element edge)."""
-    folder.mkdir(parents=True, exist_ok=True)
-    k = np.linspace(-HALF_BOX, HALF_BOX, 8 * n + 1)
-    edges = {
-        "bottom": np.column_stack([k, np.full_like(k, -HALF_BOX)]),
-        "top": np.column_stack([k, np.full_like(k, HALF_BOX)]),
-        "left": np.column_stack([np.full_like(k, -HALF_BOX), k]),
-        "right": np.column_stack([np.full_like(k, HALF_BOX), k]),
+def box_edges(origin, size, n_per_edge) -> dict:
+    """Points along the four edges of a box, n_per_edge + 1 each (corners included)."""
+    x0, y0 = origin
+    w, h = size
+    kx = np.linspace(x0, x0 + w, n_per_edge + 1)
+    ky = np.linspace(y0, y0 + h, n_per_edge + 1)
+    return {
+        "bottom": np.column_stack([kx, np.full_like(kx, y0)]),
+        "top": np.column_stack([kx, np.full_like(kx, y0 + h)]),
+        "left": np.column_stack([np.full_like(ky, x0), ky]),
+        "right": np.column_stack([np.full_like(ky, x0 + w), ky]),
     }
-    for name, pts in edges.items():
-        u = cf.displacement(pts, **exact_kwargs(prob))
-        with open(folder / f"{name}.csv", "w", newline="") as fh:
-            w = csv.writer(fh)
-            w.writerow(["x", "y", "ux", "uy"])
-            w.writerows(
-                [f"{v:.17g}" for v in (*xy, *uv)] for xy, uv in zip(pts, u, strict=True)
-            )
+
+
+def write_edge_csv(path: Path, points, values) -> None:
+    """Boundary CSV (case-format.md): header x,y,ux,uy, one row per point."""
+    with open(path, "w") as f:
+        f.write("x,y,ux,uy\n")
+        for (x, y), (ux, uy) in zip(points, values, strict=True):
+            f.write(f"{x:.17g},{y:.17g},{ux:.17g},{uy:.17g}\n")
+
+
+def write_case(
+    folder: Path,
+    n: int,
+    prob: Problem,
+    tip: str | None,
+    penalty: float,
+    **options,
+) -> Path:
+    """Write case.toml and the four edge CSV files (8 points per element edge);
+    ``options`` (steps, solver) go to case_text."""
+    folder.mkdir(parents=True, exist_ok=True)
+    box = (-HALF_BOX, -HALF_BOX), (2 * HALF_BOX, 2 * HALF_BOX)
+    for name, pts in box_edges(*box, 8 * n).items():
+        write_edge_csv(
+            folder / f"{name}.csv", pts, cf.displacement(pts, **exact_kwargs(prob))
+        )
     path = folder / "case.toml"
-    path.write_text(case_text(n, prob, tip, penalty))
+    path.write_text(case_text(n, prob, tip, penalty, **options))
     return path
 
 

@@ -2,7 +2,9 @@
 
 from __future__ import annotations
 
-from xfemslip.case import loads_case
+import numpy as np
+
+from xfemslip.case import FractureSpec, loads_case
 
 
 def fracture_case(points, tip="ramp", n=6, size=6.0):
@@ -29,3 +31,18 @@ stress = {{ xx = -20.0e6, yy = -40.0e6, xy = 0.0 }}
 bottom = {{ ux = 0.0, uy = 0.0 }}
 top = "traction"
 """)
+
+
+def fracture_spec(points, index=0, tip="ramp", friction=0.5) -> FractureSpec:
+    """A FractureSpec with penalties 1e12 Pa/m, no cohesion, automatic tip radius
+    (for tests that build fractures without a case file)."""
+    return FractureSpec(
+        index=index,
+        points=np.asarray(points, dtype=float),
+        friction=friction,
+        cohesion=0.0,
+        kn=1.0e12,
+        kt=1.0e12,
+        tip=tip,
+        tip_radius=None,
+    )

@@ -4,8 +4,8 @@ cell-by-cell evaluation of every slot with the public candidate_values."""
 from __future__ import annotations
 
 import numpy as np
+from casegen import fracture_spec
 
-from xfemslip.case import FractureSpec
 from xfemslip.enrichment import (
     build_enriched_cells,
     candidate_values,
@@ -24,19 +24,7 @@ def _network(n=24):
         ([[0.52, 0.12], [0.93, 0.33]], "ramp"),
         ([[0.27, 0.90], [0.62, 0.95]], "branch"),  # second branch-tipped one
     ]
-    specs = [
-        FractureSpec(
-            index=i,
-            points=np.asarray(p, float),
-            friction=0.5,
-            cohesion=0.0,
-            kn=1e12,
-            kt=1e12,
-            tip=tip,
-            tip_radius=None,
-        )
-        for i, (p, tip) in enumerate(lines)
-    ]
+    specs = [fracture_spec(p, i, tip) for i, (p, tip) in enumerate(lines)]
     return mesh, build_fractures(mesh, specs, np.array([0.0, 1.0, 0.0, 1.0]))
 
 

@@ -10,8 +10,8 @@ import math
 
 import numpy as np
 import pytest
+from casegen import fracture_spec
 
-from xfemslip.case import FractureSpec
 from xfemslip.errors import GeometryError
 from xfemslip.geometry import build_fracture, build_fractures, clip_segment
 from xfemslip.mesh import build_mesh
@@ -27,17 +27,7 @@ def _mesh(n: int = N_CELLS):
     return build_mesh(grid, grid)
 
 
-def _spec(points, index: int = 0, tip: str = "ramp") -> FractureSpec:
-    return FractureSpec(
-        index=index,
-        points=np.asarray(points, dtype=float),
-        friction=0.5,
-        cohesion=0.0,
-        kn=1.0e12,
-        kt=1.0e12,
-        tip=tip,
-        tip_radius=None,
-    )
+_spec = fracture_spec
 
 
 def _fracture(points, tip: str = "ramp"):

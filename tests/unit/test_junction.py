@@ -13,8 +13,8 @@ import math
 
 import numpy as np
 import pytest
+from casegen import fracture_spec
 
-from xfemslip.case import FractureSpec
 from xfemslip.enrichment import HEAVISIDE, build_enriched_cells, find_candidates
 from xfemslip.errors import GeometryError
 from xfemslip.geometry import JUNCTION_SNAP_CELLS, build_fractures
@@ -31,16 +31,7 @@ def _mesh(n=N_CELLS):
 
 
 def _spec(points, index, tip="ramp"):
-    return FractureSpec(
-        index=index,
-        points=np.asarray(points, dtype=float),
-        friction=0.0,
-        cohesion=0.0,
-        kn=1.0e12,
-        kt=1.0e12,
-        tip=tip,
-        tip_radius=None,
-    )
+    return fracture_spec(points, index, tip, friction=0.0)
 
 
 def _build(*polylines, n=N_CELLS):

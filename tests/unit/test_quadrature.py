@@ -13,9 +13,9 @@ from itertools import product
 
 import numpy as np
 import pytest
+from casegen import fracture_spec
 from scipy import integrate
 
-from xfemslip.case import FractureSpec
 from xfemslip.geometry import build_fracture
 from xfemslip.mesh import build_mesh
 from xfemslip.quadrature import (
@@ -394,16 +394,7 @@ def _fractures(points_list, n=8, tip="ramp"):
     frs = tuple(
         build_fracture(
             mesh,
-            FractureSpec(
-                index=i,
-                points=np.asarray(p, float),
-                friction=0.5,
-                cohesion=0.0,
-                kn=1e12,
-                kt=1e12,
-                tip=tip,
-                tip_radius=None,
-            ),
+            fracture_spec(p, i, tip),
             box,
         )
         for i, p in enumerate(points_list)

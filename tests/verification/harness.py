@@ -15,6 +15,7 @@ import numpy as np
 
 from xfemslip.case import load_case
 from xfemslip.simulation import run_case
+from xfemslip.verify import box_edges, write_edge_csv  # noqa: F401 (re-exported)
 
 OPEN, STICK, SLIP = 0, 1, 2  # state codes of output-format.md
 
@@ -161,25 +162,3 @@ def segment(center, length, angle_deg):
         )
     )
     return [list(c - d), list(c + d)]
-
-
-def write_edge_csv(path: Path, points, values) -> None:
-    """Boundary CSV (case-format.md): header x,y,ux,uy, one row per point."""
-    with open(path, "w") as f:
-        f.write("x,y,ux,uy\n")
-        for (x, y), (ux, uy) in zip(points, values, strict=True):
-            f.write(f"{x:.17g},{y:.17g},{ux:.17g},{uy:.17g}\n")
-
-
-def box_edges(origin, size, n_per_edge):
-    """Points along the four edges of a box, n_per_edge + 1 each (corners included)."""
-    x0, y0 = origin
-    w, h = size
-    kx = np.linspace(x0, x0 + w, n_per_edge + 1)
-    ky = np.linspace(y0, y0 + h, n_per_edge + 1)
-    return {
-        "bottom": np.column_stack([kx, np.full_like(kx, y0)]),
-        "top": np.column_stack([kx, np.full_like(kx, y0 + h)]),
-        "left": np.column_stack([np.full_like(ky, x0), ky]),
-        "right": np.column_stack([np.full_like(ky, x0 + w), ky]),
-    }

@@ -41,24 +41,25 @@ jump tau / kt.
 
 from __future__ import annotations
 
-import math
 from pathlib import Path
 
 import numpy as np
 import pytest
-from harness import SLIP, STICK, box_edges, read_result, write_edge_csv
+from harness import SLIP, STICK, read_result
 
 from xfemslip import closed_form as cf
+from xfemslip import verify as V
 from xfemslip.case import load_case
 from xfemslip.simulation import run_case
 
 pytestmark = pytest.mark.verification
 
-HALF = 1.0  # half-width of the box [m]
-A = 0.5  # crack half-length [m]
-CENTER = (0.0123, -0.0077)  # off the mesh lines on purpose [m]
-STRESS = (-20e6, -40e6, 0.0)  # remote stress, tension positive [Pa]
-E, NU = 5e9, 0.3
+# the box, crack and stress of xfemslip.verify, whose case writer runs them
+HALF = V.HALF_BOX  # half-width of the box [m]
+A = V.HALF_LENGTH  # crack half-length [m]
+CENTER = V.CENTER  # off the mesh lines on purpose [m]
+STRESS = V.STRESS  # remote stress, tension positive [Pa]
+E, NU = V.E, V.NU
 PENALTY = 100.0  # kn = kt = PENALTY * E / h
 LIMIT = 0.03  # allowed relative L2 slip error at h = a/16 (n = 64)
 
@@ -77,63 +78,12 @@ def run_inclined(
 ):
     """Write the case and the four boundary CSV files into folder, run, read the result.
 
+    The case is ``xfemslip.verify``'s (the same box, crack and exact edges).
     Returns (s, slip, state, exact slip at s).
     """
-    folder.mkdir(parents=True, exist_ok=True)
-    field = dict(
-        center=CENTER,
-        a=A,
-        E=E,
-        nu=NU,
-        plane=plane,
-        stress=STRESS,
-        psi_deg=psi,
-        friction=friction,
-        cohesion=cohesion,
-    )
-    for name, pts in box_edges((-HALF, -HALF), (2 * HALF, 2 * HALF), 8 * n).items():
-        write_edge_csv(folder / f"{name}.csv", pts, cf.displacement(pts, **field))
-    t = (math.cos(math.radians(psi)), math.sin(math.radians(psi)))
-    p0 = (CENTER[0] - A * t[0], CENTER[1] - A * t[1])
-    p1 = (CENTER[0] + A * t[0], CENTER[1] + A * t[1])
-    kn = penalty * E / (2 * HALF / n)
-    text = f"""name = "inclined-crack"
-
-[domain]
-size = [{2 * HALF}, {2 * HALF}]
-origin = [{-HALF}, {-HALF}]
-
-[mesh]
-elements = [{n}, {n}]
-
-[material]
-E = {E!r}
-nu = {NU!r}
-model = "{plane}"
-
-[[fractures]]
-points = [[{p0[0]!r}, {p0[1]!r}], [{p1[0]!r}, {p1[1]!r}]]
-friction = {friction!r}
-cohesion = {cohesion!r}
-kn = {kn!r}
-kt = {kn!r}
-
-[loading]
-steps = {steps}
-
-[boundary]
-bottom = {{ file = "bottom.csv" }}
-top = {{ file = "top.csv" }}
-left = {{ file = "left.csv" }}
-right = {{ file = "right.csv" }}
-
-[output]
-formats = ["h5"]
-"""
-    if patch is not None:
-        text += f"\n[solver]\ncontact_patch = {patch!r}\n"
-    case = folder / "case.toml"
-    case.write_text(text)
+    prob = V.Problem("inclined", psi, friction, cohesion, plane)
+    solver = "" if patch is None else f"contact_patch = {patch!r}\n"
+    case = V.write_case(folder, n, prob, None, penalty, steps=steps, solver=solver)
     run_case(load_case(case), folder / "out")
     fr = read_result(folder / "out" / "result.h5").fr
     exact = cf.slip_profile(fr["s"], A, E, NU, plane, STRESS, psi, friction, cohesion)
