@@ -205,6 +205,16 @@ SOLVER_OPTIONS: tuple[Option, ...] = (
         "free dofs on cells up to 4:1)",
         ("auto", "superlu", "amg"),
     ),
+    Option(
+        "kernels",
+        str,
+        "auto",
+        "how the cell and contact loops run: 'numpy' (whole-array NumPy, no "
+        "Numba start-up), 'numba' (compiled, cached once per install) or 'auto' "
+        "(numpy unless the enriched cells are many; the answer is the same to "
+        "round-off)",
+        ("auto", "numba", "numpy"),
+    ),
 )
 
 

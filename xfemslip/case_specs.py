@@ -119,6 +119,7 @@ class SolverSpec:
     contact_patch: float = CONTACT_PATCH_CELLS  # patch length [cells]; 0 = pointwise
     max_step_cuts: int = 5  # bisections of a failing load step
     linear_solver: str = "auto"  # "auto" | "superlu" | "amg" (xfemslip.linsolve)
+    kernels: str = "auto"  # "auto" | "numba" | "numpy" (xfemslip.kernels)
     UNITS: ClassVar[dict[str, str]] = {
         "tolerance": "-",
         "max_iterations": "-",
@@ -126,6 +127,7 @@ class SolverSpec:
         "contact_patch": "cells",
         "max_step_cuts": "-",
         "linear_solver": "",
+        "kernels": "",
     }
 
 

@@ -112,6 +112,8 @@ class ContactSet:
     state_committed: np.ndarray = field(default=None)  # (m,) int8
     gt_committed: np.ndarray = field(default=None)
     pt_committed: np.ndarray = field(default=None)
+    # kernel backend of the model ("numba" | "numpy"; None: the active one)
+    kernels: str | None = None
 
     @property
     def n(self) -> int:
@@ -125,7 +127,7 @@ class ContactSet:
         out_K = np.zeros((n, J2, J2))
         gn, gt, pn, pt, slip = (np.zeros(n) for _ in range(5))
         state = np.zeros(n, np.int8)
-        kernels.contact_response(
+        kernels.backend(self.kernels).contact_response(
             np.ascontiguousarray(u, dtype=np.float64),
             self.dofs,
             self.coef,

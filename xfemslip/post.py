@@ -13,7 +13,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from xfemslip.kernels.contact import OPEN, SLIP, STICK  # noqa: F401  (codes mirrored)
+from xfemslip.kernels.codes import OPEN, SLIP, STICK  # noqa: F401  (codes mirrored)
 from xfemslip.writers import FractureFields, VisMesh
 
 STATE_CODES = "0 open, 1 stick, 2 slip"

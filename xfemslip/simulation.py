@@ -15,7 +15,7 @@ from pathlib import Path
 
 import numpy as np
 
-from xfemslip import __version__
+from xfemslip import __version__, kernels
 from xfemslip.assembly import BulkSystem, assemble_bulk
 from xfemslip.boundary import dirichlet, hold_enriched, traction_load
 from xfemslip.contact import ContactSet, build_contact
@@ -101,6 +101,14 @@ def check_geometry(spec) -> None:
         dirichlet(mesh, spec.boundary)
 
 
+def kernel_work(ec) -> float:
+    """Size of the enriched-cell assembly for ``kernels.choose``: quadrature
+    points of the enriched cells times (8 + 2 S)^2, S the slots per cell (the
+    padded columns the NumPy backend multiplies)."""
+    nd = 8 + 2 * ec.slot_node.shape[1]
+    return float(ec.qp_w.size) * nd * nd
+
+
 def build_model(spec) -> Model:
     """Build the discrete problem of a validated case."""
     mesh, fractures = _geometry(spec)
@@ -108,6 +116,8 @@ def build_model(spec) -> Model:
     D = elasticity_matrix(mat.E, mat.nu, mat.model)
     cand = find_candidates(mesh, fractures)
     ec = build_enriched_cells(mesh, fractures, cand)
+    kernel_backend = kernels.choose(spec.solver.kernels, kernel_work(ec))
+    kernels.use(kernel_backend)
     ip = interface_points(fractures, mesh.h_min)
     materials = build_materials(spec, mesh, ec, fractures)
     if spec.reservoir is None:
@@ -128,6 +138,7 @@ def build_model(spec) -> Model:
         mat.E,
         spec.solver.contact_patch,
     )
+    contact.kernels = kernel_backend
     with _naming_the_file(spec):
         bc = hold_enriched(dirichlet(mesh, spec.boundary), cand, bulk.dofmap)
     F = traction_load(
@@ -152,7 +163,7 @@ def build_model(spec) -> Model:
     )
     logger.info(
         "model: %d x %d cells, %d fracture(s), %d dofs (%d nodes enriched with %d "
-        "functions), %d contact points",
+        "functions), %d contact points, %s kernels",
         mesh.nx,
         mesh.ny,
         len(fractures),
@@ -160,6 +171,7 @@ def build_model(spec) -> Model:
         np.unique(cand.node[bulk.dofmap.cand_dof >= 0]).size,
         bulk.dofmap.n_enriched_functions,
         ip.n,
+        kernel_backend,
     )
     return Model(
         spec=spec,
@@ -351,6 +363,7 @@ def write_output(model: Model, results, out_dir: Path, *, converged, wall, itera
         "tangent": spec.solver.tangent,
         "contact_patch_cells": float(spec.solver.contact_patch),
         "n_dofs": int(model.problem.n_dofs),
+        "kernels": model.contact.kernels,
         "status_codes": STATE_CODES,
     }
     hdf5.write_result(

@@ -33,7 +33,11 @@ def test_consistent_tangent_converges_in_one_iteration_once_the_set_settles(fric
     consistent tangent is its exact Jacobian: the iteration after the first one
     without a switch must land on round-off (not just decrease)."""
     checked = 0
-    for step in _solve("consistent", steps=3, friction=friction):
+    # 4 steps: a step may also converge in one solve (no iterate i >= 2 to
+    # check) when its first solve lands on the final set; every patch that
+    # slipped in the step before starts the step exactly on the Coulomb bound,
+    # so which steps do is decided by round-off (kernel backend, BLAS)
+    for step in _solve("consistent", steps=4, friction=friction):
         eta, sw = step.residuals, step.switches
         assert eta[-1] <= 1e-10
         # sw[i] = switches between the states at iterates i-1 and i: when it is

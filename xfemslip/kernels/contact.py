@@ -15,16 +15,14 @@ import numpy as np
 from numba import njit
 
 from xfemslip.kernels._config import NUMBA_CACHE
-
-OPEN = 0
-STICK = 1
-SLIP = 2
-
-TANGENT_CONSISTENT = 0
-TANGENT_SECANT = 1
-
-# |Delta g_T| below this (m) has no usable secant; the elastic k_T is used.
-_SECANT_MIN_INCREMENT = 1.0e-300
+from xfemslip.kernels.codes import (  # noqa: F401  (re-exported names)
+    OPEN,
+    SLIP,
+    STICK,
+    TANGENT_CONSISTENT,
+    TANGENT_SECANT,
+)
+from xfemslip.kernels.codes import SECANT_MIN_INCREMENT as _SECANT_MIN_INCREMENT
 
 
 @njit(cache=NUMBA_CACHE)

@@ -1,0 +1,133 @@
+#!/usr/bin/env python3
+"""Whole-process time of `xfemslip run` with the NumPy and the Numba kernel
+backends (`[solver] kernels`), interleaved, on cases of growing enriched-cell
+work: the measurement behind `kernels.AUTO_NUMPY_MAX_WORK` (the "auto" rule).
+
+    python benchmarks/kernels_backend.py [--runs 3] [--json out.json]
+
+Each configuration runs in a fresh process with a warm Numba cache and cached
+bytecode (as an installed package has), h5 output only.  Reported: the
+enriched-cell work of the model (`simulation.kernel_work`), median wall and
+CPU (user + system) per backend, and numpy / numba.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import re
+import resource
+import statistics
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+def reservoir(n: int) -> str:
+    text = (ROOT / "cases/reservoir_depletion.toml").read_text()
+    return text.replace("elements = [50, 50]", f"elements = [{n}, {n}]")
+
+
+def network(n: int, count: int, tip: str) -> str:
+    text = (ROOT / "cases/sweeps/dfn_realizations.toml").read_text()
+    text = text[text.index("[base]") :].replace("[base.", "[").replace("[base]\n", "")
+    text = re.sub(r"elements = \[\d+, \d+\]", f"elements = [{n}, {n}]", text)
+    text = re.sub(r"count = \d+", f"count = {count}", text)
+    return text.replace('tip = "ramp"', f'tip = "{tip}"')
+
+
+CONFIGS = {
+    "reservoir 50": lambda: reservoir(50),
+    "reservoir 100": lambda: reservoir(100),
+    "reservoir 200": lambda: reservoir(200),
+    "reservoir 400": lambda: reservoir(400),
+    "network 80 (shipped)": lambda: (ROOT / "cases/fracture_network.toml").read_text(),
+    "dfn 30 ramp, 50": lambda: network(50, 30, "ramp"),
+    "dfn 30 ramp, 100": lambda: network(100, 30, "ramp"),
+    "dfn 100 ramp, 200": lambda: network(200, 100, "ramp"),
+    "dfn 300 ramp, 400": lambda: network(400, 300, "ramp"),
+}
+
+
+def with_backend(text: str, backend: str) -> str:
+    text = re.sub(r"(?m)^kernels = .*\n", "", text)
+    text = re.sub(r'(?m)^formats = .*$', 'formats = ["h5"]', text)
+    if "[solver]" in text:
+        return text.replace("[solver]", f'[solver]\nkernels = "{backend}"', 1)
+    return text + f'\n[solver]\nkernels = "{backend}"\n'
+
+
+def once(case: Path, out: Path, env) -> tuple[float, float]:
+    before = resource.getrusage(resource.RUSAGE_CHILDREN)
+    start = time.perf_counter()
+    proc = subprocess.run(
+        [sys.executable, "-m", "xfemslip", "run", "-q", "--overwrite", str(case),
+         "-o", str(out)],
+        env=env, capture_output=True, text=True,
+    )
+    wall = time.perf_counter() - start
+    after = resource.getrusage(resource.RUSAGE_CHILDREN)
+    if proc.returncode != 0:
+        sys.exit(f"{case}: exit {proc.returncode}: {proc.stderr[-400:]}")
+    cpu = after.ru_utime - before.ru_utime + after.ru_stime - before.ru_stime
+    return wall, cpu
+
+
+def work_of(case: Path) -> float:
+    from xfemslip.case import load_case
+    from xfemslip.enrichment import build_enriched_cells, find_candidates
+    from xfemslip.simulation import _geometry, kernel_work
+
+    spec = load_case(case)
+    mesh, fractures = _geometry(spec)
+    cand = find_candidates(mesh, fractures)
+    return kernel_work(build_enriched_cells(mesh, fractures, cand))
+
+
+def main() -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--runs", type=int, default=3)
+    ap.add_argument("--only", nargs="*", help="configuration names (default: all)")
+    ap.add_argument("--json", type=Path)
+    args = ap.parse_args()
+    folder = Path(tempfile.mkdtemp(prefix="xfemslip-kernels-"))
+    env = dict(os.environ, NUMBA_CACHE_DIR=str(folder / "numba"),
+               PYTHONPYCACHEPREFIX=str(folder / "pycache"))
+    env.pop("PYTHONDONTWRITEBYTECODE", None)
+    rows = []
+    for name, make in CONFIGS.items():
+        if args.only and name not in args.only:
+            continue
+        cases = {}
+        for backend in ("numpy", "numba"):
+            case = folder / f"{re.sub(r'[^a-z0-9]+', '_', name)}_{backend}.toml"
+            case.write_text(with_backend(make(), backend))
+            cases[backend] = case
+            once(case, folder / "out", env)  # warm the caches
+        times = {b: [] for b in cases}
+        for _ in range(args.runs):
+            for backend, case in cases.items():
+                times[backend].append(once(case, folder / "out", env))
+        row = {"case": name, "work": work_of(cases["numpy"])}
+        for backend in cases:
+            row[f"{backend}_wall"] = statistics.median(t[0] for t in times[backend])
+            row[f"{backend}_cpu"] = statistics.median(t[1] for t in times[backend])
+        rows.append(row)
+        print(
+            f"| {name} | {row['work']:.3g} | {row['numpy_wall']:.2f} ({row['numpy_cpu']:.2f})"
+            f" | {row['numba_wall']:.2f} ({row['numba_cpu']:.2f})"
+            f" | {row['numpy_cpu'] / row['numba_cpu']:.2f} |",
+            flush=True,
+        )
+    if args.json:
+        args.json.write_text(json.dumps(rows, indent=1))
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,240 @@
+"""The kernels as NumPy array code: the same functions, signatures and results
+(to round-off) as the Numba kernels of bulk.py, contact.py and scatter.py,
+without importing Numba.
+
+Why two implementations: a warm ``xfemslip run`` of a small case paid about
+0.2 s to import Numba and 0.3 s for its target set-up at the first cached
+dispatch (benchmarks/RESULTS.md, *Start-up*), against a few milliseconds of
+kernel work on a 50 x 50 mesh; a first run after install paid about 9 s of
+compilation.  Every kernel here is a loop over independent cells or points,
+which NumPy does as whole-array operations: the intact cells share one
+stiffness per distinct size (a handful of rows), the contact law is
+elementwise, and the enriched cells are one small matrix product each.  The
+backend is chosen per model (``xfemslip.kernels.choose``); these functions are
+also the NumPy reference the Numba kernels are tested against (house style,
+kernels rule 8).
+
+Formulas and argument conventions: see the Numba kernel of the same name.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from xfemslip.kernels.codes import (
+    OPEN,
+    SECANT_MIN_INCREMENT,
+    SLIP,
+    STICK,
+    TANGENT_SECANT,
+)
+
+_XI_A = np.array([-1.0, 1.0, 1.0, -1.0])
+_ETA_A = np.array([-1.0, -1.0, 1.0, 1.0])
+_GAUSS2 = np.array([-1.0 / np.sqrt(3.0), 1.0 / np.sqrt(3.0)])
+
+
+def q4_shape(x, y, x0, x1, y0, y1):
+    """N (..., 4) and dN (..., 4, 2) [1/m] of Q4 rectangles at points (x, y)
+    (arrays of one shape; kernels/shape.py for the node order)."""
+    hx = x1 - x0
+    hy = y1 - y0
+    xi = ((2.0 * x - x0 - x1) / hx)[..., None]
+    eta = ((2.0 * y - y0 - y1) / hy)[..., None]
+    N = 0.25 * (1.0 + xi * _XI_A) * (1.0 + eta * _ETA_A)
+    dN = np.empty(N.shape + (2,))
+    dN[..., 0] = 0.25 * _XI_A * (1.0 + eta * _ETA_A) * 2.0 / hx[..., None]
+    dN[..., 1] = 0.25 * _ETA_A * (1.0 + xi * _XI_A) * 2.0 / hy[..., None]
+    return N, dN
+
+
+def rectangle_stiffness(hx, hy, D):
+    """Stiffness (m, 8, 8) of intact rectangles, 2x2 Gauss (bulk.rectangle_stiffness)."""
+    m = hx.shape[0]
+    K = np.zeros((m, 8, 8))
+    zero = np.zeros(m)
+    for gi in range(2):
+        for gj in range(2):
+            x = 0.5 * hx * (1.0 + _GAUSS2[gi])
+            y = 0.5 * hy * (1.0 + _GAUSS2[gj])
+            _, dN = q4_shape(x, y, zero, hx, zero, hy)
+            B = np.zeros((m, 3, 8))
+            B[:, 0, 0::2] = dN[..., 0]
+            B[:, 1, 1::2] = dN[..., 1]
+            B[:, 2, 0::2] = dN[..., 1]
+            B[:, 2, 1::2] = dN[..., 0]
+            w = 0.25 * hx * hy
+            K += np.einsum("mki,kl,mlj->mij", B, D, B) * w[:, None, None]
+    return K
+
+
+def function_gradients(qp_xy, bounds, slot_node, slot_fnode, qp_F, qp_gradF):
+    """d/dx and d/dy (nq, 4 + S) of the cell's shape functions at every
+    quadrature point: the four Q4 functions N_a, then the shifted enrichment
+    Phi_s = N_a (F - F(x_a)) of each slot (paper eq. 11; 0 for an empty slot).
+    ``bounds``, ``slot_node``, ``slot_fnode`` are those of each point's cell,
+    (nq, 4), (nq, S), (nq, S).  Local dof 2 f + c is function f, component c,
+    as in bulk._enriched_B."""
+    N, dN = q4_shape(
+        qp_xy[:, 0], qp_xy[:, 1], bounds[:, 0], bounds[:, 1], bounds[:, 2], bounds[:, 3]
+    )
+    used = slot_node >= 0
+    a = np.where(used, slot_node, 0)
+    shift = np.where(used, qp_F - slot_fnode, 0.0)
+    Na = np.where(used, np.take_along_axis(N, a, 1), 0.0)
+    gx = np.take_along_axis(dN[:, :, 0], a, 1) * shift + Na * qp_gradF[:, :, 0]
+    gy = np.take_along_axis(dN[:, :, 1], a, 1) * shift + Na * qp_gradF[:, :, 1]
+    return np.concatenate([dN[:, :, 0], gx], 1), np.concatenate([dN[:, :, 1], gy], 1)
+
+
+def enriched_cell_matrices(
+    bounds, qp_offsets, qp_xy, qp_w, qp_F, qp_gradF, slot_node, slot_fnode, D
+):
+    """K (nc, 8 + 2S, 8 + 2S) = sum_qp B^T D B w and Bbar (nc, 3, 8 + 2S) =
+    (1/A) sum_qp B w of enriched cells (bulk.enriched_cell_matrices).
+
+    With B's Voigt rows [exx, eyy, gxy] = [bx u_x, by u_y, by u_x + bx u_y]
+    (paper eq. 16), each (x|y, x|y) block of K_e is a combination of the four
+    gradient products sum_qp w b_f b_g: four small products per cell instead
+    of one over the 3 x (8 + 2S) B.
+    """
+    nc = bounds.shape[0]
+    S = slot_node.shape[1]
+    nf = 4 + S
+    K = np.zeros((nc, 2 * nf, 2 * nf))
+    Bbar = np.zeros((nc, 3, 2 * nf))
+    counts = np.diff(qp_offsets)
+    if nc == 0 or counts.sum() == 0:
+        return K, Bbar
+    cell = np.repeat(np.arange(nc), counts)
+    bx, by = function_gradients(
+        qp_xy, bounds[cell], slot_node[cell], slot_fnode[cell], qp_F, qp_gradF
+    )
+    wx, wy = bx * qp_w[:, None], by * qp_w[:, None]
+    blocks = K.reshape(nc, nf, 2, nf, 2)
+    d = D
+    for e in np.nonzero(counts)[0]:
+        lo, hi = qp_offsets[e], qp_offsets[e + 1]
+        xx = wx[lo:hi].T @ bx[lo:hi]
+        xy = wx[lo:hi].T @ by[lo:hi]
+        yx = wy[lo:hi].T @ bx[lo:hi]
+        yy = wy[lo:hi].T @ by[lo:hi]
+        blk = blocks[e]
+        blk[:, 0, :, 0] = d[0, 0] * xx + d[0, 2] * xy + d[2, 0] * yx + d[2, 2] * yy
+        blk[:, 0, :, 1] = d[0, 1] * xy + d[0, 2] * xx + d[2, 1] * yy + d[2, 2] * yx
+        blk[:, 1, :, 0] = d[1, 0] * yx + d[1, 2] * yy + d[2, 0] * xx + d[2, 2] * xy
+        blk[:, 1, :, 1] = d[1, 1] * yy + d[1, 2] * yx + d[2, 1] * xy + d[2, 2] * xx
+    full = np.nonzero(counts)[0]
+    sx = np.add.reduceat(wx, qp_offsets[full], axis=0)  # (k, nf)
+    sy = np.add.reduceat(wy, qp_offsets[full], axis=0)
+    area = np.add.reduceat(qp_w, qp_offsets[full])[:, None]
+    bar = Bbar.reshape(nc, 3, nf, 2)
+    bar[full, 0, :, 0] = sx / area
+    bar[full, 1, :, 1] = sy / area
+    bar[full, 2, :, 0] = sy / area
+    bar[full, 2, :, 1] = sx / area
+    return K, Bbar
+
+
+def coulomb_return_map(gn, gt, slip_old, pn0, kn, kt, friction, cohesion):
+    """The return map of contact.coulomb_return_map on arrays of points:
+    (pn, pt, state, slip_new, d_nn, d_nt, d_tn, d_tt), each (n,)."""
+    pn = kn * gn + pn0
+    is_open = pn > 0.0
+    pt_trial = kt * (gt - slip_old)
+    bound = cohesion - friction * pn
+    stick = ~is_open & (np.abs(pt_trial) <= bound)
+    slip = ~is_open & ~stick
+    sgn = np.where(pt_trial > 0.0, 1.0, -1.0)
+    pt = np.where(slip, sgn * bound, pt_trial)
+    state = np.where(is_open, OPEN, np.where(stick, STICK, SLIP)).astype(np.int8)
+    with np.errstate(divide="ignore", invalid="ignore"):  # kt = 0 never slips
+        slip_new = np.where(is_open, gt, np.where(stick, slip_old, gt - pt / kt))
+    pn = np.where(is_open, 0.0, pn)
+    pt = np.where(is_open, 0.0, pt)
+    d_nn = np.where(is_open, 0.0, kn)
+    d_nt = np.zeros_like(pn)
+    d_tn = np.where(slip, -sgn * friction * kn, 0.0)
+    d_tt = np.where(stick, kt, 0.0)
+    return pn, pt, state, slip_new, d_nn, d_nt, d_tn, d_tt
+
+
+def contact_response(
+    u,
+    ip_dofs,
+    ip_coef,
+    ip_normal,
+    ip_tangent,
+    ip_weight,
+    pn0,
+    slip_old,
+    kn,
+    kt,
+    friction,
+    cohesion,
+    tangent_mode,
+    pt_prev,
+    gt_prev,
+    out_f,
+    out_K,
+    out_gn,
+    out_gt,
+    out_pn,
+    out_pt,
+    out_state,
+    out_slip,
+):
+    """Contact forces and tangent of every interface point (contact.contact_response)."""
+    n0, n1 = ip_normal[:, 0], ip_normal[:, 1]
+    t0, t1 = ip_tangent[:, 0], ip_tangent[:, 1]
+    dx, dy = ip_dofs[:, 0::2], ip_dofs[:, 1::2]
+    ux = np.where(dx >= 0, u[np.maximum(dx, 0)], 0.0)
+    uy = np.where(dy >= 0, u[np.maximum(dy, 0)], 0.0)
+    j0 = (ip_coef * ux).sum(axis=1)  # paper eq. 14
+    j1 = (ip_coef * uy).sum(axis=1)
+    gn = j0 * n0 + j1 * n1
+    gt = j0 * t0 + j1 * t1
+    pn, pt, state, slip, dnn, dnt, dtn, dtt = coulomb_return_map(
+        gn, gt, slip_old, pn0, kn, kt, friction, cohesion
+    )
+    if tangent_mode == TANGENT_SECANT:  # paper eq. 28, no n-t coupling
+        dg = np.abs(gt - gt_prev)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            sec = np.where(
+                dg <= SECANT_MIN_INCREMENT, kt, np.abs(pt - pt_prev) / dg
+            )
+        sliding = state == SLIP
+        dtt = np.where(sliding, np.minimum(sec, kt), dtt)
+        dtn = np.where(sliding, 0.0, dtn)
+    out_gn[:] = gn
+    out_gt[:] = gt
+    out_pn[:] = pn
+    out_pt[:] = pt
+    out_state[:] = state
+    out_slip[:] = slip
+    T = np.column_stack([pn * n0 + pt * t0, pn * n1 + pt * t1])
+    # C = n (dnn n + dnt t)^T + t (dtn n + dtt t)^T
+    a = dnn[:, None] * ip_normal + dnt[:, None] * ip_tangent
+    b = dtn[:, None] * ip_normal + dtt[:, None] * ip_tangent
+    C = ip_normal[:, :, None] * a[:, None, :] + ip_tangent[:, :, None] * b[:, None, :]
+    ck = ip_weight[:, None] * ip_coef  # (n, J)
+    J = ip_coef.shape[1]
+    n = ip_coef.shape[0]
+    out_f[:] = (ck[:, :, None] * T[:, None, :]).reshape(n, 2 * J)
+    ckm = ck[:, :, None] * ip_coef[:, None, :]  # (n, J, J)
+    out_K[:] = (
+        (ckm[:, :, None, :, None] * C[:, None, :, None, :])
+        .reshape(n, 2 * J, 2 * J)
+    )
+
+
+def block_triplets(dofs, blocks):
+    """(rows, cols, vals) of the entries of blocks (m, k, k) whose dofs (m, k)
+    are both >= 0, cell by cell and row-major (scatter.block_triplets: the
+    same arrays, to the bit)."""
+    keep = dofs >= 0
+    pair = keep[:, :, None] & keep[:, None, :]
+    k = dofs.shape[1]
+    rows = np.broadcast_to(dofs[:, :, None], (dofs.shape[0], k, k))[pair]
+    cols = np.broadcast_to(dofs[:, None, :], (dofs.shape[0], k, k))[pair]
+    return rows.astype(np.int64), cols.astype(np.int64), blocks[pair]
