@@ -99,6 +99,25 @@ def test_key_scalars_match_golden(runs, case):
         f"no golden for {case.name}: run python tests/regression/regen.py {case.stem}"
     )
     _, out, summary = runs(case)
+    _assert_matches_golden(case, out, summary)
+
+
+@pytest.mark.parametrize("case", CASES, ids=IDS)
+def test_numba_kernels_match_golden(case, tmp_path, monkeypatch):
+    """The same goldens through the other kernel backend: "auto" runs every
+    shipped case with the NumPy kernels (xfemslip.kernels.choose); here the
+    Numba kernels are forced, as a large case would get them."""
+    from xfemslip import kernels
+
+    monkeypatch.setenv(kernels.ENV_OVERRIDE, "numba")
+    out = tmp_path / "out"
+    summary = run(case, out)
+    with h5py.File(out / "result.h5", "r") as f:
+        assert f.attrs["kernels"] == "numba"
+    _assert_matches_golden(case, out, summary)
+
+
+def _assert_matches_golden(case, out, summary):
     got, want = key_scalars(out, summary), read_golden(case)
     assert set(got) == set(want)
     for key in EXACT:

@@ -18,6 +18,7 @@ from __future__ import annotations
 
 import importlib
 import logging
+import os
 
 from xfemslip.kernels.codes import (
     OPEN,
@@ -38,10 +39,17 @@ KERNELS = (
     "rectangle_stiffness",
 )
 # "auto" takes NumPy up to this many enriched-cell quadrature points times
-# enriched-cell columns squared (the enriched-cell assembly, NumPy's one
-# per-cell loop), and Numba above; measured crossover in benchmarks/RESULTS.md
-# (*Start-up, session 4*).
-AUTO_NUMPY_MAX_WORK = 2.0e8
+# (8 + 2 S)^2 (simulation.kernel_work), and Numba above.  Measured
+# (benchmarks/kernels_backend.py, RESULTS.md *Kernel backends*): NumPy's
+# enriched-cell assembly and contact law cost 0.06 s more than Numba's on the
+# 50 x 50 reservoir case (work 3.6e7) and about 0.35 s more on the shipped
+# 15-fracture network (1.9e8), against about 0.5 s of Numba import and
+# set-up in every process (9 s of compilation after install); at 1.4e9 (100
+# fractures on 200 x 200 cells) they cost 1.4 s more per assembly and 0.14 s
+# more per contact evaluation.
+AUTO_NUMPY_MAX_WORK = 2.5e8
+# XFEMSLIP_KERNELS=numba|numpy overrides "auto" (the test suite runs both).
+ENV_OVERRIDE = "XFEMSLIP_KERNELS"
 
 _active = "numba"
 
@@ -95,6 +103,9 @@ def choose(requested: str, work: float) -> str:
         raise ValueError(f"unknown kernel backend {requested!r}")
     if requested != "auto":
         return requested
+    forced = os.environ.get(ENV_OVERRIDE, "").strip().lower()
+    if forced in ("numba", "numpy"):
+        return forced
     return "numpy" if work <= AUTO_NUMPY_MAX_WORK else "numba"
 
 
