@@ -211,7 +211,8 @@ def study_mesh(hs, element):
             order = math.log(errs[-2] / errs[-1]) / math.log(hs[-2] / hs[-1])
             rad = "default" if radius is None else f"{radius:g} m"
             print(
-                f"| {fine:g}, {growth:g} | {rad} | " + " | ".join(cells)
+                f"| {fine:g}, {growth:g} | {rad} | "
+                + " | ".join(cells)
                 + f" | {order:.2f} |",
                 flush=True,
             )
