@@ -267,14 +267,17 @@ def test_block_beyond_the_threshold_is_reported(fraction):
 
 
 def test_nearly_incompressible_locking_is_measured():
-    """nu = 0.499 (plane strain, Q4): volumetric locking stiffens the bulk; the
-    slip error against the closed form grows from 1.0 % (nu = 0.3) to about
-    20 % (measured 19.7 %).  Reported, not hidden: it converges, and the
-    error is bounded here so a change is noticed."""
+    """nu = 0.499 (plane strain): volumetric locking stiffens the bulk; the
+    slip error against the closed form grows from 0.94 % (nu = 0.3) to about
+    8 % (measured 7.99 %; 3.18 % at nu = 0.49).  The intact cells' incompatible
+    modes (kernels.bulk.rectangle_stiffness) relieve most of it -- with plain
+    Q4 intact cells it was 19.7 % -- the enriched cells are plain Q4 and
+    still lock.  Reported, not hidden: it converges, and the error is bounded
+    here so a change is noticed."""
     base, _, _ = run_crack(Crack(nu=0.3))
     out, err, _ = run_crack(Crack(nu=0.499))
     assert out.converged, out.error
-    assert 0.10 < err < 0.25
+    assert 0.05 < err < 0.11
     assert out.max_slip < base.max_slip * 1.2  # locking: slip is underestimated
 
 

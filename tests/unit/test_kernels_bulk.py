@@ -1,8 +1,9 @@
 """Tests of xfemslip.kernels.bulk against NumPy references written here.
 
 - rectangle_stiffness: an isoparametric Q4 with 2x2 Gauss (Jacobian from the
-  node coordinates), rigid-body modes, and the closed-form nodal forces of a
-  uniform stress;
+  node coordinates) plus Wilson's incompatible modes, condensed; rigid-body
+  modes, the closed-form nodal forces of a uniform stress and of pure bending
+  (where the plain Q4 is too stiff);
 - enriched_cell_matrices: a per-point NumPy loop on the inputs of a built
   model, and the strain energy of a piecewise-linear field cut by the fracture
   (closed form A_+ eps^T D eps).
@@ -68,6 +69,26 @@ def q4_reference(coords, D):
     return K
 
 
+def qm6_reference(coords, D):
+    """8x8 condensed stiffness of the isoparametric Q4 plus the incompatible
+    modes 1 - xi^2, 1 - eta^2 on each component (Wilson et al. 1973), 2x2 Gauss."""
+    g = 1.0 / np.sqrt(3.0)
+    K = np.zeros((12, 12))
+    for xi in (-g, g):
+        for eta in (-g, g):
+            dN_dnat = 0.25 * np.array([XI * (1.0 + eta * ETA), ETA * (1.0 + xi * XI)])
+            dP_dnat = np.array([[-2.0 * xi, 0.0], [0.0, -2.0 * eta]])  # (2, 2)
+            J = dN_dnat @ coords
+            dN = np.linalg.solve(J, np.hstack([dN_dnat, dP_dnat]))  # (2, 6)
+            B = np.zeros((3, 12))
+            B[0, 0::2] = dN[0]
+            B[1, 1::2] = dN[1]
+            B[2, 0::2] = dN[1]
+            B[2, 1::2] = dN[0]
+            K += B.T @ D @ B * np.linalg.det(J)
+    return K[:8, :8] - K[:8, 8:] @ np.linalg.solve(K[8:, 8:], K[8:, :8])
+
+
 def enriched_reference(b, xy, w, F, gradF, slot_node, slot_fnode, D):
     """K (nd, nd) and Bbar (3, nd) of one enriched cell, point by point."""
     S = slot_node.size
@@ -131,7 +152,7 @@ def test_rectangle_stiffness_equals_the_isoparametric_reference(D):
         coords = (
             np.array([[0.0, 0.0], [hx[e], 0.0], [hx[e], hy[e]], [0.0, hy[e]]]) + 4.2
         )
-        ref = q4_reference(coords, D)
+        ref = qm6_reference(coords, D)
         # the shifted coordinates cost the reference a few digits on the 3 mm cell
         np.testing.assert_allclose(K[e], ref, rtol=0, atol=1e-11 * np.abs(ref).max())
 
@@ -175,6 +196,53 @@ def test_rectangle_stiffness_uniform_strain_gives_boundary_tractions():
         ]
     )
     np.testing.assert_allclose(K @ u, f, rtol=1e-12, atol=1e-9 * np.abs(f).max())
+
+
+def _bending(x, y, c, D):
+    """Nodal values (8,) of the pure-bending field sigma_xx = c y, sigma_yy =
+    sigma_xy = 0: u = s11 c x y, v = -s11 c x^2 / 2 + s12 c y^2 / 2 (S = D^-1)."""
+    S = np.linalg.inv(D)
+    return np.column_stack(
+        [S[0, 0] * c * x * y, -0.5 * S[0, 0] * c * x**2 + 0.5 * S[1, 0] * c * y**2]
+    ).ravel()
+
+
+@pytest.mark.parametrize("hx, hy", [(0.5, 0.2), (2.0, 0.05), (0.1, 0.3)])
+def test_rectangle_stiffness_is_exact_in_pure_bending(hx, hy):
+    """K times the nodal values of pure bending (anywhere in the plane) is the
+    nodal force of the linear edge traction -+c y on the two vertical edges."""
+    c = 3.0e6
+    x0, y0 = -0.7, 0.4
+    x = np.array([x0, x0 + hx, x0 + hx, x0])
+    y = np.array([y0, y0, y0 + hy, y0 + hy])
+    u = _bending(x, y, c, D_STRAIN)
+    y1 = y0 + hy
+    low, high = c * hy * (2 * y0 + y1) / 6.0, c * hy * (y0 + 2 * y1) / 6.0
+    f = np.zeros(8)
+    f[[0, 2, 4, 6]] = [-low, low, high, -high]  # x forces at nodes 0..3
+    K = rectangle_stiffness(np.array([hx]), np.array([hy]), D_STRAIN)[0]
+    np.testing.assert_allclose(K @ u, f, rtol=0, atol=1e-10 * np.abs(f).max())
+
+
+@pytest.mark.parametrize("hx, hy", [(0.5, 0.2), (2.0, 0.05), (0.1, 0.3)])
+def test_plain_q4_bending_energy_has_the_parasitic_shear_term(hx, hy):
+    """On a centred cell the bilinear interpolant of pure bending is u = s11 c x y,
+    v = const: shear strain s11 c x, so the Q4 stores 2U = s11^2 c^2 (D11 hx hy^3
+    + D33 hy hx^3) / 12 against the exact s11 c^2 hx hy^3 / 12 (too stiff by a
+    term growing with (hx / hy)^2).  The incompatible modes store the exact one."""
+    D = D_STRAIN
+    c = 3.0e6
+    x = 0.5 * hx * XI
+    y = 0.5 * hy * ETA
+    u = _bending(x, y, c, D)
+    s11 = np.linalg.inv(D)[0, 0]
+    exact = s11 * c**2 * hx * hy**3 / 12.0
+    q4 = s11**2 * c**2 * (D[0, 0] * hx * hy**3 + D[2, 2] * hy * hx**3) / 12.0
+    e_q4 = u @ q4_reference(np.column_stack([x, y]), D) @ u
+    e_im = u @ rectangle_stiffness(np.array([hx]), np.array([hy]), D)[0] @ u
+    assert e_q4 == pytest.approx(q4, rel=1e-12)
+    assert e_im == pytest.approx(exact, rel=1e-9)  # condensation round-off
+    assert e_q4 > 1.05 * e_im
 
 
 # ------------------------------------------------------------- enriched_cell_matrices
@@ -240,9 +308,10 @@ def test_enriched_cell_matrices_equal_the_numpy_reference(key):
 
 
 @pytest.mark.parametrize("n_slots", [0, 2])
-def test_uncut_cell_without_slots_reproduces_rectangle_stiffness(n_slots):
+def test_uncut_cell_without_slots_reproduces_the_q4(n_slots):
     """A cell integrated with the sub-cell machinery (two triangles, degree-5 rule,
-    which is exact for the degree-2 integrand) and empty slots is the plain Q4."""
+    which is exact for the degree-2 integrand) and empty slots is the plain Q4
+    (enriched cells have no incompatible modes, unlike rectangle_stiffness)."""
     from xfemslip.quadrature import triangle_rule
 
     b = np.array([[1.5, 2.0, -0.5, -0.25]])
@@ -261,7 +330,7 @@ def test_uncut_cell_without_slots_reproduces_rectangle_stiffness(n_slots):
         np.zeros((1, n_slots)),
         D_STRAIN,
     )
-    K_rect = rectangle_stiffness(np.array([x1 - x0]), np.array([y1 - y0]), D_STRAIN)[0]
+    K_rect = q4_reference(np.array([[x0, y0], [x1, y0], [x1, y1], [x0, y1]]), D_STRAIN)
     assert K.shape == (1, 8 + 2 * n_slots, 8 + 2 * n_slots)
     np.testing.assert_allclose(
         K[0, :8, :8], K_rect, rtol=0, atol=1e-13 * np.abs(K_rect).max()

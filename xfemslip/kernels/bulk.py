@@ -1,5 +1,8 @@
 """Bulk element matrices: intact rectangles and enriched (cut / blending) cells.
 
+Intact rectangles are Q4 with condensed incompatible modes (rectangle_stiffness);
+enriched cells are plain Q4 plus their enrichment slots.
+
 Local dof order of a cell: standard ``2*a + c`` (a = 0..3 local node, c = 0 x,
 1 y), then enriched slot s: ``8 + 2*s + c``.  A slot is one (node, fracture)
 enrichment with the shifted function (paper eq. 11)
@@ -22,7 +25,22 @@ _GAUSS2 = np.array([-1.0 / np.sqrt(3.0), 1.0 / np.sqrt(3.0)])
 
 @njit(cache=NUMBA_CACHE)
 def rectangle_stiffness(hx, hy, D):
-    """Stiffness of intact rectangles, 2x2 Gauss (exact for bilinear fields).
+    """Stiffness of intact rectangles: Q4 with Wilson's incompatible modes.
+
+    The bilinear field is enriched inside each cell with the two bubble modes
+    P1 = 1 - xi^2, P2 = 1 - eta^2 per displacement component (Wilson, Taylor,
+    Doherty & Ghaboussi 1973; Taylor, Beresford & Wilson 1976, QM6), which are
+    condensed out, so the cell keeps its 8 nodal dofs.  On a rectangle the
+    derivatives of P1, P2 integrate to zero over the cell: a uniform strain
+    leaves the bubbles at rest (patch test), the cell-average strain is that
+    of the nodal field alone, and the cell is exact in pure bending, where the
+    plain Q4 is too stiff by parasitic shear.  That stiffness grows with
+    (cell length / length scale of the field)^2, which is what the coarse,
+    elongated cells of a graded far field see; it made the slip of a crack
+    converge to a floor (benchmarks/RESULTS.md, "Slip convergence on the
+    OpenGeoSys peer problem").  Enriched cells stay plain Q4 (the bubbles are
+    internal to each cell, so the two kinds of cells are conforming).
+    2x2 Gauss is exact for every term (at most quadratic in xi or eta).
 
     Parameters
     ----------
@@ -37,20 +55,40 @@ def rectangle_stiffness(hx, hy, D):
     K = np.zeros((m, 8, 8))
     N = np.empty(4)
     dN = np.empty((4, 2))
-    B = np.zeros((3, 8))
+    B = np.zeros((3, 12))
+    Kf = np.zeros((12, 12))
     for e in range(m):
+        Kf[:, :] = 0.0
         for gi in range(2):
             for gj in range(2):
                 x = 0.5 * hx[e] * (1.0 + _GAUSS2[gi])
                 y = 0.5 * hy[e] * (1.0 + _GAUSS2[gj])
                 q4_shape(x, y, 0.0, hx[e], 0.0, hy[e], N, dN)
+                B[:, :] = 0.0
                 for a in range(4):
                     B[0, 2 * a] = dN[a, 0]
                     B[1, 2 * a + 1] = dN[a, 1]
                     B[2, 2 * a] = dN[a, 1]
                     B[2, 2 * a + 1] = dN[a, 0]
+                # bubbles: d(1 - xi^2)/dx = -4 xi / hx, d(1 - eta^2)/dy = -4 eta / hy
+                p1x = -4.0 * _GAUSS2[gi] / hx[e]
+                p2y = -4.0 * _GAUSS2[gj] / hy[e]
+                B[0, 8] = p1x  # P1 on ux
+                B[2, 9] = p1x  # P1 on uy
+                B[1, 11] = p2y  # P2 on uy
+                B[2, 10] = p2y  # P2 on ux
                 w = 0.25 * hx[e] * hy[e]
-                K[e] += (B.T @ D @ B) * w
+                Kf += (B.T @ D @ B) * w
+        # static condensation of the four bubble dofs
+        Kaa = np.ascontiguousarray(Kf[8:, 8:])
+        Kau = np.ascontiguousarray(Kf[8:, :8])
+        X = np.linalg.solve(Kaa, Kau)
+        K[e] = Kf[:8, :8] - Kau.T @ X
+        for i in range(8):  # exact symmetry (the solve leaves round-off)
+            for j in range(i + 1, 8):
+                v = 0.5 * (K[e, i, j] + K[e, j, i])
+                K[e, i, j] = v
+                K[e, j, i] = v
     return K
 
 
