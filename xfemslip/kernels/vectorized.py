@@ -49,23 +49,35 @@ def q4_shape(x, y, x0, x1, y0, y1):
 
 
 def rectangle_stiffness(hx, hy, D):
-    """Stiffness (m, 8, 8) of intact rectangles, 2x2 Gauss (bulk.rectangle_stiffness)."""
+    """Stiffness (m, 8, 8) of intact rectangles: Q4 with Wilson's condensed
+    incompatible modes, 2x2 Gauss (bulk.rectangle_stiffness)."""
     m = hx.shape[0]
-    K = np.zeros((m, 8, 8))
+    Kf = np.zeros((m, 12, 12))
     zero = np.zeros(m)
     for gi in range(2):
         for gj in range(2):
             x = 0.5 * hx * (1.0 + _GAUSS2[gi])
             y = 0.5 * hy * (1.0 + _GAUSS2[gj])
             _, dN = q4_shape(x, y, zero, hx, zero, hy)
-            B = np.zeros((m, 3, 8))
-            B[:, 0, 0::2] = dN[..., 0]
-            B[:, 1, 1::2] = dN[..., 1]
-            B[:, 2, 0::2] = dN[..., 1]
-            B[:, 2, 1::2] = dN[..., 0]
+            B = np.zeros((m, 3, 12))
+            B[:, 0, 0:8:2] = dN[..., 0]
+            B[:, 1, 1:8:2] = dN[..., 1]
+            B[:, 2, 0:8:2] = dN[..., 1]
+            B[:, 2, 1:8:2] = dN[..., 0]
+            # bubbles: d(1 - xi^2)/dx = -4 xi / hx, d(1 - eta^2)/dy = -4 eta / hy
+            p1x = -4.0 * _GAUSS2[gi] / hx
+            p2y = -4.0 * _GAUSS2[gj] / hy
+            B[:, 0, 8] = p1x  # P1 on ux
+            B[:, 2, 9] = p1x  # P1 on uy
+            B[:, 2, 10] = p2y  # P2 on ux
+            B[:, 1, 11] = p2y  # P2 on uy
             w = 0.25 * hx * hy
-            K += np.einsum("mki,kl,mlj->mij", B, D, B) * w[:, None, None]
-    return K
+            Kf += np.einsum("mki,kl,mlj->mij", B, D, B) * w[:, None, None]
+    # static condensation of the four bubble dofs
+    Kau = Kf[:, 8:, :8]
+    X = np.linalg.solve(Kf[:, 8:, 8:], Kau)
+    K = Kf[:, :8, :8] - np.einsum("mai,maj->mij", Kau, X)
+    return 0.5 * (K + K.transpose(0, 2, 1))  # exact symmetry
 
 
 def function_gradients(qp_xy, bounds, slot_node, slot_fnode, qp_F, qp_gradF):
