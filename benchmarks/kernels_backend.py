@@ -56,7 +56,7 @@ CONFIGS = {
 
 def with_backend(text: str, backend: str) -> str:
     text = re.sub(r"(?m)^kernels = .*\n", "", text)
-    text = re.sub(r'(?m)^formats = .*$', 'formats = ["h5"]', text)
+    text = re.sub(r"(?m)^formats = .*$", 'formats = ["h5"]', text)
     if "[solver]" in text:
         return text.replace("[solver]", f'[solver]\nkernels = "{backend}"', 1)
     return text + f'\n[solver]\nkernels = "{backend}"\n'
@@ -66,9 +66,20 @@ def once(case: Path, out: Path, env) -> tuple[float, float]:
     before = resource.getrusage(resource.RUSAGE_CHILDREN)
     start = time.perf_counter()
     proc = subprocess.run(
-        [sys.executable, "-m", "xfemslip", "run", "-q", "--overwrite", str(case),
-         "-o", str(out)],
-        env=env, capture_output=True, text=True,
+        [
+            sys.executable,
+            "-m",
+            "xfemslip",
+            "run",
+            "-q",
+            "--overwrite",
+            str(case),
+            "-o",
+            str(out),
+        ],
+        env=env,
+        capture_output=True,
+        text=True,
     )
     wall = time.perf_counter() - start
     after = resource.getrusage(resource.RUSAGE_CHILDREN)
@@ -96,8 +107,11 @@ def main() -> int:
     ap.add_argument("--json", type=Path)
     args = ap.parse_args()
     folder = Path(tempfile.mkdtemp(prefix="xfemslip-kernels-"))
-    env = dict(os.environ, NUMBA_CACHE_DIR=str(folder / "numba"),
-               PYTHONPYCACHEPREFIX=str(folder / "pycache"))
+    env = dict(
+        os.environ,
+        NUMBA_CACHE_DIR=str(folder / "numba"),
+        PYTHONPYCACHEPREFIX=str(folder / "pycache"),
+    )
     env.pop("PYTHONDONTWRITEBYTECODE", None)
     rows = []
     for name, make in CONFIGS.items():
@@ -119,7 +133,8 @@ def main() -> int:
             row[f"{backend}_cpu"] = statistics.median(t[1] for t in times[backend])
         rows.append(row)
         print(
-            f"| {name} | {row['work']:.3g} | {row['numpy_wall']:.2f} ({row['numpy_cpu']:.2f})"
+            f"| {name} | {row['work']:.3g} | "
+            f"{row['numpy_wall']:.2f} ({row['numpy_cpu']:.2f})"
             f" | {row['numba_wall']:.2f} ({row['numba_cpu']:.2f})"
             f" | {row['numpy_cpu'] / row['numba_cpu']:.2f} |",
             flush=True,

@@ -69,7 +69,9 @@ def xfem_case(h, half=10.0, growth=1.3, radius=None) -> str:
     x = graded(h, half=half, growth=growth)
     t = (math.cos(math.radians(PSI)), math.sin(math.radians(PSI)))
     coords = ", ".join(f"{v:.12g}" for v in x)
-    tip = "" if radius is None else f'\ntip = {{ kind = "branch", radius = {radius!r} }}'
+    tip = (
+        "" if radius is None else f'\ntip = {{ kind = "branch", radius = {radius!r} }}'
+    )
     return f"""name = "ogs-compare"
 [mesh]
 x = [{coords}]
@@ -177,8 +179,6 @@ def ogs_result(h, summaries) -> dict:
     }
 
 
-
-
 def at_error(rows, err, key="wall"):
     """Time to reach slip error `err`: interpolated log-log on the cost-error
     front (runs sorted by time, each kept only if it is more accurate than
@@ -202,15 +202,21 @@ def main() -> int:
     ap.add_argument("--ogs-h", type=float, nargs="+", default=[0.01, 0.005, 0.0025])
     ap.add_argument("--runs", type=int, default=3)
     ap.add_argument(
-        "--L", type=float, default=20.0,
+        "--L",
+        type=float,
+        default=20.0,
         help="box edge [m] for both codes (the peer script's default 20 m biases the "
         "slip by about +0.55 %% against the infinite plane; 400 m: below 0.002 %%)",
     )
     ap.add_argument("--growth", type=float, default=1.3, help="xfemslip cell growth")
     ap.add_argument(
-        "--radius", type=float, help="xfemslip branch-tip radius [m] (default: automatic)"
+        "--radius",
+        type=float,
+        help="xfemslip branch-tip radius [m] (default: automatic)",
     )
-    ap.add_argument("--ogs-h-far", type=float, default=1.0, help="OGS far-field size [m]")
+    ap.add_argument(
+        "--ogs-h-far", type=float, default=1.0, help="OGS far-field size [m]"
+    )
     ap.add_argument("--codes", nargs="+", default=["xfemslip", "ogs"])
     ap.add_argument("--json", type=Path)
     ap.add_argument(
@@ -249,7 +255,12 @@ def main() -> int:
             for h in args.ogs_h:
                 ogs[h].append(
                     ogs_once(
-                        h, i, folder, args.ogs_python, args.ogs_script, args.L,
+                        h,
+                        i,
+                        folder,
+                        args.ogs_python,
+                        args.ogs_script,
+                        args.L,
                         args.ogs_h_far,
                     )
                 )

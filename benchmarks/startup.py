@@ -72,9 +72,10 @@ def main() -> int:
         return compare(args)
     with tempfile.TemporaryDirectory() as tmp:
         out = Path(tmp) / "out"
-        cold = []
-        for i in range(args.runs):
-            cold.append(timed_run(args.case, str(Path(tmp) / f"cold{i}"), out))
+        cold = [
+            timed_run(args.case, str(Path(tmp) / f"cold{i}"), out)
+            for i in range(args.runs)
+        ]
         cold_cpu = CPU[:]
         warm_cache = str(Path(tmp) / "warm")
         timed_run(args.case, warm_cache, out)  # fill the cache

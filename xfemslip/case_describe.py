@@ -156,6 +156,7 @@ def _describe_pore(spec: CaseSpec) -> list[str]:
         )
     return lines
 
+
 def _network_count(spec: CaseSpec) -> str:
     """`` ([[fractures]] 1, network.file 3, network.generate 40)`` or ""."""
     sources = [

@@ -124,7 +124,10 @@ def _assert_matches_golden(case, out, summary):
         assert got[key] == want[key], f"{key}: {got[key]} != golden {want[key]}"
     its, want_its = got["iterations_per_step"], want["iterations_per_step"]
     assert len(its) == len(want_its)
-    assert np.all(np.abs(np.subtract(its, want_its)) <= ITERATION_SLACK), (its, want_its)
+    assert np.all(np.abs(np.subtract(its, want_its)) <= ITERATION_SLACK), (
+        its,
+        want_its,
+    )
     for key, rtol in RTOL.items():
         np.testing.assert_allclose(
             got[key], want[key], rtol=rtol, atol=0, err_msg=f"{case.stem}: {key}"

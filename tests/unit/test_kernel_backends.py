@@ -221,7 +221,11 @@ def test_a_small_run_never_imports_numba(tmp_path):
     """The point of the NumPy backend: `xfemslip run` of a small case loads
     no Numba at all (no import, no target set-up, no compilation)."""
     case = tmp_path / "small.toml"
-    case.write_text(_small_case("auto", steps=1).replace('formats = ["h5", "vtu"]', 'formats = ["h5"]'))
+    case.write_text(
+        _small_case("auto", steps=1).replace(
+            'formats = ["h5", "vtu"]', 'formats = ["h5"]'
+        )
+    )
     code = (
         "import sys\n"
         "from xfemslip.cli import cli\n"
@@ -229,7 +233,8 @@ def test_a_small_run_never_imports_numba(tmp_path):
         f"    cli(['run', '-q', {str(case)!r}, '-o', {str(tmp_path / 'out')!r}])\n"
         "except SystemExit as e:\n"
         "    assert not e.code, e.code\n"
-        "print(sorted(m for m in sys.modules if m.split('.')[0] in ('numba', 'llvmlite')))\n"
+        "jit = ('numba', 'llvmlite')\n"
+        "print(sorted(m for m in sys.modules if m.split('.')[0] in jit))\n"
     )
     env = {k: v for k, v in os.environ.items() if k != kernels.ENV_OVERRIDE}
     proc = subprocess.run(

@@ -103,7 +103,8 @@ def test_cohesion_and_plane_stress_at_a_over_20(tmp_path, plane):
 
 # Measured (default tip "branch" with its geometric radius, contact patches,
 # kn = 100 E / h): slip L2 error 0.796 % (a/10), 0.414 % (a/20), 0.156 % (a/40):
-# order 1.18 over a/10..a/40 (branch radius capped at 6 tip cells).  With the former fixed 4-cell branch radius and
+# order 1.18 over a/10..a/40 (branch radius capped at 6 tip cells).  With the
+# former fixed 4-cell branch radius and
 # pointwise contact it was 0.802 / 0.421 / 0.294 %, order 0.72 (the error
 # levelled off near 0.3 %).
 

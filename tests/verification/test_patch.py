@@ -300,7 +300,6 @@ INTERIOR = {
 K_MID, K_HIGH = 5.0e15, 5.0e17  # kn = kt [Pa/m]; k h / E = 5e4 and 5e6
 
 
-
 def run_interior(folder: Path, points, traction_edges, tip, k, model, n=20):
     folder.mkdir(parents=True, exist_ok=True)
     boundary = linear_edges(folder, STRESS, model, traction_edges)
@@ -322,10 +321,11 @@ def run_interior(folder: Path, points, traction_edges, tip, k, model, n=20):
 
 
 def _interior_cases():
-    cases = []
-    for name in INTERIOR:
-        for tip in ("ramp", "branch"):
-            cases.append(pytest.param(name, tip, "plane_strain", id=f"{name}-{tip}"))
+    cases = [
+        pytest.param(name, tip, "plane_strain", id=f"{name}-{tip}")
+        for name in INTERIOR
+        for tip in ("ramp", "branch")
+    ]
     cases += [
         pytest.param(name, tip, "plane_stress", id=f"{name}-{tip}-plane_stress")
         for name in ("generic", "through-nodes")

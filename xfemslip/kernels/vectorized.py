@@ -196,7 +196,8 @@ def contact_response(
     out_state,
     out_slip,
 ):
-    """Contact forces and tangent of every interface point (contact.contact_response)."""
+    """Contact forces and tangent of every interface point
+    (contact.contact_response)."""
     n0, n1 = ip_normal[:, 0], ip_normal[:, 1]
     t0, t1 = ip_tangent[:, 0], ip_tangent[:, 1]
     dx, dy = ip_dofs[:, 0::2], ip_dofs[:, 1::2]
@@ -212,9 +213,7 @@ def contact_response(
     if tangent_mode == TANGENT_SECANT:  # paper eq. 28, no n-t coupling
         dg = np.abs(gt - gt_prev)
         with np.errstate(divide="ignore", invalid="ignore"):
-            sec = np.where(
-                dg <= SECANT_MIN_INCREMENT, kt, np.abs(pt - pt_prev) / dg
-            )
+            sec = np.where(dg <= SECANT_MIN_INCREMENT, kt, np.abs(pt - pt_prev) / dg)
         sliding = state == SLIP
         dtt = np.where(sliding, np.minimum(sec, kt), dtt)
         dtn = np.where(sliding, 0.0, dtn)
@@ -234,9 +233,8 @@ def contact_response(
     n = ip_coef.shape[0]
     out_f[:] = (ck[:, :, None] * T[:, None, :]).reshape(n, 2 * J)
     ckm = ck[:, :, None] * ip_coef[:, None, :]  # (n, J, J)
-    out_K[:] = (
-        (ckm[:, :, None, :, None] * C[:, None, :, None, :])
-        .reshape(n, 2 * J, 2 * J)
+    out_K[:] = (ckm[:, :, None, :, None] * C[:, None, :, None, :]).reshape(
+        n, 2 * J, 2 * J
     )
 
 
