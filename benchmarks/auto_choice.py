@@ -58,6 +58,7 @@ def record(text: str, max_systems: int):
     """Build, run with SuperLU; the Newton systems (Kc, r) and model facts."""
     from xfemslip import linsolve
     from xfemslip.case import loads_case
+    from xfemslip.errors import ConvergenceError
     from xfemslip.simulation import build_model, newton_solver
 
     spec = loads_case(text, "auto_choice.toml")
@@ -78,9 +79,11 @@ def record(text: str, max_systems: int):
     ns.linear.solve = rec
     try:
         ns.run(spec.loading.steps)
-        finished = True
+        finished = "yes"
     except _Enough:
-        finished = False
+        finished = "stopped"
+    except ConvergenceError:  # the systems solved until then still count
+        finished = "failed"
     node_xy = model.problem.node_xy
     facts = linsolve.system_facts(ns.K_ff, ns.free, node_xy)
     return ns, systems, {
@@ -161,7 +164,7 @@ def main(argv=None) -> int:
             print(
                 f"| {tip} | {row['fractures']} | {row['n_free']:,} | "
                 f"{row['enriched_share']:.1%} | {row['band_share']:.1%} | "
-                f"{row['auto']} | {row['systems']}{'' if row['run_finished'] else '+'} | "
+                f"{row['auto']} | {row['systems']}{dict(yes='', stopped='+', failed=' (run failed)')[row['run_finished']]} | "
                 f"{med['superlu']:.2f} | {med['amg']:.2f} | {row['ratio']:.2f} | "
                 f"{row['superlu_factorizations']} | {row['amg_krylov']}"
                 f"{' (fell back)' if row['amg_fallbacks'] else ''} |",

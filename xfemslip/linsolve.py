@@ -90,6 +90,8 @@ AMG_BAND_LAYERS = 3
 # at its mean rate, would not reach KRYLOV_RTOL within AMG_MAX_ITERATIONS
 # (benchmarks/RESULTS.md, "auto solver choice (issue 7, session 4)").
 AMG_STALL_STOP = True
+# ... checked every STALL_CHECK iterations within the first restart cycle.
+STALL_CHECK = 20
 
 # SuperLU settings for K + K_contact, whose sparsity pattern is symmetric even
 # when the slip tangent's values are not: minimum degree on A^T + A in symmetric
@@ -244,20 +246,46 @@ def lu_solve(A, b):
     return lu_factor(A)[1](b)
 
 
+class _Stalled(Exception):
+    pass
+
+
+def _projected(iterations, reduction):
+    """Iterations to reduce a residual by KRYLOV_RTOL at the mean rate per
+    iteration of `reduction` in `iterations` (inf if it did not fall)."""
+    if not reduction < 1.0:
+        return np.inf
+    return iterations * np.log(KRYLOV_RTOL) / np.log(max(reduction, 1e-300))
+
+
 def _gmres(A, b, M, restart, maxiter, give_up=False):
     """GMRES from zero until ||A x - b|| <= KRYLOV_RTOL ||b|| (the true
     residual: scipy's test is on the preconditioned one), one restart cycle
-    at a time, at most `maxiter` iterations.  With `give_up`, stop after a
-    cycle whose true residual, extrapolated at the mean rate per iteration
-    so far, would not reach the target within `maxiter` (a stalled solve
-    stops after its first cycle instead of using the whole cap).  Returns
-    (x, converged, iterations, relative residual)."""
+    at a time, at most `maxiter` iterations.
+
+    With `give_up` (for a caller that has a fall-back), stop as soon as the
+    solve is projected not to converge within `maxiter`: in the first cycle,
+    every STALL_CHECK iterations, when the preconditioned residual's fall
+    since the first iteration, extrapolated at its mean rate, would not reach
+    KRYLOV_RTOL within `maxiter`; after each cycle, the same with the true
+    residual.  Returns (x, converged, iterations, residual ratio): the true
+    relative residual ||A x - b|| / ||b||, or after a stop within the first
+    cycle the preconditioned residual's fall (x is then not usable)."""
     from scipy.sparse.linalg import gmres
 
     count = [0]
+    first = []  # preconditioned residuals of the first cycle
 
-    def callback(_):
+    def callback(pr):
         count[0] += 1
+        if give_up and len(first) == count[0] - 1:
+            first.append(pr)
+            k = count[0]
+            if k % STALL_CHECK == 0 and k < maxiter:
+                ratio = pr / first[0] if first[0] > 0.0 else 0.0
+                if 1 + _projected(k - 1, ratio) > maxiter:
+                    first.append(ratio)
+                    raise _Stalled
 
     x = np.zeros_like(b)
     norm_b = np.linalg.norm(b)
@@ -266,18 +294,22 @@ def _gmres(A, b, M, restart, maxiter, give_up=False):
     rel = 1.0
     while count[0] < maxiter:
         before = count[0]
-        x, _ = gmres(
-            A,
-            b,
-            x0=x,
-            M=M,
-            rtol=KRYLOV_RTOL,
-            atol=0.0,
-            restart=min(restart, maxiter - before),
-            maxiter=1,
-            callback=callback,
-            callback_type="pr_norm",
-        )
+        try:
+            x, _ = gmres(
+                A,
+                b,
+                x0=x,
+                M=M,
+                rtol=KRYLOV_RTOL,
+                atol=0.0,
+                restart=min(restart, maxiter - before),
+                maxiter=1,
+                callback=callback,
+                callback_type="pr_norm",
+            )
+        except _Stalled:
+            return x, False, count[0], float(first[-1])
+        first.append(None)  # the first cycle is over
         if not np.all(np.isfinite(x)):
             rel = np.inf
             break
@@ -286,9 +318,8 @@ def _gmres(A, b, M, restart, maxiter, give_up=False):
         ok = res <= target
         if ok or count[0] == before:
             break
-        if give_up and count[0] < maxiter:
-            if rel >= 1.0 or count[0] * np.log(KRYLOV_RTOL) / np.log(rel) > maxiter:
-                break
+        if give_up and count[0] < maxiter and _projected(count[0], rel) > maxiter:
+            break
     return x, bool(ok), count[0], float(rel)
 
 
@@ -529,7 +560,7 @@ class LinearSolver:
         self.stats["amg_fallback_time"] += wasted
         logger.warning(
             "AMG-preconditioned Krylov solve did not converge (%d iterations, "
-            "relative residual %.1e, %.2f s lost); SuperLU solves this and the "
+            "residual ratio %.1e, %.2f s lost); SuperLU solves this and the "
             "later systems of the run",
             its,
             rel,

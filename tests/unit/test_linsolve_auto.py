@@ -147,7 +147,37 @@ def test_stalled_gmres_stops_after_one_cycle():
     assert rel1 == pytest.approx(np.linalg.norm(A @ x1 - b) / np.sqrt(n), rel=1e-12)
     assert 5 * np.log(linsolve.KRYLOV_RTOL) / np.log(rel1) > 50
     assert rel2 < rel1 < 1.0
-    # and a solvable system converges with the stop on: diag(1 .. 2)
+
+
+def test_stall_stop_within_the_first_cycle_and_not_on_a_slow_convergence():
+    """GMRES(60), cap 150, no preconditioner.  diag(1 .. 1e4): after 20
+    iterations the residual has fallen by 0.1 only, which at that rate needs
+    about 200 more: stopped at STALL_CHECK = 20 (without the stop: all 150
+    iterations, not converged).  diag(1 .. 100) converges in 114 iterations,
+    through a restart, with and without the stop alike."""
+    n = 2000
+    b = np.ones(n)
+    M = spla.LinearOperator((n, n), matvec=lambda v: v, dtype=float)
+    A = sp.diags(np.linspace(1.0, 1.0e4, n)).tocsr()
+    _, ok, its, ratio = linsolve._gmres(A, b, M, 60, 150, give_up=True)
+    assert not ok and its == linsolve.STALL_CHECK
+    assert 1 + linsolve._projected(its - 1, ratio) > 150
+    _, ok, its, _ = linsolve._gmres(A, b, M, 60, 150, give_up=False)
+    assert not ok and its == 150
+    A = sp.diags(np.linspace(1.0, 100.0, n)).tocsr()
+    runs = [linsolve._gmres(A, b, M, 60, 150, give_up=g) for g in (True, False)]
+    for x, ok, its, rel in runs:
+        assert ok and 60 < its < 150 and rel <= linsolve.KRYLOV_RTOL
+        np.testing.assert_allclose(x, 1.0 / np.linspace(1.0, 100.0, n), rtol=1e-8)
+    assert runs[0][2] == runs[1][2]
+
+
+def test_gmres_converges_with_the_stop_on():
+    """The check after each restart cycle does not stop a GMRES(5) that
+    converges (diag(1 .. 2))."""
+    n = 2000
+    b = np.ones(n)
+    M = spla.LinearOperator((n, n), matvec=lambda v: v, dtype=float)
     A = sp.diags(np.linspace(1.0, 2.0, n)).tocsr()
     x, ok, its, rel = linsolve._gmres(A, b, M, 5, 100, give_up=True)
     assert ok and rel <= linsolve.KRYLOV_RTOL
