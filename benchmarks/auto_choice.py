@@ -4,13 +4,15 @@ generated fracture networks, by mesh size, fracture count and tip.
 
     OPENBLAS_NUM_THREADS=1 PYTHONPATH=$PWD python benchmarks/auto_choice.py \
         --mesh 100 --counts 1,10,30,100 --tips ramp,branch [--steps 2] \
-        [--runs 2] [--max-systems 8] [--json out.json]
+        [--runs 2] [--max-systems 8] [--json out.json] [--source dfn|build]
 
 Case: the 20-realization sweep's network (cases/sweeps/dfn_realizations.toml,
 seed 1, two sets, lengths 0.12-0.4 m) with `count` generated fractures on
 mesh x mesh cells, the stress path of benchmarks/network_solve.py (in-situ
 sigma_xx = -20, sigma_yy = -40 MPa, then sigma_xx to -8 MPa in --steps steps)
-so that fractures slip and Newton iterates.
+so that fractures slip and Newton iterates.  With --source build: the
+seed-6 network of benchmarks/network_build.py (straight fractures of
+0.08-0.25 m, uniform orientations) on its own stress path (1 load step).
 
 For each configuration the model is built once and run with
 linear_solver = "superlu", recording every Newton system (K_ff + K_c, r) it
@@ -49,7 +51,12 @@ class _Enough(Exception):
     pass
 
 
-def case_text(mesh: int, count: int, tip: str, steps: int) -> str:
+def case_text(mesh: int, count: int, tip: str, steps: int, source="dfn") -> str:
+    if source == "build":  # the seed-6 network of network_build.py, 1 step
+        import network_build
+
+        text = network_build.case_text(network_build.network(count), mesh, tip)
+        return text + '[solver]\nlinear_solver = "superlu"\n'
     text = _network_text(mesh, tip, "superlu", steps)
     return re.sub(r"count = \d+", f"count = {count}", text, count=1)
 
@@ -124,11 +131,19 @@ def main(argv=None) -> int:
     ap.add_argument("--runs", type=int, default=2)
     ap.add_argument("--max-systems", type=int, default=8)
     ap.add_argument("--json", type=Path)
+    ap.add_argument(
+        "--source",
+        choices=("dfn", "build"),
+        default="dfn",
+        help="dfn: the sweep's generated network; build: network_build.py's "
+        "seed-6 network (its own stress path, 1 step)",
+    )
     args = ap.parse_args(argv)
     logging.disable(logging.WARNING)
     rows = []
     print(
-        f"{args.mesh} x {args.mesh} cells, {args.steps} steps, <= "
+        f"{args.source} network, {args.mesh} x {args.mesh} cells, "
+        f"{args.steps if args.source == 'dfn' else 1} steps, <= "
         f"{args.max_systems} Newton systems, {args.runs} interleaved replays, "
         "CPU s (median)",
         flush=True,
@@ -140,7 +155,7 @@ def main(argv=None) -> int:
     print("|---|---|---|---|---|---|---|---|---|---|---|---|", flush=True)
     for tip in args.tips.split(","):
         for count in map(int, args.counts.split(",")):
-            text = case_text(args.mesh, count, tip, args.steps)
+            text = case_text(args.mesh, count, tip, args.steps, args.source)
             ns, systems, row = record(text, args.max_systems)
             out = {"superlu": [], "amg": []}
             replay(ns, systems[:1], "amg")  # warm-up (imports)
@@ -152,6 +167,7 @@ def main(argv=None) -> int:
                 mesh=args.mesh,
                 tip=tip,
                 count=count,
+                source=args.source,
                 superlu=med["superlu"],
                 amg=med["amg"],
                 ratio=med["amg"] / med["superlu"],
