@@ -30,10 +30,19 @@ linear_solver``), each keeping what does not change:
   only the small band is refactored per Newton system.  A system without
   enriched dofs is solved by AMG-preconditioned CG.
   If the Krylov solve does not converge, that system and the rest of the run
-  go to SuperLU.
+  go to SuperLU.  The time lost on the AMG attempt is bounded: GMRES stops
+  as soon as its residual, extrapolated at its mean rate, would not reach
+  KRYLOV_RTOL within AMG_MAX_ITERATIONS (checked every STALL_CHECK
+  iterations of the first restart cycle and after each cycle), and the
+  attempt is logged (warning: iterations, seconds lost) and counted in
+  stats["amg_fallbacks"], stats["amg_fallback_time"].
 - ``"auto"`` (default): ``"amg"`` from AUTO_AMG_MIN_DOFS free dofs up on
-  meshes with cell aspect ratios up to AUTO_AMG_MAX_ASPECT (pyamg installed,
-  node coordinates known), ``"superlu"`` otherwise.
+  meshes with cell aspect ratios up to AUTO_AMG_MAX_ASPECT whose AMG band
+  (the enriched dofs and AMG_BAND_LAYERS matrix neighbours: what the band LU
+  of every Newton system factors) holds at most AUTO_AMG_MAX_BAND of the
+  free dofs (pyamg installed, node coordinates known), ``"superlu"``
+  otherwise.  All three inputs are known before the first solve
+  (system_facts); the choice is logged at debug level.
 
 Why not a low-rank (Woodbury) update or a Schur complement on the contact
 dofs: both cost one back-solve per contact dof, and on the reservoir case at
@@ -380,17 +389,25 @@ class LinearSolver:
         if "band_share" in self.facts:
             logger.debug(
                 "linear solver: %s (auto: %d free dofs, %.1f %% enriched, "
-                "AMG band %.1f %% of them, largest AMG band %.0f %%)",
+                "AMG band %.1f %% of them (AMG up to %.0f %%), cells up to "
+                "%.1f:1 (AMG up to %.0f:1))",
                 self.method,
                 n,
                 100.0 * self.facts["enriched_share"],
                 100.0 * self.facts["band_share"],
                 100.0 * AUTO_AMG_MAX_BAND,
+                cell_aspect_ratio(node_xy),
+                AUTO_AMG_MAX_ASPECT,
+            )
+        elif method == "auto":
+            logger.debug(
+                "linear solver: %s (auto: %d free dofs, AMG from %d)",
+                self.method,
+                n,
+                AUTO_AMG_MIN_DOFS,
             )
         else:
-            logger.debug(
-                "linear solver: %s (%s, %d free dofs)", self.method, method, n
-            )
+            logger.debug("linear solver: %s (%d free dofs)", self.method, n)
 
     # ------------------------------------------------------------------ #
     def solve(self, Kc, r):
