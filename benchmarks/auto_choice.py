@@ -38,13 +38,14 @@ import sys
 import time
 from pathlib import Path
 
-import numpy as np
 import scipy.sparse as sp
 
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT / "benchmarks"))
 
 from network_solve import case_text as _network_text  # noqa: E402
+
+MARK = {"yes": "", "stopped": "+", "failed": " (run failed)"}
 
 
 class _Enough(Exception):
@@ -93,16 +94,20 @@ def record(text: str, max_systems: int):
         finished = "failed"
     node_xy = model.problem.node_xy
     facts = linsolve.system_facts(ns.K_ff, ns.free, node_xy)
-    return ns, systems, {
-        "build": t1 - t0,
-        "fractures": len(model.fractures),
-        "n_free": int(ns.free.size),
-        "enriched_share": facts["enriched_share"],
-        "band_share": facts["band_share"],
-        "auto": linsolve.choose("auto", ns.free.size, node_xy, facts["band_share"]),
-        "systems": len(systems),
-        "run_finished": finished,
-    }
+    return (
+        ns,
+        systems,
+        {
+            "build": t1 - t0,
+            "fractures": len(model.fractures),
+            "n_free": int(ns.free.size),
+            "enriched_share": facts["enriched_share"],
+            "band_share": facts["band_share"],
+            "auto": linsolve.choose("auto", ns.free.size, node_xy, facts["band_share"]),
+            "systems": len(systems),
+            "run_finished": finished,
+        },
+    )
 
 
 def replay(ns, systems, method: str) -> dict:
@@ -180,7 +185,7 @@ def main(argv=None) -> int:
             print(
                 f"| {tip} | {row['fractures']} | {row['n_free']:,} | "
                 f"{row['enriched_share']:.1%} | {row['band_share']:.1%} | "
-                f"{row['auto']} | {row['systems']}{dict(yes='', stopped='+', failed=' (run failed)')[row['run_finished']]} | "
+                f"{row['auto']} | {row['systems']}{MARK[row['run_finished']]} | "
                 f"{med['superlu']:.2f} | {med['amg']:.2f} | {row['ratio']:.2f} | "
                 f"{row['superlu_factorizations']} | {row['amg_krylov']}"
                 f"{' (fell back)' if row['amg_fallbacks'] else ''} |",

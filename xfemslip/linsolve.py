@@ -368,9 +368,7 @@ class LinearSolver:
         self.facts = {"n_free": n}
         if method == "auto" and node_xy is not None and n >= AUTO_AMG_MIN_DOFS:
             self.facts = system_facts(self.K, self.free, node_xy)
-        self.method = choose(
-            method, n, node_xy, self.facts.get("band_share", 0.0)
-        )
+        self.method = choose(method, n, node_xy, self.facts.get("band_share", 0.0))
         if self.method == "amg" and node_xy is None:
             raise ValueError("the AMG linear solver needs the node coordinates")
         self.stats = {
