@@ -77,10 +77,10 @@ AUTO_AMG_MIN_DOFS = 50_000
 AUTO_AMG_MAX_ASPECT = 4.0
 # ... and whose AMG band (enriched dofs and AMG_BAND_LAYERS neighbours) holds
 # at most this share of the free dofs.  Measured on generated networks of
-# 1-100 fractures, 80k-360k dofs (benchmarks/auto_choice.py, RESULTS.md "auto
+# 1-100 fractures, 80k-375k dofs (benchmarks/auto_choice.py, RESULTS.md "auto
 # solver choice (issue 7, session 4)"): the band LU of every Newton system
 # grows with the band, and AMG's CPU time on the same Newton systems, 0.54 to
-# 0.82 of SuperLU's with bands of 13-64 %, was 0.92-0.93 with 67 % and 79 %;
+# 0.82 of SuperLU's with bands of 12-64 %, was 0.92-0.93 with 67 % and 79 %;
 # the one run with a larger band that fell back to SuperLU (a singular band
 # matrix, 72 %) took 1.08.  Above 0.65 the gain is under 10 %, within one
 # run's noise on the shared machine, and a fall-back costs more than that.
