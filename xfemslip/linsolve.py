@@ -30,10 +30,19 @@ linear_solver``), each keeping what does not change:
   only the small band is refactored per Newton system.  A system without
   enriched dofs is solved by AMG-preconditioned CG.
   If the Krylov solve does not converge, that system and the rest of the run
-  go to SuperLU.
+  go to SuperLU.  The time lost on the AMG attempt is bounded: GMRES stops
+  as soon as its residual, extrapolated at its mean rate, would not reach
+  KRYLOV_RTOL within AMG_MAX_ITERATIONS (checked every STALL_CHECK
+  iterations of the first restart cycle and after each cycle), and the
+  attempt is logged (warning: iterations, seconds lost) and counted in
+  stats["amg_fallbacks"], stats["amg_fallback_time"].
 - ``"auto"`` (default): ``"amg"`` from AUTO_AMG_MIN_DOFS free dofs up on
-  meshes with cell aspect ratios up to AUTO_AMG_MAX_ASPECT (pyamg installed,
-  node coordinates known), ``"superlu"`` otherwise.
+  meshes with cell aspect ratios up to AUTO_AMG_MAX_ASPECT whose AMG band
+  (the enriched dofs and AMG_BAND_LAYERS matrix neighbours: what the band LU
+  of every Newton system factors) holds at most AUTO_AMG_MAX_BAND of the
+  free dofs (pyamg installed, node coordinates known), ``"superlu"``
+  otherwise.  All three inputs are known before the first solve
+  (system_facts); the choice is logged at debug level.
 
 Why not a low-rank (Woodbury) update or a Schur complement on the contact
 dofs: both cost one back-solve per contact dof, and on the reservoir case at
@@ -66,6 +75,16 @@ LINEAR_SOLVERS = ("auto", "superlu", "amg")
 # iterations (58k dofs).
 AUTO_AMG_MIN_DOFS = 50_000
 AUTO_AMG_MAX_ASPECT = 4.0
+# ... and whose AMG band (enriched dofs and AMG_BAND_LAYERS neighbours) holds
+# at most this share of the free dofs.  Measured on generated networks of
+# 1-100 fractures, 80k-375k dofs (benchmarks/auto_choice.py, RESULTS.md "auto
+# solver choice (issue 7, session 4)"): the band LU of every Newton system
+# grows with the band, and AMG's CPU time on the same Newton systems, 0.54 to
+# 0.82 of SuperLU's with bands of 12-64 %, was 0.92-0.93 with 67 % and 79 %;
+# the one run with a larger band that fell back to SuperLU (a singular band
+# matrix, 72 %) took 1.08.  Above 0.65 the gain is under 10 %, within one
+# run's noise on the shared machine, and a fall-back costs more than that.
+AUTO_AMG_MAX_BAND = 0.65
 # Relative residual ||A x - b|| / ||b|| at which the Krylov solves stop.
 KRYLOV_RTOL = 1.0e-10
 # GMRES iterations with a kept factorization tried before refactoring, and
@@ -80,6 +99,12 @@ AMG_RESTART = 60
 AMG_MAX_ITERATIONS = 150
 # Layers of matrix neighbours around the enriched dofs in the exact band solve.
 AMG_BAND_LAYERS = 3
+# Stop the AMG path's GMRES after a restart cycle whose residual, extrapolated
+# at its mean rate, would not reach KRYLOV_RTOL within AMG_MAX_ITERATIONS
+# (benchmarks/RESULTS.md, "auto solver choice (issue 7, session 4)").
+AMG_STALL_STOP = True
+# ... checked every STALL_CHECK iterations within the first restart cycle.
+STALL_CHECK = 20
 
 # SuperLU settings for K + K_contact, whose sparsity pattern is symmetric even
 # when the slip tangent's values are not: minimum degree on A^T + A in symmetric
@@ -118,12 +143,46 @@ def pyamg_available() -> bool:
     return importlib.util.find_spec("pyamg") is not None
 
 
-def choose(method: str, n_free: int, node_xy=None) -> str:
-    """The strategy "auto" stands for at this size and mesh."""
+def enriched_mask(free, node_xy) -> np.ndarray:
+    """Which free dofs are enriched (global dof from 2 * n_nodes on)."""
+    return np.asarray(free) >= 2 * node_xy.shape[0]
+
+
+def band_mask(K, seed, layers) -> np.ndarray:
+    """The dofs `seed` (bool) and their matrix neighbours up to `layers` deep."""
+    band = np.array(seed, dtype=bool)
+    if band.any() and layers > 0:
+        pattern = sp.csr_matrix(K, copy=True)
+        pattern.data = np.ones_like(pattern.data)
+        for _ in range(layers):
+            band |= (pattern @ band.astype(float)) > 0
+    return band
+
+
+def system_facts(K, free, node_xy) -> dict:
+    """What "auto" can know before the first solve: the free dofs, the share
+    of them that is enriched, and the share in the AMG band (enriched dofs and
+    AMG_BAND_LAYERS matrix neighbours)."""
+    n = K.shape[0]
+    enr = enriched_mask(free, node_xy)
+    band = band_mask(K, enr, AMG_BAND_LAYERS)
+    return {
+        "n_free": n,
+        "enriched_share": float(enr.sum()) / max(n, 1),
+        "band_share": float(band.sum()) / max(n, 1),
+    }
+
+
+def choose(method: str, n_free: int, node_xy=None, band_share: float = 0.0) -> str:
+    """The strategy "auto" stands for: "amg" from AUTO_AMG_MIN_DOFS free dofs
+    on meshes with cells up to AUTO_AMG_MAX_ASPECT : 1 whose AMG band (the
+    enriched dofs and AMG_BAND_LAYERS matrix neighbours, system_facts) holds
+    at most AUTO_AMG_MAX_BAND of the free dofs; "superlu" otherwise."""
     if method != "auto":
         return method
     if (
         n_free >= AUTO_AMG_MIN_DOFS
+        and band_share <= AUTO_AMG_MAX_BAND
         and node_xy is not None
         and cell_aspect_ratio(node_xy) <= AUTO_AMG_MAX_ASPECT
         and pyamg_available()
@@ -200,42 +259,81 @@ def lu_solve(A, b):
     return lu_factor(A)[1](b)
 
 
-def _gmres(A, b, M, restart, maxiter):
+class _Stalled(Exception):
+    pass
+
+
+def _projected(iterations, reduction):
+    """Iterations to reduce a residual by KRYLOV_RTOL at the mean rate per
+    iteration of `reduction` in `iterations` (inf if it did not fall)."""
+    if not reduction < 1.0:
+        return np.inf
+    return iterations * np.log(KRYLOV_RTOL) / np.log(max(reduction, 1e-300))
+
+
+def _gmres(A, b, M, restart, maxiter, give_up=False):
     """GMRES from zero until ||A x - b|| <= KRYLOV_RTOL ||b|| (the true
-    residual: scipy's test is on the preconditioned one, so GMRES is restarted
-    from its answer while the true residual is too large and iterations are
-    left); returns (x, converged, iterations)."""
+    residual: scipy's test is on the preconditioned one), one restart cycle
+    at a time, at most `maxiter` iterations.
+
+    With `give_up` (for a caller that has a fall-back), stop as soon as the
+    solve is projected not to converge within `maxiter`: in the first cycle,
+    every STALL_CHECK iterations, when the preconditioned residual's fall
+    since the first iteration, extrapolated at its mean rate, would not reach
+    KRYLOV_RTOL within `maxiter`; after each cycle, the same with the true
+    residual.  Returns (x, converged, iterations, residual ratio): the true
+    relative residual ||A x - b|| / ||b||, or after a stop within the first
+    cycle the preconditioned residual's fall (x is then not usable)."""
     from scipy.sparse.linalg import gmres
 
     count = [0]
+    first = []  # preconditioned residuals of the first cycle
 
-    def callback(_):
+    def callback(pr):
         count[0] += 1
+        if give_up and len(first) == count[0] - 1:
+            first.append(pr)
+            k = count[0]
+            if k % STALL_CHECK == 0 and k < maxiter:
+                ratio = pr / first[0] if first[0] > 0.0 else 0.0
+                if 1 + _projected(k - 1, ratio) > maxiter:
+                    first.append(ratio)
+                    raise _Stalled
 
     x = np.zeros_like(b)
-    target = KRYLOV_RTOL * np.linalg.norm(b)
+    norm_b = np.linalg.norm(b)
+    target = KRYLOV_RTOL * norm_b
     ok = False
+    rel = 1.0
     while count[0] < maxiter:
-        left = maxiter - count[0]
         before = count[0]
-        x, _ = gmres(
-            A,
-            b,
-            x0=x,
-            M=M,
-            rtol=KRYLOV_RTOL,
-            atol=0.0,
-            restart=min(restart, left),
-            maxiter=max(1, -(-left // restart)),
-            callback=callback,
-            callback_type="pr_norm",
-        )
+        try:
+            x, _ = gmres(
+                A,
+                b,
+                x0=x,
+                M=M,
+                rtol=KRYLOV_RTOL,
+                atol=0.0,
+                restart=min(restart, maxiter - before),
+                maxiter=1,
+                callback=callback,
+                callback_type="pr_norm",
+            )
+        except _Stalled:
+            return x, False, count[0], float(first[-1])
+        first.append(None)  # the first cycle is over
         if not np.all(np.isfinite(x)):
+            rel = np.inf
             break
-        ok = np.linalg.norm(A @ x - b) <= target
+        res = np.linalg.norm(A @ x - b)
+        rel = res / norm_b if norm_b > 0.0 else res
+        ok = res <= target
         if ok or count[0] == before:
             break
-    return x, bool(ok), count[0]
+        if give_up and count[0] < maxiter and _projected(count[0], rel) > maxiter:
+            break
+    return x, bool(ok), count[0], float(rel)
 
 
 def rigid_body_modes(xy: np.ndarray, component: np.ndarray) -> np.ndarray:
@@ -267,7 +365,10 @@ class LinearSolver:
         n = self.K.shape[0]
         self.free = np.arange(n) if free is None else np.asarray(free)
         self.node_xy = node_xy
-        self.method = choose(method, n, node_xy)
+        self.facts = {"n_free": n}
+        if method == "auto" and node_xy is not None and n >= AUTO_AMG_MIN_DOFS:
+            self.facts = system_facts(self.K, self.free, node_xy)
+        self.method = choose(method, n, node_xy, self.facts.get("band_share", 0.0))
         if self.method == "amg" and node_xy is None:
             raise ValueError("the AMG linear solver needs the node coordinates")
         self.stats = {
@@ -281,11 +382,34 @@ class LinearSolver:
             "refinements": 0,
             "fallbacks": 0,
             "fallback_time": 0.0,
+            "amg_fallbacks": 0,
+            "amg_fallback_time": 0.0,
         }
         self._lu = None  # (SuperLU object, checked solve, K_c it factors)
         self._amg = None  # V-cycle on the standard dofs
         self._bands = {}
-        logger.debug("linear solver: %s (%d free dofs)", self.method, n)
+        if "band_share" in self.facts:
+            logger.debug(
+                "linear solver: %s (auto: %d free dofs, %.1f %% enriched, "
+                "AMG band %.1f %% of them (AMG up to %.0f %%), cells up to "
+                "%.1f:1 (AMG up to %.0f:1))",
+                self.method,
+                n,
+                100.0 * self.facts["enriched_share"],
+                100.0 * self.facts["band_share"],
+                100.0 * AUTO_AMG_MAX_BAND,
+                cell_aspect_ratio(node_xy),
+                AUTO_AMG_MAX_ASPECT,
+            )
+        elif method == "auto":
+            logger.debug(
+                "linear solver: %s (auto: %d free dofs, AMG from %d)",
+                self.method,
+                n,
+                AUTO_AMG_MIN_DOFS,
+            )
+        else:
+            logger.debug("linear solver: %s (%d free dofs)", self.method, n)
 
     # ------------------------------------------------------------------ #
     def solve(self, Kc, r):
@@ -311,29 +435,27 @@ class LinearSolver:
         (without node coordinates: of the dofs the contact tangent touches)."""
         if layers not in self._bands:
             if self.node_xy is None:
-                band = np.diff(sp.csr_matrix(Kc).indptr) > 0
+                seed = np.diff(sp.csr_matrix(Kc).indptr) > 0
             else:
-                band = self.free >= 2 * self.node_xy.shape[0]
-            if band.any():
-                pattern = self.K.copy()
-                pattern.data = np.ones_like(pattern.data)
-                for _ in range(layers):
-                    band |= (pattern @ band.astype(float)) > 0
-            self._bands[layers] = np.nonzero(band)[0]
+                seed = enriched_mask(self.free, self.node_xy)
+            self._bands[layers] = np.nonzero(band_mask(self.K, seed, layers))[0]
         return self._bands[layers]
 
-    def _schwarz_gmres(self, A, r, coarse, band, cycles, restart, cap):
+    def _schwarz_gmres(self, A, r, coarse, band, cycles, restart, cap, give_up=False):
         """GMRES on A x = r, preconditioned by one multiplicative Schwarz sweep:
         `coarse` (an approximate inverse: the kept factorization, or the AMG
         V-cycle on the standard dofs), an exact LU solve on the dofs `band`
         with the current matrix, and (cycles == 2) `coarse` again.  None when
-        GMRES does not converge or the band matrix is singular."""
+        GMRES does not converge or the band matrix is singular (then
+        self._krylov_end holds the iterations and relative residual reached).
+        `give_up`: see _gmres."""
         from scipy.sparse.linalg import LinearOperator
 
         t = time.perf_counter()
         try:
             band_lu, _ = lu_factor(A[band][:, band], self.stats)
         except RuntimeError:  # singular band: let SuperLU judge the whole matrix
+            self._krylov_end = (0, np.inf)
             return None
         self.stats["factor_time"] += time.perf_counter() - t
 
@@ -345,8 +467,9 @@ class LinearSolver:
             return x
 
         M = LinearOperator(A.shape, matvec=sweep, dtype=float)
-        x, ok, its = _gmres(A, r, M, restart, cap)
+        x, ok, its, rel = _gmres(A, r, M, restart, cap, give_up)
         self.stats["krylov_iterations"] += its
+        self._krylov_end = (its, rel)
         logger.debug("linear solve: Schwarz-GMRES, %d iterations (%s)", its, ok)
         return x if ok else None
 
@@ -408,6 +531,7 @@ class LinearSolver:
     def _solve_amg(self, Kc, r):
         from scipy.sparse.linalg import LinearOperator, cg
 
+        start = time.perf_counter()
         if self._amg is None:
             self._setup_amg()
         A = (self.K + Kc).tocsr()
@@ -431,17 +555,36 @@ class LinearSolver:
             self.stats["krylov_iterations"] += count[0]
             if info == 0 and np.all(np.isfinite(x)):
                 return x
+            its = count[0]
+            rel = np.linalg.norm(A @ x - r) / max(np.linalg.norm(r), 1e-300)
         else:
             x = self._schwarz_gmres(
-                A, r, self._amg, band, 1, AMG_RESTART, AMG_MAX_ITERATIONS
+                A,
+                r,
+                self._amg,
+                band,
+                1,
+                AMG_RESTART,
+                AMG_MAX_ITERATIONS,
+                AMG_STALL_STOP,
             )
             if x is not None:
                 return x
-        logger.warning(
-            "AMG-preconditioned Krylov solve did not converge; SuperLU solves "
-            "this and the later systems of the run"
-        )
+            its, rel = self._krylov_end
+        # the time spent on AMG for this system (its set-up if it was the
+        # first, the band LU, the Krylov iterations) is lost
+        wasted = time.perf_counter() - start
         self.method = "superlu"
+        self.stats["amg_fallbacks"] += 1
+        self.stats["amg_fallback_time"] += wasted
+        logger.warning(
+            "AMG-preconditioned Krylov solve did not converge (%d iterations, "
+            "residual ratio %.1e, %.2f s lost); SuperLU solves this and the "
+            "later systems of the run",
+            its,
+            rel,
+            wasted,
+        )
         return self._factor(A.tocsc(), Kc)(r)
 
 
