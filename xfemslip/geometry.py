@@ -245,6 +245,12 @@ def _clip_to_domain(points, box, tol, key):
     s_offset = float(seg_len[: idx[0]].sum() + kept[idx[0]][2] * seg_len[idx[0]])
     # drop segments that became (nearly) zero length by clipping
     keep = np.concatenate([[True], np.linalg.norm(np.diff(pts, axis=0), axis=1) > tol])
+    if keep.sum() < 2:
+        raise GeometryError(
+            f"{key}: the fracture is shorter than the geometric tolerance "
+            f"({tol:.3g} m) inside the domain; give it a length of at least a "
+            "fraction of a cell"
+        )
     return pts[keep], s_offset
 
 

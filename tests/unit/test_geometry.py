@@ -225,6 +225,21 @@ def test_fracture_outside_the_domain_raises():
         _fracture([[1.2, 0.2], [1.6, 0.7]])
 
 
+@pytest.mark.parametrize(
+    "points",
+    [
+        pytest.param([[0.0, 0.0], [0.0, 2.3e-27]], id="corner-sliver"),  # fuzz find
+        pytest.param([[0.4, 0.4], [0.4 + 1e-12, 0.4]], id="interior"),
+        pytest.param([[-0.5, 1.0], [1e-13, 1.0]], id="clipped-to-a-point"),
+    ],
+)
+def test_fracture_below_the_tolerance_raises(points):
+    """Nonzero but below the geometric tolerance (the case reader refuses
+    only exact zero): a GeometryError naming the fracture, not an IndexError."""
+    with pytest.raises(GeometryError, match=r"fractures\[0\].*shorter than"):
+        _fracture(points)
+
+
 # ------------------------------------------------------------------------ pieces
 
 
