@@ -266,7 +266,10 @@ def main() -> int:
                 )
         rows = [dict(xfem_result(state), L=args.L, growth=args.growth,
                      radius=args.radius) for state in xfem]  # fmt: skip
-        rows += [dict(ogs_result(h, ogs[h]), L=args.L) for h in args.ogs_h]
+        rows += [
+            dict(ogs_result(h, ogs[h]), L=args.L, h_far=args.ogs_h_far)
+            for h in args.ogs_h
+        ]
         for row in rows:
             print(json.dumps(row), flush=True)
     if args.json:
@@ -275,17 +278,28 @@ def main() -> int:
     return 0
 
 
+def _mesh(r) -> str:
+    """How the run's mesh was graded (box edge L, growth / far-field size)."""
+    box = f"L {r.get('L', 20.0):g} m"
+    if r["code"] == "OGS":
+        return f"{box}, h_far {r.get('h_far', 1.0):g} m"
+    radius = r.get("radius")
+    tip = "auto radius" if radius is None else f"radius {radius:g} m"
+    return f"{box}, growth {r.get('growth', 1.3):g}, {tip}"
+
+
 def report(rows):
     """The two tables: every run, and the times at equal slip error."""
     print(
-        "| code | h on the crack [m] | dofs | Newton its | L2 slip error | "
+        "| code | mesh | h on the crack [m] | dofs | Newton its | L2 slip error | "
         "wall [s] | CPU [s] |"
     )
-    print("| --- | --- | --- | --- | --- | --- | --- |")
+    print("| --- | --- | --- | --- | --- | --- | --- | --- |")
     for r in rows:
         print(
-            f"| {r['code']} | {r['h']:g} | {r['dofs']:,} | {r['newton']} | "
-            f"{100 * r['err_L2']:.2f} % | {r['wall']:.2f} | {r['cpu']:.2f} |"
+            f"| {r['code']} | {_mesh(r)} | {r['h']:g} | {r['dofs']:,} | "
+            f"{r['newton']} | {100 * r['err_L2']:.3f} % | {r['wall']:.2f} | "
+            f"{r['cpu']:.2f} |"
         )
     xf = [r for r in rows if r["code"] == "xfemslip"]
     og = [r for r in rows if r["code"] == "OGS"]
