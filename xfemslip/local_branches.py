@@ -39,8 +39,9 @@ import scipy.sparse.linalg as spla
 from xfemslip.contact import SLIP
 
 # Largest cluster searched: 3**10 = 59049 combinations of 20 x 20 systems
-# (about 0.1 GB of work arrays, ~1 s).
+# (~1 s), solved CHUNK at a time (about 20 MB of work arrays per chunk).
 MAX_CLUSTER = 10
+CHUNK = 3**7
 
 
 def neighbours(c_dofs, K_ff, patches) -> np.ndarray:
@@ -95,10 +96,27 @@ def search(c, c_dofs, K_stick, u_free, res, r, idx):
     W = np.repeat(c.weight[idx], 2)
     p_now = np.column_stack([res.pn[idx], res.pt[idx]]).ravel()
     q0 = -G @ lu.solve(r - G.T @ (W * p_now))
-    kn, kt, f, coh = c.kn[idx], c.kt[idx], c.friction[idx], c.cohesion[idx]
-    gp, pn0 = c.slip_committed[idx], c.pn0[idx]
+    law = (c.kn[idx], c.kt[idx], c.friction[idx], c.cohesion[idx])
+    law += (c.slip_committed[idx], c.pn0[idx])
     combos = np.array(list(itertools.product((0, 1, -1), repeat=k)), np.int64)
-    n = combos.shape[0]
+    ok = np.zeros(combos.shape[0], bool)
+    size = np.full(combos.shape[0], np.inf)
+    for lo in range(0, combos.shape[0], CHUNK):
+        part = slice(lo, lo + CHUNK)
+        ok[part], size[part] = _check(combos[part], M * W[None, :], g, q0, law)
+    if not ok.any():
+        return None
+    # several consistent sets: the smallest move (on seed 1 of the refined
+    # DFN the other two moved the jumps by 1e8 m: near-singular systems of a
+    # cluster around a fragment of the body)
+    best = np.nonzero(ok)[0][np.argmin(size[ok])]
+    return combos[best]
+
+
+def _check(combos, MW, g, q0, law):
+    """(consistent, max |jump increment|) of each branch combination."""
+    kn, kt, f, coh, gp, pn0 = law
+    n, k = combos.shape
     A = np.zeros((n, 2 * k, 2 * k))
     a = np.zeros((n, 2 * k))
     Sd = np.zeros(2 * k)
@@ -112,14 +130,13 @@ def search(c, c_dofs, K_stick, u_free, res, r, idx):
         s = combos[~stick, j].astype(float)
         A[~stick, 2 * j + 1, 2 * j] = -s * f[j] * kn[j]
         a[~stick, 2 * j + 1] = s * (coh[j] - f[j] * pn0[j])
-    MW = M * W[None, :]
     lhs = np.eye(2 * k)[None] + MW[None] @ (A - np.diag(Sd)[None])
     rhs = q0[None] - (MW[None] @ ((A @ g) + a)[..., None])[..., 0]
     with np.errstate(all="ignore"):
         try:
             d = np.linalg.solve(lhs, rhs[..., None])[..., 0]
-        except np.linalg.LinAlgError:
-            return None
+        except np.linalg.LinAlgError:  # a singular combination in the chunk
+            d = np.stack([_solve_or_nan(L, b) for L, b in zip(lhs, rhs, strict=True)])
         gn, gt = (g + d)[:, 0::2], (g + d)[:, 1::2]
         pn = kn * gn + pn0
         trial = kt * (gt - gp)
@@ -130,15 +147,16 @@ def search(c, c_dofs, K_stick, u_free, res, r, idx):
             np.abs(trial) <= bound,
             (np.abs(trial) > bound) & (np.sign(trial) == combos),
         )
-    size = np.abs(d).max(axis=1)
-    # several consistent sets: the smallest move (on seed 1 of the refined
-    # DFN the other two moved the jumps by 1e8 m: near-singular systems of a
-    # cluster around a fragment of the body)
-    ok = ok.all(axis=1)
-    if not ok.any():
-        return None
-    best = np.nonzero(ok)[0][np.argmin(size[ok])]
-    return combos[best]
+        size = np.abs(d).max(axis=1)
+    return ok.all(axis=1), size
+
+
+def _solve_or_nan(L, b):
+    """L^-1 b, or NaN (never consistent) for a singular L."""
+    try:
+        return np.linalg.solve(L, b)
+    except np.linalg.LinAlgError:
+        return np.full(b.shape, np.nan)
 
 
 def current_branches(res, idx) -> np.ndarray:
