@@ -516,7 +516,9 @@ class NewtonSolver:
         c = self.p.contact
         near = local_branches.neighbours(self.c_dofs, self.K_ff, stubborn)
         first = np.nonzero(stubborn)[0]
-        rest = np.nonzero(near & ~stubborn)[0]
+        # open neighbours stay out: the search has no open branch, and its
+        # Woodbury form assumes a closed (stick) block for every member
+        rest = np.nonzero(near & ~stubborn & (res.state != OPEN))[0]
         idx = np.concatenate([first, rest])[: local_branches.MAX_CLUSTER]
         mask = np.zeros(c.n, bool)
         mask[idx] = True
