@@ -27,7 +27,7 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.sparse as sp
 
-from xfemslip import kernels
+from xfemslip import kernels, local_branches
 from xfemslip.assembly import coo_block
 from xfemslip.contact import OPEN, SLIP, STICK, ContactResult, ContactSet
 from xfemslip.errors import ConvergenceError
@@ -57,6 +57,12 @@ PINGPONG_PERIODS = 3
 # forever (seed 1, predictor off); 2 and 3 converge on all 20 seeds both
 # ways (benchmarks/RESULTS.md, "Newton on fracture networks").
 REVERSAL_HOLDS = 2
+# Local branch searches (xfemslip.local_branches) per Newton solve: a patch
+# that reverses its slip again after REVERSAL_HOLDS holds has no consistent
+# branch while its neighbours keep theirs (refined DFN realizations:
+# benchmarks/RESULTS.md, "Refined DFN realizations (session 4)"); the
+# stick/slip set of it and its neighbours is then searched.
+LOCAL_SEARCHES = 2
 # Load-step bisection: a load step that does not converge is cut in halves, at
 # most this many times by default ([solver] max_step_cuts), so the smallest
 # sub-step is 1/2**5 = 1/32 of the step.  Every converged sub-step commits the
@@ -107,6 +113,9 @@ class StepResult:
     # Newton steps re-solved with slip-reversing patches held in stick (each
     # one extra linear solve; NewtonSolver._reversals), all sub-steps
     reversals: int = 0
+    # local branch searches that found a consistent stick/slip set for a
+    # patch reversing after its holds and its neighbours (all sub-steps)
+    searches: int = 0
 
 
 def _regime(state, pt):
@@ -199,6 +208,7 @@ class NewtonSolver:
         units = 1 << self.max_cuts
         done, size = 0, units
         cuts = substeps = iterations = freezes = predicted = reversals = 0
+        searches = 0
         factors = []  # load factors of the converged sub-steps
         while done < units:
             end = min(done + size, units)
@@ -239,6 +249,7 @@ class NewtonSolver:
             freezes += log.freezes
             predicted += log.predicted
             reversals += log.reversals
+            searches += log.found
         if cuts:
             logger.info(
                 "step %d/%d converged in %d sub-steps after %d cut(s)",
@@ -262,6 +273,7 @@ class NewtonSolver:
                 factors=factors,
                 predicted=predicted,
                 reversals=reversals,
+                searches=searches,
             )
         )
         return u
@@ -298,6 +310,7 @@ class NewtonSolver:
         law = c  # the contact law evaluated: c, or c with frozen points
         frozen = None
         held = np.zeros(c.n, np.int64)  # times each patch was held (_reversals)
+        forced = False  # law forces the branches of a local search
         res = law.evaluate(u, self.mode, pt_prev, gt_prev)
         r, eta = self._residual(u, lam, res)
         for it in range(self.max_it + 1):
@@ -322,16 +335,17 @@ class NewtonSolver:
             )
             if not np.isfinite(eta):
                 raise self._fail(k, it, eta, flips, "the residual is not finite")
-            if eta <= self.tol and frozen is not None:
+            if eta <= self.tol and (frozen is not None or forced):
                 # converged with frozen points: restore the true law, go on
                 logger.info(
-                    "step %d/%d: converged with %d frozen point(s); "
+                    "step %d/%d: converged with %d frozen point(s)%s; "
                     "releasing them and checking the true contact law",
                     k,
                     steps,
-                    int(frozen.sum()),
+                    0 if frozen is None else int(frozen.sum()),
+                    " and searched branches" if forced else "",
                 )
-                law, frozen, history = c, None, []
+                law, frozen, forced, history = c, None, False, []
                 res = law.evaluate(u, self.mode, pt_prev, gt_prev)
                 r, eta = self._residual(u, lam, res)
                 regime = _regime(res.state, res.pt)
@@ -373,7 +387,34 @@ class NewtonSolver:
                 du = self._solve(guess[0], guess[1], k, it, eta)
             else:
                 du = self._solve(res, r, k, it, eta)
-                flipped = self._reversals(u, du, regime, law, pt_prev, gt_prev, held)
+                flipped, stubborn = self._reversals(
+                    u, du, regime, law, pt_prev, gt_prev, held
+                )
+                if (
+                    flipped is None
+                    and stubborn is not None
+                    and log.searches < LOCAL_SEARCHES
+                ):
+                    log.searches += 1
+                    searched = self._local_search(u, res, r, law, stubborn)
+                    if searched is not None:
+                        law, forced = searched, True
+                        log.found += 1
+                        logger.info(
+                            "step %d/%d iteration %d: the Newton step reverses "
+                            "the slip of %d contact patch(es) held %d times "
+                            "already; a consistent stick/slip set of them and "
+                            "their neighbours was found: solving with it",
+                            k,
+                            steps,
+                            it,
+                            int(stubborn.sum()),
+                            REVERSAL_HOLDS,
+                        )
+                        res = law.evaluate(u, self.mode, pt_prev, gt_prev)
+                        r, eta = self._residual(u, lam, res)
+                        regime = _regime(res.state, res.pt)
+                        du = self._solve(res, r, k, it, eta)
                 if flipped is not None:
                     held += flipped
                     frozen = flipped if frozen is None else (frozen | flipped)
@@ -448,12 +489,15 @@ class NewtonSolver:
         between the two slip branches passes through stick: those patches are
         held in stick (_frozen_law) until Newton converges, then the true law
         is restored and checked, as for ping-pong.  A patch is held at most
-        REVERSAL_HOLDS times per Newton solve (``held``, counts): if it keeps
-        reversing after the releases, the true law wants the other slip
-        direction there, and the step is taken.  Consistent tangent only.
+        REVERSAL_HOLDS times per Newton solve (``held``, counts).  Returns
+        (patches to hold, or None; patches that reverse again after their
+        holds, or None): for the latter the stick/slip set of them and their
+        neighbours is searched (_local_search; a patch with no consistent
+        branch of its own, refined DFN meshes); when the search finds nothing,
+        the step is taken.  Consistent tangent only.
         """
         if self.mode != kernels.TANGENT_CONSISTENT:
-            return None
+            return None, None
         trial = u.copy()
         trial[self.free] -= du
         res = law.evaluate(trial, self.mode, pt_prev, gt_prev)
@@ -461,8 +505,47 @@ class NewtonSolver:
         mask = ((regime == SLIP) & (new == SLIP + 1)) | (
             (regime == SLIP + 1) & (new == SLIP)
         )
+        stubborn = mask & (held >= REVERSAL_HOLDS)
         mask &= held < REVERSAL_HOLDS
-        return mask if mask.any() else None
+        return (mask if mask.any() else None), (stubborn if stubborn.any() else None)
+
+    def _local_search(self, u, res, r, law, stubborn):
+        """The law with the branches of ``stubborn`` and their neighbours
+        forced to a consistent local set (xfemslip.local_branches), or None
+        when the search finds none or only the current set."""
+        c = self.p.contact
+        near = local_branches.neighbours(self.c_dofs, self.K_ff, stubborn)
+        first = np.nonzero(stubborn)[0]
+        # open neighbours stay out: the search has no open branch, and its
+        # Woodbury form assumes a closed (stick) block for every member
+        rest = np.nonzero(near & ~stubborn & (res.state != OPEN))[0]
+        idx = np.concatenate([first, rest])[: local_branches.MAX_CLUSTER]
+        mask = np.zeros(c.n, bool)
+        mask[idx] = True
+        stick = _frozen_law(law, mask).evaluate(
+            u, self.mode, law.pt_committed, law.gt_committed
+        )
+        blocks = res.blocks.copy()
+        blocks[mask] = stick.blocks[mask]
+        K = self.K_ff + coo_block(self.c_dofs, blocks, self.free.size)
+        branches = local_branches.search(c, self.c_dofs, K, u[self.free], res, r, idx)
+        if branches is None:
+            logger.info("local branch search: no consistent stick/slip set")
+            return None
+        now = local_branches.current_branches(res, idx)
+        if np.array_equal(branches, now):
+            return None
+        logger.info(
+            "local branch search over %d patch(es): %d change branch",
+            idx.size,
+            int(np.count_nonzero(branches != now)),
+        )
+        # a patch of the cluster held in stick by _frozen_law gets its own
+        # cohesion back (a forced slip needs the finite bound)
+        base = dataclasses.replace(
+            law, cohesion=np.where(mask, c.cohesion, law.cohesion)
+        )
+        return _forced_law(base, idx, branches)
 
     def _line_search(self, u, du, lam, eta0, pt_prev, gt_prev, law=None):
         """Backtracking on eta along the Newton direction (Armijo on the norm).
@@ -587,6 +670,8 @@ class _NewtonLog:
     freezes: int = 0
     fallbacks: int = 0  # secant iterations replaced by a consistent one
     reversals: int = 0  # Newton steps that held reversing patches in stick
+    searches: int = 0  # local branch searches (xfemslip.local_branches)
+    found: int = 0  # of them, those that found a consistent set
     predicted: int = 0  # 1 if the first solve used the predicted set
     residuals: list = None
     switches: list = None
@@ -637,3 +722,18 @@ def _frozen_law(c: ContactSet, frozen) -> ContactSet:
     cohesion = c.cohesion.copy()
     cohesion[frozen] = math.inf
     return dataclasses.replace(c, cohesion=cohesion)
+
+
+def _forced_law(c: ContactSet, idx, branches) -> ContactSet:
+    """The contact set with the patches idx held on the branches ``branches``
+    (0 stick, +-1 slip forward / backward), as predictor.predicted_law does:
+    stick by an infinite cohesion, slip by a committed plastic slip of
+    -s * inf.  Never committed: the true law is restored and checked before a
+    step is accepted."""
+    cohesion, slip = c.cohesion.copy(), c.slip_committed.copy()
+    branches = np.asarray(branches)
+    st = idx[branches == 0]
+    sl = idx[branches != 0]
+    cohesion[st] = math.inf
+    slip[sl] = -branches[branches != 0] * math.inf
+    return dataclasses.replace(c, cohesion=cohesion, slip_committed=slip)
