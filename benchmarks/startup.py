@@ -1,8 +1,10 @@
 #!/usr/bin/env python3
 """Whole-process wall time of `xfemslip run` on a shipped case: first run after
-install (Numba compiles every kernel) and warm runs (kernels loaded from the
-on-disk cache).  Medians of several runs; results go to benchmarks/RESULTS.md
-by hand together with the machine they were measured on.
+install (empty Numba and bytecode caches: a case on the Numba kernels compiles
+them) and warm runs (caches filled).  Medians of several runs; results go to
+benchmarks/RESULTS.md by hand together with the machine they were measured on.
+`XFEMSLIP_KERNELS=numba python benchmarks/startup.py` forces the Numba kernels
+(a small case gets the NumPy ones: xfemslip.kernels.choose).
 
     python benchmarks/startup.py [--case cases/reservoir_depletion.toml] [--runs 5]
 
@@ -84,7 +86,7 @@ def main() -> int:
         warm_cpu = CPU[:]
     print(f"case {args.case}, {args.runs} runs each")
     print(
-        f"first run (JIT compile): median {statistics.median(cold):.2f} s "
+        f"first run (empty caches): median {statistics.median(cold):.2f} s "
         f"(min {min(cold):.2f}, max {max(cold):.2f})"
     )
     print(
