@@ -33,7 +33,7 @@ linear_solver``), each keeping what does not change:
   go to SuperLU.  The time lost on the AMG attempt is bounded: GMRES stops
   as soon as its residual, extrapolated at its mean rate, would not reach
   KRYLOV_RTOL within AMG_MAX_ITERATIONS (checked every STALL_CHECK
-  iterations of the first restart cycle and after each cycle), and the
+  iterations of the first scipy call, and after each call), and the
   attempt is logged (warning: iterations, seconds lost) and counted in
   stats["amg_fallbacks"], stats["amg_fallback_time"].
 - ``"auto"`` (default): ``"amg"`` from AUTO_AMG_MIN_DOFS free dofs up on
@@ -273,21 +273,24 @@ def _projected(iterations, reduction):
 
 def _gmres(A, b, M, restart, maxiter, give_up=False):
     """GMRES from zero until ||A x - b|| <= KRYLOV_RTOL ||b|| (the true
-    residual: scipy's test is on the preconditioned one), one restart cycle
-    at a time, at most `maxiter` iterations.
+    residual: scipy's test is on the preconditioned one), at most `maxiter`
+    iterations: one scipy call runs as many whole restart cycles as the cap
+    leaves, and is repeated from its answer while the true residual is too
+    large (scipy tightens its inner tolerance from cycle to cycle within a
+    call, so a call per cycle would cost iterations).
 
     With `give_up` (for a caller that has a fall-back), stop as soon as the
-    solve is projected not to converge within `maxiter`: in the first cycle,
-    every STALL_CHECK iterations, when the preconditioned residual's fall
-    since the first iteration, extrapolated at its mean rate, would not reach
-    KRYLOV_RTOL within `maxiter`; after each cycle, the same with the true
-    residual.  Returns (x, converged, iterations, residual ratio): the true
-    relative residual ||A x - b|| / ||b||, or after a stop within the first
-    cycle the preconditioned residual's fall (x is then not usable)."""
+    solve is projected not to converge within `maxiter`: during the first
+    call, every STALL_CHECK iterations, when the preconditioned residual's
+    fall since the first iteration, extrapolated at its mean rate, would not
+    reach KRYLOV_RTOL within `maxiter`; after each call, the same with the
+    true residual.  Returns (x, converged, iterations, residual ratio): the
+    true relative residual ||A x - b|| / ||b||, or after a stop within the
+    first call the preconditioned residual's fall (x is then not usable)."""
     from scipy.sparse.linalg import gmres
 
     count = [0]
-    first = []  # preconditioned residuals of the first cycle
+    first = []  # preconditioned residuals of the first call
 
     def callback(pr):
         count[0] += 1
@@ -315,14 +318,19 @@ def _gmres(A, b, M, restart, maxiter, give_up=False):
                 M=M,
                 rtol=KRYLOV_RTOL,
                 atol=0.0,
+                # as many whole cycles as the cap leaves, in one call: scipy
+                # tightens its inner (preconditioned) tolerance from one cycle
+                # to the next, which a call per cycle would reset (measured:
+                # 13 calls and 65 V-cycles instead of 1 and 41 on the
+                # 400 x 400 reservoir case, 5.9 against 4.1 s)
                 restart=min(restart, maxiter - before),
-                maxiter=1,
+                maxiter=max(1, (maxiter - before) // min(restart, maxiter - before)),
                 callback=callback,
                 callback_type="pr_norm",
             )
         except _Stalled:
             return x, False, count[0], float(first[-1])
-        first.append(None)  # the first cycle is over
+        first.append(None)  # the first call is over
         if not np.all(np.isfinite(x)):
             rel = np.inf
             break
