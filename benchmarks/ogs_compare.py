@@ -40,60 +40,16 @@ import tempfile
 import time
 from pathlib import Path
 
-import numpy as np
+from xfemslip import peer
 
 ROOT = Path(__file__).resolve().parents[1]
 OGS_PY = ROOT.parent / "ogs-venv/bin/python"
 OGS_SCRIPT = ROOT.parent / "shared/peers/ogs/ogs_lie_slip.py"
-A, E, NU, F, PSI = 1.0, 5.0e9, 0.3, 0.1, 45.0
-STRESS = (-20.0e6, -40.0e6, 0.0)
-
-
-def graded(h, fine=0.8, half=10.0, growth=1.3):
-    """Node coordinates: uniform h on [-fine, fine], then growing cells."""
-    n = max(1, round(2 * fine / h))
-    core = np.linspace(-fine, fine, n + 1)
-    outer = []
-    x, step = fine, core[1] - core[0]
-    while x < half - 1e-9:
-        step = step * growth
-        x = min(half, x + step)
-        if half - x < 0.5 * step:
-            x = half
-        outer.append(x)
-    outer = np.array(outer)
-    return np.concatenate([-outer[::-1], core, outer])
 
 
 def xfem_case(h, half=10.0, growth=1.3, radius=None) -> str:
-    x = graded(h, half=half, growth=growth)
-    t = (math.cos(math.radians(PSI)), math.sin(math.radians(PSI)))
-    coords = ", ".join(f"{v:.12g}" for v in x)
-    tip = (
-        "" if radius is None else f'\ntip = {{ kind = "branch", radius = {radius!r} }}'
-    )
-    return f"""name = "ogs-compare"
-[mesh]
-x = [{coords}]
-y = [{coords}]
-[material]
-E = {E!r}
-nu = {NU!r}
-model = "plane_strain"
-[[fractures]]
-points = [[{-A * t[0]!r}, {-A * t[1]!r}], [{A * t[0]!r}, {A * t[1]!r}]]
-friction = {F!r}
-cohesion = 0.0
-kn = 5.0e12
-kt = 5.0e12{tip}
-[loading]
-stress = {{ xx = {STRESS[0]!r}, yy = {STRESS[1]!r}, xy = 0.0 }}
-[boundary]
-bottom = {{ uy = 0.0, traction = true }}
-top = "traction"
-left = "traction"
-right = "traction"
-"""
+    """The peer problem as a case (xfemslip.peer.case_text)."""
+    return peer.case_text(h, half=half, growth=growth, radius=radius)
 
 
 def xfem_prepare(h, folder: Path, **box) -> dict:
@@ -126,16 +82,12 @@ def xfem_once(state) -> None:
 def xfem_result(state) -> dict:
     import h5py
 
-    from xfemslip.closed_form import relative_l2, slip_profile
-
     with h5py.File(state["out"] / "result.h5", "r") as f:
         s = f["fractures/0/s"][()]
         slip = f["fractures/0/slip"][()]
         dofs = int(f.attrs["n_dofs"])
         its = int(f.attrs["newton_iterations"])
-    exact = slip_profile(s, A, E, NU, "plane_strain", STRESS, PSI, F)
-    sign = np.sign(np.sum(slip * exact)) or 1.0
-    err = relative_l2(s, sign * slip, exact)
+    err = peer.slip_error(s, slip)
     return {
         "code": "xfemslip",
         "h": state["h"],

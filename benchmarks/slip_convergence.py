@@ -9,11 +9,11 @@ Usage (from the project root)::
     python benchmarks/slip_convergence.py exact --aoh 10 20 40
     python benchmarks/slip_convergence.py box --h 0.1 0.05 0.025 0.0125 [--element q4]
 
-The problem is that of ``benchmarks/ogs_compare.py`` (``xfem_case(h)``): a
+The problem is that of ``benchmarks/ogs_compare.py`` (``xfemslip.peer``): a
 crack of half-length a = 1 m at 45 degrees through the centre of a square box,
 remote stress (-20, -40, 0) MPa as edge tractions (bottom edge a roller),
 f = 0.1, c = 0, kn = kt = 5e12 Pa/m, E = 5 GPa, nu = 0.3, plane strain, one
-load step, on the rectilinear mesh ``ogs_compare.graded``: cells of size h on
+load step, on the rectilinear mesh ``peer.graded``: cells of size h on
 [-fine, fine]^2 growing by ``growth`` per cell to the box edges at +-half
 (ogs_compare: fine = 0.8, growth = 1.3; here half = 200 m unless varied, so
 the box error is negligible).  Error: relative L2 norm of slip - exact slip
@@ -46,15 +46,13 @@ from pathlib import Path
 
 import numpy as np
 
-sys.path.insert(0, str(Path(__file__).resolve().parent))
-import ogs_compare as oc  # noqa: E402
-
-from xfemslip import kernels  # noqa: E402
-from xfemslip import quadrature as Q  # noqa: E402
-from xfemslip.case import loads_case  # noqa: E402
-from xfemslip.closed_form import relative_l2, slip_profile  # noqa: E402
-from xfemslip.post import fracture_fields  # noqa: E402
-from xfemslip.simulation import build_model, newton_solver  # noqa: E402
+from xfemslip import kernels
+from xfemslip import peer as oc
+from xfemslip import quadrature as Q
+from xfemslip.case import loads_case
+from xfemslip.closed_form import relative_l2, slip_profile
+from xfemslip.post import fracture_fields
+from xfemslip.simulation import build_model, newton_solver
 
 HALF = 200.0  # [m] half-width of the box
 
@@ -71,23 +69,12 @@ def case_text(
     patch=None,
     aligned=False,
 ):
-    """ogs_compare.xfem_case(h) on the mesh graded(h, fine, half, growth), with
+    """xfemslip.peer.case_text on the mesh graded(h, fine, half, growth), with
     one option changed.  aligned: the crack at 0 degrees (off the mesh lines by
     (0.3 h, 0.37 h)) under the stress that gives it the same normal and shear
     traction as the 45-degree crack: (-30, -30, 10) MPa."""
-    x = oc.graded(h, fine=fine, half=half, growth=growth)
-    coords = ", ".join(f"{v:.12g}" for v in x)
-    txt = oc.xfem_case(h)
-    txt = re.sub(r"x = \[.*\]\ny = \[.*\]", f"x = [{coords}]\ny = [{coords}]", txt)
-    if radius is not None:
-        tip_line = f'tip = {{ kind = "branch", radius = {radius!r} }}\n'
-    elif tip is not None:
-        tip_line = f'tip = "{tip}"\n'
-    else:
-        tip_line = ""
-    txt = txt.replace("cohesion = 0.0\n", "cohesion = 0.0\n" + tip_line, 1)
-    txt = txt.replace("kn = 5.0e12", f"kn = {kn!r}").replace(
-        "kt = 5.0e12", f"kt = {kn!r}"
+    txt = oc.case_text(
+        h, half=half, fine=fine, growth=growth, radius=radius, tip=tip, kn=kn
     )
     if aligned:
         cx, cy = 0.3 * h, 0.37 * h
