@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import numpy as np
 
 from xfemslip.case import FractureSpec, loads_case
@@ -46,3 +48,23 @@ def fracture_spec(points, index=0, tip="ramp", friction=0.5) -> FractureSpec:
         tip=tip,
         tip_radius=None,
     )
+
+
+SHIPPED_DFN = Path(__file__).resolve().parents[2] / "cases/sweeps/dfn_realizations.toml"
+
+
+def sweep_member(path=SHIPPED_DFN, index=0, **keys) -> str:
+    """TOML text of case ``index`` of a sweep file as `xfemslip sweep` makes
+    it, with dotted key paths set on top (``**{"mesh.elements": [100, 100]}``):
+    the shipped DFN realizations at other sizes without a copy of the file."""
+    import tomllib
+
+    import tomli_w
+
+    from xfemslip.sweep import load_sweep, parse_key_path, set_key_path
+
+    document = tomllib.loads(load_sweep(path).cases[index].text)
+    for key, value in keys.items():
+        message = set_key_path(document, parse_key_path(key), value)
+        assert message is None, message
+    return tomli_w.dumps(document)

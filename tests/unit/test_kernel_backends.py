@@ -16,6 +16,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from casegen import sweep_member
 
 from xfemslip import kernels
 from xfemslip.case import load_case, loads_case
@@ -183,10 +184,7 @@ def test_shipped_reservoir_case_is_numpy_and_the_dfn_limit_is_numba(
         mesh, fractures = _geometry(spec)
         ec = build_enriched_cells(mesh, fractures, find_candidates(mesh, fractures))
         assert kernels.choose("auto", kernel_work(ec)) == "numpy", case
-    dfn = (ROOT / "cases/sweeps/dfn_realizations.toml").read_text()
-    dfn = dfn[dfn.index("[base]") :].replace("[base.", "[").replace("[base]\n", "")
-    dfn = dfn.replace("elements = [50, 50]", "elements = [200, 200]")
-    dfn = dfn.replace("count = 30", "count = 100")
+    dfn = sweep_member(**{"mesh.elements": [200, 200], "network.generate.count": 100})
     spec = loads_case(dfn, tmp_path / "dfn.toml")
     mesh, fractures = _geometry(spec)
     ec = build_enriched_cells(mesh, fractures, find_candidates(mesh, fractures))

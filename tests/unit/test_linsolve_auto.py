@@ -10,6 +10,7 @@ import numpy as np
 import pytest
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
+from casegen import sweep_member
 
 from xfemslip import linsolve
 from xfemslip.case import loads_case
@@ -78,33 +79,8 @@ def test_solver_weighs_the_band(monkeypatch):
     assert LinearSolver(K, "auto", free, xy).method == "superlu"
 
 
-NETWORK = """
-name = "network"
-[domain]
-size = [1.0, 1.0]
-[mesh]
-elements = [30, 30]
-[material]
-E = 5.0e9
-nu = 0.3
-[network]
-tip = "ramp"
-friction = 0.3
-[network.generate]
-seed = 1
-count = 30
-[[network.generate.sets]]
-weight = 1.0
-orientation = { distribution = "von_mises", mean = 30.0, kappa = 8.0 }
-length = { distribution = "power_law", exponent = 2.5, min = 0.12, max = 0.4 }
-[loading]
-stress = { xx = -20.0e6, yy = -40.0e6, xy = 0.0 }
-[boundary]
-bottom = { uy = 0.0 }
-top = "traction"
-left = "traction"
-right = "traction"
-"""
+# the shipped DFN sweep's seed-1 case (30 fractures) on 30 x 30 cells
+NETWORK = sweep_member(**{"mesh.elements": [30, 30]})
 
 
 def test_auto_picks_per_case_end_to_end(tmp_path, monkeypatch, caplog):

@@ -13,6 +13,7 @@ from __future__ import annotations
 from pathlib import Path
 
 import numpy as np
+from casegen import sweep_member
 
 from xfemslip.case import loads_case
 from xfemslip.contact import OPEN, SLIP
@@ -20,49 +21,9 @@ from xfemslip.simulation import build_model, newton_solver
 
 HERE = Path(__file__).resolve().parent
 
-SETS = """
-[[network.generate.sets]]
-weight = 0.6
-orientation = { distribution = "von_mises", mean = 30.0, kappa = 8.0 }
-length = { distribution = "power_law", exponent = 2.5, min = 0.12, max = 0.4 }
-
-[[network.generate.sets]]
-weight = 0.4
-orientation = { distribution = "normal", mean = 120.0, std = 10.0 }
-length = { distribution = "power_law", exponent = 2.5, min = 0.12, max = 0.4 }
-"""
-
-CASE = f"""
-name = "dfn-refined"
-[domain]
-size = [1.0, 1.0]
-[mesh]
-elements = [100, 100]
-[material]
-E = 5.0e9
-nu = 0.3
-[network]
-tip = "ramp"
-friction = 0.3
-cohesion = 0.0
-[network.generate]
-seed = 1
-count = 30
-intersections = "allow"
-outside = "reject"
-{SETS}
-[loading]
-stress = {{ xx = -20.0e6, yy = -40.0e6, xy = 0.0 }}
-steps = 1
-[boundary]
-bottom = {{ uy = 0.0 }}
-top = "traction"
-left = "traction"
-right = "traction"
-[solver]
-# a failure shows in one attempt (cuts repeat the same scaled problem)
-max_step_cuts = 0
-"""
+# the shipped sweep's seed-1 case, 100 x 100; a failure shows in one attempt
+# (cuts repeat the same scaled problem)
+CASE = sweep_member(**{"mesh.elements": [100, 100], "solver.max_step_cuts": 0})
 
 
 def test_refined_dfn_realization_converges_to_the_true_law():
