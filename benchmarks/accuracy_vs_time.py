@@ -36,7 +36,6 @@ from __future__ import annotations
 
 import argparse
 import math
-import os
 import statistics
 import subprocess
 import sys
@@ -46,6 +45,7 @@ from pathlib import Path
 
 import h5py
 import numpy as np
+from xfem_process import timed_run
 
 from xfemslip import closed_form as cf
 from xfemslip import verify as V
@@ -58,27 +58,7 @@ PENALTIES = (1.0, 1e1, 1e2, 1e3, 1e4, 1e5, 1e6)
 
 def whole_process(case: Path, out: Path) -> float:
     """Wall time of one ``xfemslip run`` process [s]."""
-    start = time.perf_counter()
-    proc = subprocess.run(
-        [
-            sys.executable,
-            "-m",
-            "xfemslip",
-            "run",
-            "-q",
-            "--overwrite",
-            str(case),
-            "-o",
-            str(out),
-        ],
-        capture_output=True,
-        text=True,
-        env=dict(os.environ),
-    )
-    wall = time.perf_counter() - start
-    if proc.returncode != 0:
-        sys.exit(f"xfemslip run failed: {proc.stderr.strip()[-400:]}")
-    return wall
+    return timed_run(case, out)[0]
 
 
 def measure_case(case: Path, prob, runs: int, processes: bool):

@@ -20,14 +20,9 @@ from __future__ import annotations
 import argparse
 import logging
 import statistics
-import sys
 import time
-from pathlib import Path
 
-ROOT = Path(__file__).resolve().parents[1]
-sys.path.insert(0, str(ROOT / "benchmarks"))
-
-from ogs_compare import xfem_case  # noqa: E402
+from xfemslip.peer import case_text as xfem_case
 
 
 def one(spec, method: str, stall_stop: bool) -> dict:

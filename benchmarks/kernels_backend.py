@@ -17,13 +17,12 @@ import argparse
 import json
 import os
 import re
-import resource
 import statistics
-import subprocess
 import sys
 import tempfile
-import time
 from pathlib import Path
+
+from xfem_process import timed_run
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -62,33 +61,6 @@ def with_backend(text: str, backend: str) -> str:
     return text + f'\n[solver]\nkernels = "{backend}"\n'
 
 
-def once(case: Path, out: Path, env) -> tuple[float, float]:
-    before = resource.getrusage(resource.RUSAGE_CHILDREN)
-    start = time.perf_counter()
-    proc = subprocess.run(
-        [
-            sys.executable,
-            "-m",
-            "xfemslip",
-            "run",
-            "-q",
-            "--overwrite",
-            str(case),
-            "-o",
-            str(out),
-        ],
-        env=env,
-        capture_output=True,
-        text=True,
-    )
-    wall = time.perf_counter() - start
-    after = resource.getrusage(resource.RUSAGE_CHILDREN)
-    if proc.returncode != 0:
-        sys.exit(f"{case}: exit {proc.returncode}: {proc.stderr[-400:]}")
-    cpu = after.ru_utime - before.ru_utime + after.ru_stime - before.ru_stime
-    return wall, cpu
-
-
 def work_of(case: Path) -> float:
     from xfemslip.case import load_case
     from xfemslip.enrichment import build_enriched_cells, find_candidates
@@ -122,11 +94,11 @@ def main() -> int:
             case = folder / f"{re.sub(r'[^a-z0-9]+', '_', name)}_{backend}.toml"
             case.write_text(with_backend(make(), backend))
             cases[backend] = case
-            once(case, folder / "out", env)  # warm the caches
+            timed_run(case, folder / "out", env)  # warm the caches
         times = {b: [] for b in cases}
         for _ in range(args.runs):
             for backend, case in cases.items():
-                times[backend].append(once(case, folder / "out", env))
+                times[backend].append(timed_run(case, folder / "out", env))
         row = {"case": name, "work": work_of(cases["numpy"])}
         for backend in cases:
             row[f"{backend}_wall"] = statistics.median(t[0] for t in times[backend])

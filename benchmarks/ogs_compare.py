@@ -32,13 +32,13 @@ import json
 import math
 import os
 import re
-import resource
 import statistics
 import subprocess
 import sys
 import tempfile
-import time
 from pathlib import Path
+
+from xfem_process import timed_run
 
 from xfemslip import peer
 
@@ -47,36 +47,24 @@ OGS_PY = ROOT.parent / "ogs-venv/bin/python"
 OGS_SCRIPT = ROOT.parent / "shared/peers/ogs/ogs_lie_slip.py"
 
 
-def xfem_case(h, half=10.0, growth=1.3, radius=None) -> str:
-    """The peer problem as a case (xfemslip.peer.case_text)."""
-    return peer.case_text(h, half=half, growth=growth, radius=radius)
-
-
 def xfem_prepare(h, folder: Path, **box) -> dict:
-    """Write the case and warm the caches; returns the state of its runs."""
+    """Write the case (xfemslip.peer.case_text; ``box``: half, growth,
+    radius) and warm the caches; returns the state of its runs."""
     case = folder / f"case_{h:g}.toml"
-    case.write_text(xfem_case(h, **box))
+    case.write_text(peer.case_text(h, **box))
     out = folder / f"out_{h:g}"
-    cmd = [sys.executable, "-m", "xfemslip", "run", "-q", "--overwrite", str(case)]
-    cmd += ["-o", str(out)]
     # Python's bytecode cached as an installed package has it (see
     # benchmarks/startup.py: PYTHONDONTWRITEBYTECODE=1 recompiles every run)
     env = dict(os.environ, PYTHONPYCACHEPREFIX=str(folder / "pycache"))
     env.pop("PYTHONDONTWRITEBYTECODE", None)
-    # warm the Numba and bytecode caches
-    subprocess.run(cmd, check=True, capture_output=True, env=env)
-    return {"h": h, "cmd": cmd, "env": env, "out": out, "walls": [], "cpus": []}
+    timed_run(case, out, env)  # warm the Numba and bytecode caches
+    return {"h": h, "case": case, "env": env, "out": out, "walls": [], "cpus": []}
 
 
 def xfem_once(state) -> None:
-    before = resource.getrusage(resource.RUSAGE_CHILDREN)
-    start = time.perf_counter()
-    subprocess.run(state["cmd"], check=True, capture_output=True, env=state["env"])
-    state["walls"].append(time.perf_counter() - start)
-    after = resource.getrusage(resource.RUSAGE_CHILDREN)
-    state["cpus"].append(
-        after.ru_utime - before.ru_utime + after.ru_stime - before.ru_stime
-    )
+    wall, cpu = timed_run(state["case"], state["out"], state["env"])
+    state["walls"].append(wall)
+    state["cpus"].append(cpu)
 
 
 def xfem_result(state) -> dict:

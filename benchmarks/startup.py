@@ -20,13 +20,12 @@ from __future__ import annotations
 
 import argparse
 import os
-import resource
 import statistics
-import subprocess
 import sys
 import tempfile
-import time
 from pathlib import Path
+
+from xfem_process import timed_run as run_process
 
 CPU: list[float] = []  # CPU time (user + system) of every timed run, in order
 
@@ -41,21 +40,8 @@ def timed_run(case: str, cache_dir: str, out: Path, tree: str | None = None) -> 
         PYTHONPYCACHEPREFIX=str(Path(cache_dir) / "pycache"),
     )
     env.pop("PYTHONDONTWRITEBYTECODE", None)
-    before = resource.getrusage(resource.RUSAGE_CHILDREN)
-    start = time.perf_counter()
-    proc = subprocess.run(
-        ["xfemslip", "run", "-q", "--overwrite", case, "-o", str(out)],
-        env=env,
-        capture_output=True,
-        text=True,
-    )
-    wall = time.perf_counter() - start
-    after = resource.getrusage(resource.RUSAGE_CHILDREN)
-    CPU.append(after.ru_utime - before.ru_utime + after.ru_stime - before.ru_stime)
-    if proc.returncode != 0:
-        sys.exit(
-            f"xfemslip run failed ({proc.returncode}): {proc.stderr.strip()[-500:]}"
-        )
+    wall, cpu = run_process(case, out, env, command=("xfemslip",))
+    CPU.append(cpu)
     return wall
 
 

@@ -162,7 +162,8 @@ def band_mask(K, seed, layers) -> np.ndarray:
 def system_facts(K, free, node_xy) -> dict:
     """What "auto" can know before the first solve: the free dofs, the share
     of them that is enriched, and the share in the AMG band (enriched dofs and
-    AMG_BAND_LAYERS matrix neighbours)."""
+    AMG_BAND_LAYERS matrix neighbours), with the band itself ("band", free-dof
+    indices) for the AMG path to keep."""
     n = K.shape[0]
     enr = enriched_mask(free, node_xy)
     band = band_mask(K, enr, AMG_BAND_LAYERS)
@@ -170,6 +171,7 @@ def system_facts(K, free, node_xy) -> dict:
         "n_free": n,
         "enriched_share": float(enr.sum()) / max(n, 1),
         "band_share": float(band.sum()) / max(n, 1),
+        "band": np.nonzero(band)[0],
     }
 
 
@@ -395,7 +397,10 @@ class LinearSolver:
         }
         self._lu = None  # (SuperLU object, checked solve, K_c it factors)
         self._amg = None  # V-cycle on the standard dofs
-        self._bands = {}
+        # the AMG band of "auto"'s facts is the one the AMG path solves on
+        self._bands = (
+            {AMG_BAND_LAYERS: self.facts["band"]} if "band" in self.facts else {}
+        )
         if "band_share" in self.facts:
             logger.debug(
                 "linear solver: %s (auto: %d free dofs, %.1f %% enriched, "

@@ -9,9 +9,10 @@ import numpy as np
 from xfemslip.case import FractureSpec, loads_case
 
 
-def fracture_case(points, tip="ramp", n=6, size=6.0):
+def fracture_case(points, tip="ramp", n=6, size=6.0, friction=0.5):
     """Square of side ``size`` on n x n cells, one fracture, bottom fixed,
-    top loaded by sigma = (-20, -40, 0) MPa; E = 10 GPa, nu = 0.3, f = 0.5."""
+    top loaded by sigma = (-20, -40, 0) MPa; E = 10 GPa, nu = 0.3, friction
+    f (default 0.5)."""
     return loads_case(f"""
 [domain]
 size = [{size!r}, {size!r}]
@@ -23,7 +24,7 @@ nu = 0.3
 model = "plane_strain"
 [[fractures]]
 points = {points!r}
-friction = 0.5
+friction = {friction!r}
 kn = 1.0e12
 kt = 1.0e12
 tip = "{tip}"

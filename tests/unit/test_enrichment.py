@@ -20,6 +20,7 @@ import scipy.sparse.linalg as spla
 from casegen import fracture_case
 
 from xfemslip import kernels
+from xfemslip.assembly import _enriched_matrices
 from xfemslip.case import loads_case
 from xfemslip.enrichment import ENRICHMENT_DIAG_RATIO, HEAVISIDE, find_candidates
 from xfemslip.simulation import build_model
@@ -141,17 +142,7 @@ def _enriched_diagonal(m):
     """Per candidate: its enriched stiffness diagonal (min over x, y) over the
     diagonal of its node's standard dofs, recomputed from the enriched cells."""
     ec = m.ec
-    K, _ = kernels.enriched_cell_matrices(
-        np.ascontiguousarray(m.mesh.bounds[ec.cells]),
-        ec.qp_offsets,
-        ec.qp_xy,
-        ec.qp_w,
-        ec.qp_F,
-        ec.qp_gradF,
-        ec.slot_node,
-        ec.slot_fnode,
-        m.D,
-    )
+    K, _ = _enriched_matrices(m.mesh, ec, m.D, None)
     cand = find_candidates(m.mesh, m.fractures)
     diag = np.zeros((cand.node.size, 2))
     for e in range(ec.cells.size):

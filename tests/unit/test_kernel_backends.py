@@ -19,6 +19,7 @@ import pytest
 from casegen import sweep_member
 
 from xfemslip import kernels
+from xfemslip.assembly import _enriched_matrices
 from xfemslip.case import load_case, loads_case
 from xfemslip.enrichment import build_enriched_cells, find_candidates
 from xfemslip.kernels import vectorized
@@ -46,23 +47,21 @@ def test_rectangle_stiffness_agrees():
     assert np.max(np.abs(got @ np.tile([1.0, 0.0], 4))) < 1e-6 * np.max(np.abs(got))
 
 
-def _enriched_inputs(text, folder):
+def _enriched_both(text, folder):
+    """(K, Bbar) of every enriched cell of a case, by each backend, through
+    the assembly's own call (assembly._enriched_matrices)."""
     spec = loads_case(text, folder / "case.toml")
     mesh, fractures = _geometry(spec)
-    cand = find_candidates(mesh, fractures)
-    ec = build_enriched_cells(mesh, fractures, cand)
+    ec = build_enriched_cells(mesh, fractures, find_candidates(mesh, fractures))
     D = elasticity_matrix(spec.material.E, spec.material.nu, spec.material.model)
-    return (
-        np.ascontiguousarray(mesh.bounds[ec.cells]),
-        ec.qp_offsets,
-        ec.qp_xy,
-        ec.qp_w,
-        ec.qp_F,
-        ec.qp_gradF,
-        ec.slot_node,
-        ec.slot_fnode,
-        D,
-    )
+    out = {}
+    for name in ("numba", "numpy"):
+        previous = kernels.use(name)
+        try:
+            out[name] = _enriched_matrices(mesh, ec, D, None)
+        finally:
+            kernels.use(previous)
+    return out["numba"], out["numpy"]
 
 
 @pytest.mark.parametrize(
@@ -75,9 +74,7 @@ def _enriched_inputs(text, folder):
 )
 def test_enriched_cell_matrices_agree(case, edit, tmp_path):
     text = (ROOT / "cases" / case).read_text().replace(*edit)
-    args = _enriched_inputs(text, tmp_path)
-    K0, B0 = NUMBA.enriched_cell_matrices(*args)
-    K1, B1 = vectorized.enriched_cell_matrices(*args)
+    (K0, B0), (K1, B1) = _enriched_both(text, tmp_path)
     assert K1.shape == K0.shape and B1.shape == B0.shape
     assert K0.shape[0] > 50  # the case has enriched cells to compare
     assert _rel(K1, K0) < 1e-13

@@ -17,6 +17,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from casegen import fracture_case
 
 from xfemslip import kernels
 from xfemslip.case import loads_case
@@ -135,40 +136,13 @@ def test_wrong_guess_costs_iterations_not_accuracy():
     assert _solves(wrong)[0] > _solves(right)[0] == 1
 
 
-def _clamped(points, friction, n=12):
-    """casegen.fracture_case with another friction coefficient."""
-    return loads_case(_CLAMPED.format(points=points, friction=friction, n=n))
-
-
-_CLAMPED = """
-[domain]
-size = [6.0, 6.0]
-[mesh]
-elements = [{n}, {n}]
-[material]
-E = 10.0e9
-nu = 0.3
-model = "plane_strain"
-[[fractures]]
-points = {points!r}
-friction = {friction!r}
-kn = 1.0e12
-kt = 1.0e12
-[loading]
-stress = {{ xx = -20.0e6, yy = -40.0e6, xy = 0.0 }}
-[boundary]
-bottom = {{ ux = 0.0, uy = 0.0 }}
-top = "traction"
-"""
-
-
 @pytest.mark.parametrize("points", [[[1.5, 1.5], [4.5, 4.8]], [[1.0, 0.6], [5.0, 4.5]]])
 def test_inclined_crack_near_a_clamped_edge(points):
     """Bottom edge clamped, sides free: the stress at the crack is not the
     far-field stress of the case file (sigma_xx is about 0, not -20 MPa), so
     the guess is an approximation; here it is right (the crack slips
     throughout) and the answer is unchanged."""
-    spec = _clamped(points, 0.3)
+    spec = fracture_case(points, tip="branch", n=12, friction=0.3)
     plain, model = _run(spec, False)
     guess, _ = _run(spec, True)
     _same_answer(plain, guess, model)

@@ -1,8 +1,8 @@
 """The kernels: loops over cells and contact points, in two backends.
 
-- ``"numba"``: bulk.py, contact.py, scatter.py, shape.py, compiled by Numba
-  (``cache=True``: once per install).  All Numba code of xfemslip lives in
-  this subpackage, and only here.
+- ``"numba"``: bulk.py, contact.py, scatter.py, shape.py (gathered in
+  jit.py), compiled by Numba (``cache=True``: once per install).  All Numba
+  code of xfemslip lives in this subpackage, and only here.
 - ``"numpy"``: vectorized.py, the same functions as whole-array NumPy code.
   It imports no Numba, so a small run skips Numba's import and its target
   set-up at the first dispatch (about 0.5 s of a 1 s warm run, and the 9 s of
@@ -52,35 +52,16 @@ AUTO_NUMPY_MAX_WORK = 2.5e8
 ENV_OVERRIDE = "XFEMSLIP_KERNELS"
 
 _active = "numba"
-
-
-class _Numba:
-    """The Numba kernels, imported on first use."""
-
-    def __getattr__(self, name):
-        if name not in KERNELS:
-            raise AttributeError(name)
-        module = {
-            "block_triplets": "scatter",
-            "contact_response": "contact",
-            "coulomb_return_map": "contact",
-            "enriched_cell_matrices": "bulk",
-            "rectangle_stiffness": "bulk",
-        }[name]
-        return getattr(importlib.import_module(f"xfemslip.kernels.{module}"), name)
-
-
-_NUMBA = _Numba()
+# each backend's namespace, imported on first use
+_MODULES = {"numba": "xfemslip.kernels.jit", "numpy": "xfemslip.kernels.vectorized"}
 
 
 def backend(name: str | None = None):
     """The kernel namespace of backend ``name`` (None: the active one)."""
     name = _active if name is None else name
-    if name == "numpy":
-        return importlib.import_module("xfemslip.kernels.vectorized")
-    if name == "numba":
-        return _NUMBA
-    raise ValueError(f"unknown kernel backend {name!r}; expected numba or numpy")
+    if name not in _MODULES:
+        raise ValueError(f"unknown kernel backend {name!r}; expected numba or numpy")
+    return importlib.import_module(_MODULES[name])
 
 
 def active() -> str:

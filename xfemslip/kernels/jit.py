@@ -1,0 +1,14 @@
+"""The Numba backend's namespace: the compiled kernels under the names the
+NumPy backend (vectorized.py) also has.  Importing it imports Numba."""
+
+from xfemslip.kernels.bulk import enriched_cell_matrices, rectangle_stiffness
+from xfemslip.kernels.contact import contact_response, coulomb_return_map
+from xfemslip.kernels.scatter import block_triplets
+
+__all__ = [
+    "block_triplets",
+    "contact_response",
+    "coulomb_return_map",
+    "enriched_cell_matrices",
+    "rectangle_stiffness",
+]
