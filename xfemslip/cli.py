@@ -125,13 +125,67 @@ def _reported_errors(debug: bool) -> Iterator[None]:
 
 def _load(case: Path):
     """Load and validate a case file (``CaseError`` on any problem)."""
+    from xfemslip.case import load_case, path_problem
+
+    problem = path_problem(case)
+    if problem:
+        raise UsageError(f"{_shown_path(case)}: the path {problem}")
     if not case.exists():
         raise UsageError(f"{case}: no such file")
     if case.is_dir():
         raise UsageError(f"{case}: is a directory, expected a case file (.toml)")
-    from xfemslip.case import load_case
-
     return load_case(case)
+
+
+def _shown_path(path) -> str:
+    """A path for a message: NUL bytes escaped, cut to 80 characters."""
+    text = repr(str(path))[1:-1]
+    return text if len(text) <= 80 else text[:77] + "..."
+
+
+def _checked_output(ctx, param, value):
+    """-o/--output: refuse a path no file system can hold before any work."""
+    from xfemslip.case import path_problem
+
+    problem = path_problem(value) if value is not None else None
+    if problem:
+        raise click.BadParameter(f"{_shown_path(value)}: {problem}")
+    return value
+
+
+class _OneLineUsageError(click.UsageError):
+    """A click usage error shown as one line ``Error: ...`` (no usage block),
+    like every other refusal of the CLI."""
+
+    def show(self, file=None) -> None:
+        hint = f" (see '{self.ctx.command_path} --help')" if self.ctx else ""
+        message = " ".join(self.format_message().split())
+        click.echo(f"Error: {message}{hint}", err=True)
+
+
+@contextlib.contextmanager
+def _one_line_usage() -> Iterator[None]:
+    """Re-raise click's usage errors (bad options, arguments) as one line."""
+    try:
+        yield
+    except _OneLineUsageError:
+        raise
+    except getattr(click.exceptions, "NoArgsIsHelpError", ()):
+        raise  # `xfemslip` alone prints the help
+    except click.UsageError as err:
+        raise _OneLineUsageError(err.format_message(), err.ctx) from None
+
+
+class _Group(click.Group):
+    """The command group; its usage errors and its subcommands' are one line."""
+
+    def make_context(self, info_name, args, parent=None, **extra):
+        with _one_line_usage():
+            return super().make_context(info_name, args, parent, **extra)
+
+    def invoke(self, ctx):
+        with _one_line_usage():
+            return super().invoke(ctx)
 
 
 _debug_option = click.option(
@@ -140,10 +194,14 @@ _debug_option = click.option(
 _case_argument = click.argument("case", type=click.Path(path_type=Path))
 
 
-@click.group(context_settings={"help_option_names": ["-h", "--help"]})
+@click.group(cls=_Group, context_settings={"help_option_names": ["-h", "--help"]})
 @click.version_option(__version__, prog_name="xfemslip")
 def cli() -> None:
     """XFEM frictional contact on 2D fractures, driven by TOML case files."""
+    from xfemslip.cli_env import check_environment
+
+    with _reported_errors(debug=False):
+        check_environment()
 
 
 def _solve_options(command):
@@ -157,6 +215,7 @@ def _solve_options(command):
                 "output",
                 type=click.Path(file_okay=False, path_type=Path),
                 default=None,
+                callback=_checked_output,
                 help="Output directory [default: output.directory of the case, "
                 "else out/<name>].",
             ),

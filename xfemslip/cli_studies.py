@@ -16,12 +16,15 @@ from pathlib import Path
 
 import click
 
+from xfemslip.case_files import path_problem
 from xfemslip.cli import (
     EXIT_FAILURE,
+    _checked_output,
     _configure_logging,
     _debug_option,
     _load,
     _reported_errors,
+    _shown_path,
 )
 from xfemslip.errors import UsageError
 
@@ -40,6 +43,7 @@ KINDS = ("displacement", "principal_stress", "deformed_mesh", "slip", "mohr")
     "--output",
     type=click.Path(file_okay=False, path_type=Path),
     default=None,
+    callback=_checked_output,
     help="Sweep folder [default: output.directory of the sweep, else "
     "out/sweeps/<name>].",
 )
@@ -70,6 +74,9 @@ def sweep(sweep_file, output, jobs, scheduler, force, verbose, debug) -> None:
     """
     with _reported_errors(debug):
         _configure_logging(verbose, not verbose)
+        problem = path_problem(sweep_file)
+        if problem:
+            raise UsageError(f"{_shown_path(sweep_file)}: the path {problem}")
         if not sweep_file.is_file():
             raise UsageError(f"{sweep_file}: no such file")
         from xfemslip.sweep import load_sweep
