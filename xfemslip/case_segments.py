@@ -52,12 +52,17 @@ def _csv_header(line: str | None, file: Path) -> tuple[list[str], list[str]]:
     columns = [c.strip().lower() for c in line.split(",")]
     allowed = SEGMENT_COLUMNS + OPTIONAL_COLUMNS
     unknown = [c for c in columns if c not in allowed]
-    bad = [
-        f"{file} line 1: unknown column {_quote(c)}{_suggest(c, allowed)}"
-        for c in unknown[:MAX_CSV_PROBLEMS]
-    ]
     if len(unknown) > MAX_CSV_PROBLEMS:
-        bad.append(f"{file} line 1: {len(unknown)} unknown columns in all")
+        first = ", ".join(_quote(c) for c in unknown[:3])
+        bad = [
+            f"{file} line 1: {len(unknown)} unknown columns ({first}, ...); "
+            "allowed: " + ", ".join(allowed)
+        ]
+    else:
+        bad = [
+            f"{file} line 1: unknown column {_quote(c)}{_suggest(c, allowed)}"
+            for c in unknown
+        ]
     counts = Counter(c for c in columns if c in allowed)
     bad += [
         f"{file} line 1: column {c!r} appears twice"
