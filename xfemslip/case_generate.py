@@ -133,12 +133,15 @@ def _drawable(table: _Table, law: dfn.LengthLaw) -> dfn.LengthLaw | None:
     out finite and in [min, max]; values such as min = 1e-300 with exponent
     2.5 overflow (min**(1 - exponent) = 1e450)."""
     try:
-        mean = dfn.mean_length(law)
-        ends = (
-            dfn.power_law_ppf(np.array([0.0, 1.0]), law.exponent, law.lmin, law.lmax)
-            if law.kind == "power_law"
-            else np.array([mean, mean])
-        )
+        with np.errstate(all="ignore"):  # an overflow is the answer, not a warning
+            mean = dfn.mean_length(law)
+            ends = (
+                dfn.power_law_ppf(
+                    np.array([0.0, 1.0]), law.exponent, law.lmin, law.lmax
+                )
+                if law.kind == "power_law"
+                else np.array([mean, mean])
+            )
     except (OverflowError, ZeroDivisionError, ValueError):
         mean, ends = math.nan, np.array([math.nan, math.nan])
     lo = law.lmin if law.lmin is not None else 0.0

@@ -24,6 +24,7 @@ from __future__ import annotations
 
 import contextlib
 import logging
+import math
 import platform
 import sys
 import traceback
@@ -33,6 +34,7 @@ from pathlib import Path
 import click
 
 from xfemslip import __version__
+from xfemslip.case_files import path_problem
 from xfemslip.errors import (
     CaseError,
     GeometryError,
@@ -125,7 +127,7 @@ def _reported_errors(debug: bool) -> Iterator[None]:
 
 def _load(case: Path):
     """Load and validate a case file (``CaseError`` on any problem)."""
-    from xfemslip.case import load_case, path_problem
+    from xfemslip.case import load_case
 
     problem = path_problem(case)
     if problem:
@@ -143,13 +145,50 @@ def _shown_path(path) -> str:
     return text if len(text) <= 80 else text[:77] + "..."
 
 
-def _checked_output(ctx, param, value):
-    """-o/--output: refuse a path no file system can hold before any work."""
-    from xfemslip.case import path_problem
+class _Path(click.Path):
+    """``click.Path`` that refuses a path no file system can hold (a NUL byte,
+    which click's own ``os.stat`` turns into a ValueError; a name over 255
+    bytes) and, with ``empty_ok=False``, an empty path (``-o ""`` would write
+    into the current folder)."""
 
-    problem = path_problem(value) if value is not None else None
-    if problem:
-        raise click.BadParameter(f"{_shown_path(value)}: {problem}")
+    def __init__(self, *args, empty_ok: bool = True, **kwargs):
+        super().__init__(*args, **kwargs)
+        self.empty_ok = empty_ok
+
+    def convert(self, value, param, ctx):
+        if isinstance(value, str):
+            if not value and not self.empty_ok:
+                self.fail("the path is empty", param, ctx)
+            problem = path_problem(value)
+            if problem:
+                self.fail(f"{_shown_path(value)}: {problem}", param, ctx)
+        return super().convert(value, param, ctx)
+
+
+class _FiniteFloat(click.FloatRange):
+    """``click.FloatRange`` without NaN and infinities (``float("nan")``
+    passes every range test)."""
+
+    def convert(self, value, param, ctx):
+        number = super().convert(value, param, ctx)
+        if not math.isfinite(number):
+            self.fail(f"{number!r} is not a finite number", param, ctx)
+        return number
+
+
+def _figure_path(ctx, param, value):
+    """A figure file whose suffix matplotlib can write (checked before any
+    work; matplotlib is imported only when a figure is asked for)."""
+    if value is None:
+        return value
+    from matplotlib.backend_bases import FigureCanvasBase
+
+    known = FigureCanvasBase.get_supported_filetypes()
+    if value.suffix.lstrip(".").lower() not in known:
+        raise click.BadParameter(
+            f"{_shown_path(value)}: the suffix must be one of "
+            + ", ".join(f".{k}" for k in sorted(known))
+        )
     return value
 
 
@@ -191,7 +230,7 @@ class _Group(click.Group):
 _debug_option = click.option(
     "--debug", is_flag=True, help="Show the traceback of a reported error."
 )
-_case_argument = click.argument("case", type=click.Path(path_type=Path))
+_case_argument = click.argument("case", type=_Path(path_type=Path))
 
 
 @click.group(cls=_Group, context_settings={"help_option_names": ["-h", "--help"]})
@@ -213,9 +252,8 @@ def _solve_options(command):
                 "-o",
                 "--output",
                 "output",
-                type=click.Path(file_okay=False, path_type=Path),
+                type=_Path(file_okay=False, path_type=Path, empty_ok=False),
                 default=None,
-                callback=_checked_output,
                 help="Output directory [default: output.directory of the case, "
                 "else out/<name>].",
             ),
@@ -315,13 +353,14 @@ def info() -> None:
 )
 @click.option(
     "--plot",
-    type=click.Path(dir_okay=False, path_type=Path),
+    type=_Path(dir_okay=False, path_type=Path, empty_ok=False),
+    callback=_figure_path,
     help="Write error vs h and error vs wall time (.png or .pdf).",
 )
 @click.option(
     "--csv",
     "csv_path",
-    type=click.Path(dir_okay=False, path_type=Path),
+    type=_Path(dir_okay=False, path_type=Path, empty_ok=False),
     help="Write the table as CSV.",
 )
 @click.option(

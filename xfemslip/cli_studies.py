@@ -19,15 +19,18 @@ import click
 from xfemslip.case_files import path_problem
 from xfemslip.cli import (
     EXIT_FAILURE,
-    _checked_output,
     _configure_logging,
     _debug_option,
+    _FiniteFloat,
     _load,
+    _Path,
     _reported_errors,
     _shown_path,
 )
 from xfemslip.errors import UsageError
 
+# A figure of a few inches at this resolution is already ~100 megapixels.
+MAX_DPI = 2400.0
 KINDS = ("displacement", "principal_stress", "deformed_mesh", "slip", "mohr")
 
 
@@ -37,13 +40,12 @@ KINDS = ("displacement", "principal_stress", "deformed_mesh", "slip", "mohr")
 
 
 @click.command()
-@click.argument("sweep_file", metavar="SWEEP", type=click.Path(path_type=Path))
+@click.argument("sweep_file", metavar="SWEEP", type=_Path(path_type=Path))
 @click.option(
     "-o",
     "--output",
-    type=click.Path(file_okay=False, path_type=Path),
+    type=_Path(file_okay=False, path_type=Path, empty_ok=False),
     default=None,
-    callback=_checked_output,
     help="Sweep folder [default: output.directory of the sweep, else "
     "out/sweeps/<name>].",
 )
@@ -141,11 +143,11 @@ def _default_figure_dir(results: list[Path]) -> Path:
 
 
 @click.command()
-@click.argument("results", nargs=-1, required=True, type=click.Path(path_type=Path))
+@click.argument("results", nargs=-1, required=True, type=_Path(path_type=Path))
 @click.option(
     "-o",
     "--output",
-    type=click.Path(file_okay=False, path_type=Path),
+    type=_Path(file_okay=False, path_type=Path, empty_ok=False),
     default=None,
     help="Folder for the figures [default: <result folder>/figures, or the "
     "results' common folder /figures].",
@@ -172,13 +174,13 @@ def _default_figure_dir(results: list[Path]) -> Path:
 )
 @click.option(
     "--scale",
-    type=click.FloatRange(min=0.0, min_open=True),
+    type=_FiniteFloat(min=0.0, min_open=True),
     default=None,
     help="Displacement magnification of the deformed mesh [default: auto].",
 )
 @click.option(
     "--dpi",
-    type=click.FloatRange(min=10.0),
+    type=_FiniteFloat(min=10.0, max=MAX_DPI),
     default=110.0,
     show_default=True,
     help="Resolution of the PNG files.",
@@ -218,11 +220,11 @@ def plot_run(out_dir: Path) -> None:
 
 
 @click.command()
-@click.argument("case", required=False, type=click.Path(path_type=Path))
+@click.argument("case", required=False, type=_Path(path_type=Path))
 @click.option(
     "--stress",
     nargs=3,
-    type=float,
+    type=_FiniteFloat(),
     default=None,
     metavar="XX YY XY",
     help="Total far-field stress [Pa], tension positive "
@@ -231,7 +233,7 @@ def plot_run(out_dir: Path) -> None:
 @click.option(
     "-p",
     "--pore-pressure",
-    type=float,
+    type=_FiniteFloat(),
     default=None,
     help="Pore pressure p [Pa]; effective stress = stress + p I "
     "[default: the final far-field pore pressure of CASE's [pore_pressure], "
@@ -239,13 +241,13 @@ def plot_run(out_dir: Path) -> None:
 )
 @click.option(
     "--friction",
-    type=click.FloatRange(min=0.0),
+    type=_FiniteFloat(min=0.0),
     default=None,
     help="Friction coefficient f [default: the first fracture's].",
 )
 @click.option(
     "--cohesion",
-    type=click.FloatRange(min=0.0),
+    type=_FiniteFloat(min=0.0),
     default=None,
     help="Cohesion c [Pa] [default: the first fracture's, else 0].",
 )
@@ -253,13 +255,13 @@ def plot_run(out_dir: Path) -> None:
     "--angle",
     "angles",
     multiple=True,
-    type=float,
+    type=_FiniteFloat(),
     help="A fracture angle to screen [deg, CCW from +x] (repeatable) "
     "[default: the fractures of CASE].",
 )
 @click.option(
     "--step",
-    type=click.FloatRange(min=0.1, max=90.0),
+    type=_FiniteFloat(min=0.1, max=90.0),
     default=5.0,
     show_default=True,
     help="Angle step of the orientation table [deg].",
@@ -267,14 +269,14 @@ def plot_run(out_dir: Path) -> None:
 @click.option(
     "--csv",
     "csv_path",
-    type=click.Path(dir_okay=False, path_type=Path),
+    type=_Path(dir_okay=False, path_type=Path, empty_ok=False),
     default=None,
     help="Also write the orientation table as CSV.",
 )
 @click.option(
     "--plot",
     "plot_dir",
-    type=click.Path(file_okay=False, path_type=Path),
+    type=_Path(file_okay=False, path_type=Path, empty_ok=False),
     default=None,
     help="Also draw the Mohr diagram into this folder.",
 )

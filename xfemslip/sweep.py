@@ -73,6 +73,9 @@ __all__ = [
 SWEEP_KEYS = ("name", "base", "combine", "vary", "output")
 COMBINE = ("product", "zip")
 MAX_PROBLEMS = 20  # invalid generated cases listed in one message
+# Bytes of a case id (ASCII) and of the base name in a case's name: together
+# below the 255 bytes of a folder name.
+MAX_CASE_ID = 100
 # A generous bound on cases x base-case size: a 2 kB base allows far more
 # than MAX_CASES cases; a 1 MB base (thousands of inline fractures) 256.
 MAX_SWEEP_TEXT_BYTES = 256e6
@@ -119,13 +122,14 @@ def _slug(value) -> str:
 
 
 def case_id(index: int, n_cases: int, params) -> str:
-    """Folder name of a case: ``002_angle=45``: index, then each key's last name."""
+    """Folder name of a case: ``002_angle=45``: index, then each key's last
+    name, cut to MAX_CASE_ID characters (the index first keeps it unique)."""
     width = max(3, len(str(n_cases - 1)))
     parts = [f"{index:0{width}d}"]
     for key, value in params:
         name = re.sub(r"\[\d+\]", "", key.rsplit(".", 1)[-1])
         parts.append(f"{name}={_slug(value)}")
-    return "_".join(parts)
+    return "_".join(parts)[:MAX_CASE_ID].rstrip("_")
 
 
 def _combinations(vary: list, combine: str) -> list[tuple[tuple[str, object], ...]]:
@@ -147,7 +151,8 @@ def _build_case(base: dict, base_name: str, index: int, n: int, params, path: Pa
         message = set_key_path(document, parse_key_path(key), value)
         if message:
             problems.append((f'vary."{key}"', message))
-    document["name"] = f"{base_name}-{cid}"
+    short = str(base_name).encode("utf-8")[:MAX_CASE_ID].decode("utf-8", "ignore")
+    document["name"] = f"{short}-{cid}"
     output = document.get("output")
     if isinstance(output, dict):
         output.pop("directory", None)  # the sweep chooses the folder
