@@ -24,6 +24,7 @@ from xfemslip.case_csv import (
 from xfemslip.case_grid import _Grid
 from xfemslip.case_polyline import _segment_meets_box, _self_intersection
 from xfemslip.case_tables import (
+    _COORDINATE,
     _NON_NEGATIVE,
     _POSITIVE,
     _exact,
@@ -92,7 +93,8 @@ def _csv_cell(name: str, text: str) -> tuple[object, str | None]:
         return None, f"{name} is not a number: {_quote(text)}"
     if not math.isfinite(value):
         return None, f"{name} must be finite, got {_quote(text)}"
-    message = _range_problem(value, PROPERTY_RULES.get(name), name)
+    rule = _COORDINATE if name in SEGMENT_COLUMNS else PROPERTY_RULES.get(name)
+    message = _range_problem(value, rule, name)
     return value, (f"{name} {message}" if message else None)
 
 

@@ -41,6 +41,10 @@ MAX_SUGGESTIONS = 20  # unknown keys of one table that get a 'did you mean'
 
 _POSITIVE = Range(0.0, lo_open=True)
 _NON_NEGATIVE = Range(0.0)
+# |x|, |y| of every point of a case [m]: the geometry squares distances, which
+# must stay finite (1e150**2 = 1e300); a kilometre-scale model is at 1e3.
+MAX_COORDINATE = 1e150
+_COORDINATE = Range(-MAX_COORDINATE, MAX_COORDINATE)
 
 
 # --------------------------------------------------------------------------- #

@@ -444,7 +444,8 @@ def test_p21_count_is_p21_times_area_over_the_mean_length(tmp_path):
         (
             "seed = 3",
             "seed = 3\nregion = [[-1e308, 0.0], [1e308, 1.0]]",
-            "network.generate.region: width x height overflows the float range",
+            "network.generate.region: expected [[x0, y0], [x1, y1]] (lower-left and "
+            "upper-right corners, m, within +-1e+150), got array of 2 items",
         ),
     ],
     ids=["p21-1e308", "p20-1e308", "power-law-min-1e-300", "lognormal-1e308", "region"],
