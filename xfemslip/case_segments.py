@@ -128,6 +128,27 @@ def _csv_rows(lines: list[str], columns: list[str], file: Path):
     return rows, bad
 
 
+def _fracture_count(lines: list[str], columns: list[str]) -> int:
+    """Fractures of the file from its ``fracture`` column alone (a row without
+    an id is a fracture of its own), counted before any number is read."""
+    rows = (
+        line.split(",")
+        for line in lines[1:]
+        if line.strip() and not line.lstrip().startswith("#")
+    )
+    if "fracture" not in columns:
+        return sum(1 for _ in rows)
+    at = columns.index("fracture")
+    ids, single = set(), 0
+    for fields in rows:
+        fid = fields[at].strip() if at < len(fields) else ""
+        if fid:
+            ids.add(fid)
+        else:
+            single += 1
+    return len(ids) + single
+
+
 def _group_rows(rows: list) -> list[tuple[str, list]]:
     """Rows grouped by the ``fracture`` column in order of first appearance; a
     row without a fracture id is a fracture of its own."""
@@ -204,17 +225,16 @@ def _read_segments_file(
     if bad:
         _add_capped(table.problems, key, bad)
         return None
+    count = _fracture_count(lines, columns)
+    if count > MAX_NETWORK_FRACTURES:  # before a number is read
+        table.error(
+            "file", f"{file}: {count} fractures, more than {MAX_NETWORK_FRACTURES}"
+        )
+        return None
     rows, bad = _csv_rows(lines, columns, file)
     tol = CSV_TOLERANCE * max(grid.size) if grid is not None else 0.0
-    groups = _group_rows(rows)
-    if len(groups) > MAX_NETWORK_FRACTURES:  # before any per-fracture work
-        bad.insert(
-            0, f"{file}: {len(groups)} fractures, more than {MAX_NETWORK_FRACTURES}"
-        )
-        _add_capped(table.problems, key, bad)
-        return None
     out = []
-    for fid, group in groups:
+    for fid, group in _group_rows(rows):
         points, chain_bad = _chain(group, fid, file, tol)
         props, prop_bad = _group_properties(group, fid, file, defaults)
         bad += chain_bad + prop_bad

@@ -354,7 +354,6 @@ def info() -> None:
 @click.option(
     "--plot",
     type=_Path(dir_okay=False, path_type=Path, empty_ok=False),
-    callback=_figure_path,
     help="Write error vs h and error vs wall time (.png or .pdf).",
 )
 @click.option(

@@ -666,6 +666,10 @@ def network_csv_inputs() -> list[Input]:
         "nan": (header + "\na,nan,0.3,0.5,0.5", {2}),
         "negative-friction": ("x0,y0,x1,y1,friction\n0.2,0.3,0.5,0.5,-1", {2}),
         "6000-fractures": (many, {2}),
+        "600k-fractures-28MB": (
+            lambda: "x0,y0,x1,y1\n" + "0.1,0.5,0.2,0.5\n" * 600_000,
+            {2},
+        ),
         "long-fracture-id": (
             header + "\n" + "f" * 100_000 + ",0.2,0.3,0.5,0.5",
             {0, 1},
@@ -1367,6 +1371,12 @@ def size_inputs() -> list[Input]:
     return out
 
 
+# A run of these takes seconds once the geometry is simplified below the mesh
+# resolution; walked point by point it takes minutes.  The bound leaves room
+# for a loaded machine.
+SHAPE_TIMEOUT = 60.0
+
+
 def shape_inputs() -> list[Input]:
     """Geometry with many vertices: it must be simplified (with a warning),
     refused or run -- within the time bound, not walked point by point."""
@@ -1398,8 +1408,33 @@ def shape_inputs() -> list[Input]:
                 files={"case.toml": toml(doc)},
                 argv=(*RUN, "case.toml", "-o", OUT),
                 expect=frozenset({0, 1, 2}),
+                timeout=SHAPE_TIMEOUT,
             )
         )
+
+    def trace(n):  # a digitised fault trace: one fracture of n segments
+        p = [
+            (0.1 + 0.8 * i / n, 0.5 + 0.01 * math.sin(40 * i / n)) for i in range(n + 1)
+        ]
+        return "fracture,x0,y0,x1,y1\n" + "".join(
+            f"a,{p[i][0]!r},{p[i][1]!r},{p[i + 1][0]!r},{p[i + 1][1]!r}\n"
+            for i in range(n)
+        )
+
+    out.append(
+        Input(
+            id="shapes/network-csv-trace-20000",
+            family="shapes",
+            files={
+                "case.toml": toml(network_case(file="net.csv")),
+                "net.csv": _lazy(lambda: trace(20_000)),
+            },
+            argv=("check", "case.toml"),
+            expect=frozenset({0, 2}),
+            out=None,
+            timeout=SHAPE_TIMEOUT,
+        )
+    )
     for n in (300, 5000):
         doc = copy.deepcopy(DEPLETION)
         doc["mesh"] = {"elements": [10, 10]}
@@ -1412,6 +1447,7 @@ def shape_inputs() -> list[Input]:
                 files={"case.toml": toml(doc)},
                 argv=(*RUN, "case.toml", "-o", OUT),
                 expect=frozenset({0, 1, 2}),
+                timeout=SHAPE_TIMEOUT,
             )
         )
     out.append(
@@ -1421,6 +1457,7 @@ def shape_inputs() -> list[Input]:
             files={"case.toml": toml(DEPLETION)},
             argv=("deplete", "-q", "case.toml", "-o", OUT, "--tolerance", "1e-10"),
             expect=frozenset({0, 1, 2}),
+            timeout=SHAPE_TIMEOUT,
         )
     )
     return out

@@ -473,7 +473,8 @@ def test_deplete_names_pore_pressure_change_zero(runner, tmp_path):
         + "\n[pore_pressure]\ninitial = 0.0\nchange = -0.0\n"
         + "\n[[fractures]]\npoints = [[0.2, 0.3], [0.8, 0.7]]\nfriction = 0.5\n"
     )
-    result = runner.invoke(cli, ["deplete", str(path), "-o", str(tmp_path / "out")])
+    out = str(tmp_path / "out")
+    result = runner.invoke(cli, ["deplete", "-q", str(path), "-o", out])
     assert result.exit_code == 2
     line = _assert_one_error_line(result)
     assert line.startswith(f"Error: {path}: pore_pressure.change: must be non-zero")
