@@ -29,6 +29,9 @@ from xfemslip.cli import (
 )
 from xfemslip.errors import UsageError
 
+# Each local worker holds its own interpreter, NumPy, SciPy and model
+# (~0.2-1 GB); more than a few per CPU only adds memory.
+MAX_JOBS = 4 * (os.cpu_count() or 1)
 # A figure of a few inches at this resolution is already ~100 megapixels.
 MAX_DPI = 2400.0
 KINDS = ("displacement", "principal_stress", "deformed_mesh", "slip", "mohr")
@@ -52,10 +55,10 @@ KINDS = ("displacement", "principal_stress", "deformed_mesh", "slip", "mohr")
 @click.option(
     "-j",
     "--jobs",
-    type=click.IntRange(min=1),
+    type=click.IntRange(min=1, max=MAX_JOBS),
     default=None,
-    help="Local worker processes [default: the number of CPUs]; 1 runs the "
-    "cases in this process.",
+    help="Local worker processes [default: the number of CPUs, at most "
+    f"{MAX_JOBS} = 4 x CPUs]; 1 runs the cases in this process.",
 )
 @click.option(
     "--scheduler",
