@@ -170,6 +170,8 @@ def _step_and_bisect(solver, model, steps, tolerance, onsets) -> None:
     found = [False] * n_frac
     centres = _patch_centres(model)
     pn0, pt0 = contact.pn0.copy(), contact.pt_committed.copy()
+    for fi in range(n_frac):
+        found[fi] = _slips_in_situ(solver.in_situ, contact, onsets[fi], fi, centres)
     u = np.zeros(model.problem.n_dofs)
     lam0 = 0.0
     prev_res = None
@@ -198,6 +200,28 @@ def _step_and_bisect(solver, model, steps, tolerance, onsets) -> None:
         _restore(contact, after)
         prev_res = res
         lam0 = lam1
+
+
+def _slips_in_situ(zero, contact, onset, fi, centres) -> bool:
+    """A fracture whose in-situ shear is already above the friction limit
+    slips at dp = 0 (the first load step releases the excess: see
+    ContactSet.in_situ_force); its onset is the initial state, found without
+    bisection, at the patch with the largest excess.  Returns whether it does."""
+    over = np.nonzero(_slipping(contact, zero, fi))[0]
+    if over.size == 0:
+        return False
+    excess = np.abs(contact.kt[over] * contact.slip_committed[over]) - np.abs(
+        zero.pt[over]
+    )
+    onset.dp_lower = onset.dp_upper = onset.dp_linear = 0.0
+    onset.x, onset.y = (float(v) for v in centres[over[np.argmax(excess)]])
+    logger.info(
+        "fracture %d: slips in situ, before any depletion (its initial shear "
+        "traction is above the friction limit on %d patch(es))",
+        onset.fracture,
+        over.size,
+    )
+    return True
 
 
 def _drop_nonlinear(onsets) -> None:

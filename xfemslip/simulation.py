@@ -18,7 +18,7 @@ import numpy as np
 from xfemslip import __version__, kernels
 from xfemslip.assembly import BulkSystem, assemble_bulk
 from xfemslip.boundary import dirichlet, hold_enriched, traction_load
-from xfemslip.contact import ContactSet, build_contact
+from xfemslip.contact import OPEN, SLIP, STICK, ContactSet, build_contact
 from xfemslip.enrichment import EnrichedCells, build_enriched_cells, find_candidates
 from xfemslip.errors import ConvergenceError, GeometryError, OutputError, UsageError
 from xfemslip.geometry import build_fractures
@@ -191,7 +191,7 @@ def build_model(spec) -> Model:
 def newton_solver(model: Model) -> NewtonSolver:
     """The Newton solver of a model, with the options of its [solver] table."""
     opt = model.spec.solver
-    return NewtonSolver(
+    solver = NewtonSolver(
         model.problem,
         opt.tolerance,
         opt.max_iterations,
@@ -199,6 +199,44 @@ def newton_solver(model: Model) -> NewtonSolver:
         opt.linear_solver,
         max_step_cuts=opt.max_step_cuts,
     )
+    _log_in_situ_release(model, solver.in_situ)
+    return solver
+
+
+def _log_in_situ_release(model: Model, zero) -> None:
+    """Say, per fracture, where the in-situ traction is not admissible (shear
+    above the friction limit, or tension) and how much of it the first load
+    step releases (ContactSet.in_situ_force)."""
+    c = model.contact
+    if model.spec.loading.initial_stress is None or not np.any(zero.state != STICK):
+        return
+    pt_in_situ = c.kt * (0.0 - c.slip_committed)
+    for fi, fr in enumerate(model.fractures):
+        mine = c.fracture == fi
+        slips = mine & (zero.state == SLIP)
+        opens = mine & (zero.state == OPEN)
+        total = float(c.weight[mine].sum())
+        if slips.any():
+            excess = np.abs(pt_in_situ[slips]) - np.abs(zero.pt[slips])
+            logger.info(
+                "fractures[%d]: the initial stress exceeds the friction limit on "
+                "%.4g m of its %.4g m, by up to %.4g MPa of shear; the excess is "
+                "released in load step 1 (the fracture slips by what it drives)",
+                fr.index,
+                float(c.weight[slips].sum()),
+                total,
+                float(excess.max()) / 1e6,
+            )
+        if opens.any():
+            logger.info(
+                "fractures[%d]: the initial stress pulls it open on %.4g m of its "
+                "%.4g m, with up to %.4g MPa of tension; released in load step 1 "
+                "(the fracture opens)",
+                fr.index,
+                float(c.weight[opens].sum()),
+                total,
+                float(c.pn0[opens].max()) / 1e6,
+            )
 
 
 def floating_parts(mesh, fractures, contact, bc):

@@ -1,11 +1,15 @@
 """Load stepping and Newton-Raphson (paper eq. 21).
 
-Residual r(u) = K_bulk u + f_con(u) - f_con(0) - lambda F_ext on the free dofs
-(f_con(0) is the in-situ contact force that balances the initial stress, zero
-without one).  Convergence: eta = ||r_free|| / ||F_ref|| <= tolerance, where
-F_ref stacks the applied forces on the free dofs and the reactions on the
-prescribed ones, so displacement-driven cases (no applied force at all) have a
-meaningful reference (eta of the paper with F_ext including reactions).
+Residual r(u) = K_bulk u + f_con(u) - f_0 - lambda F_ext on the free dofs, where
+f_0 is the contact force of the in-situ traction sigma0 . n at zero jump (the
+force that balances the initial stress; zero without one).  Where the contact
+law cannot carry that traction (shear above the friction limit, tension), f_0
+differs from f_con(0) and the excess is released in the first load step
+(ContactSet.in_situ_force).  Convergence: eta = ||r_free|| / ||F_ref|| <=
+tolerance, where F_ref stacks the applied forces on the free dofs, the
+released in-situ excess and the reactions on the prescribed ones, so
+displacement-driven cases (no applied force at all) have a meaningful
+reference (eta of the paper with F_ext including reactions).
 
 Tangents: "consistent" uses the exact derivative of the return map (not
 symmetric while slipping), which gives quadratic convergence once the
@@ -160,7 +164,15 @@ class NewtonSolver:
         c = problem.contact
         self.c_dofs = np.where(c.dofs >= 0, self.reduced[np.maximum(c.dofs, 0)], -1)
         zero = c.evaluate(np.zeros(n), self.mode, c.pt_committed, c.gt_committed)
-        self.f_c0 = zero.force
+        # the contact law at zero jump: what it admits of the in-situ traction
+        self.in_situ = zero
+        self.f_c0 = c.in_situ_force(zero)
+        # the in-situ excess over the contact law (ContactSet.in_situ_force),
+        # released from the first load step on: a load like lam F_ext, so it
+        # is stacked into the reference of eta (None: nothing to release)
+        self._release = (
+            None if self.f_c0 is zero.force else (self.f_c0 - zero.force)[self.free]
+        )
         self.completed: list[StepResult] = []
         # committed normal traction and load factor (for the predictor)
         self._pn_committed = c.pn0.copy()
@@ -187,12 +199,12 @@ class NewtonSolver:
     def _residual(self, u, lam, res: ContactResult):
         f_int = self.p.K @ u + res.force - self.f_c0
         r = f_int - lam * self.p.F_unit
-        ref = math.sqrt(
-            float(
-                np.sum((lam * self.p.F_unit[self.free]) ** 2)
-                + np.sum(r[self.p.fixed] ** 2)
-            )
+        ref2 = float(
+            np.sum((lam * self.p.F_unit[self.free]) ** 2) + np.sum(r[self.p.fixed] ** 2)
         )
+        if self._release is not None:
+            ref2 += float(np.sum(self._release**2))
+        ref = math.sqrt(ref2)
         norm = float(np.linalg.norm(r[self.free]))
         eta = norm / ref if ref > 0.0 else (0.0 if norm == 0.0 else math.inf)
         return r[self.free], eta
