@@ -1,6 +1,8 @@
-"""Inputs whose cost must follow the mesh, not their number of vertices, and
-a measured child process: shared by tests/unit/test_hard_inputs.py and
-benchmarks/hard_inputs.py (imported by basename)."""
+"""Inputs whose cost must follow the mesh, not their number of vertices, a
+child process measured for its peak memory, and a case's memory estimates:
+shared by tests/unit/test_hard_inputs.py, tests/unit/test_memory.py and
+benchmarks/hard_inputs.py, benchmarks/memory_estimate.py (imported by
+basename)."""
 
 from __future__ import annotations
 
@@ -164,3 +166,27 @@ def measure(argv, timeout, log) -> tuple[int | str, float, float, list[str]]:
         lines = [line for line in out.read().splitlines() if line.strip()]
     peak = math.nan if code == "timeout" else float(Path(peak_file).read_text()) / 1024
     return code, wall, peak, lines
+
+
+def estimates(path) -> list[float]:
+    """The three memory estimates [B] of a case file (xfemslip.memory: from
+    the case, after the node enrichments, from the built model), with no
+    limit applied."""
+    from xfemslip import memory
+    from xfemslip.case import load_case
+    from xfemslip.enrichment import find_candidates
+    from xfemslip.geometry import build_fractures
+    from xfemslip.mesh import build_mesh
+    from xfemslip.simulation import build_model
+
+    spec = load_case(path)
+    out = [memory.estimate_terms(memory.case_footprint(spec))["total"]]
+    mesh = build_mesh(spec.mesh.x, spec.mesh.y)
+    box = [mesh.x[0], mesh.x[-1], mesh.y[0], mesh.y[-1]]
+    fractures = build_fractures(mesh, spec.fractures, box)
+    cand = find_candidates(mesh, fractures)
+    fp = memory.enriched_footprint(spec, mesh, fractures, cand)
+    out.append(memory.estimate_terms(fp)["total"])
+    model = build_model(spec)
+    out.append(memory.estimate_terms(memory.model_footprint(model))["total"])
+    return out
