@@ -42,6 +42,9 @@ GEOMETRY_TOL = 1.0e-9
 SIMPLIFY_MIN_SEGMENT = 0.25
 SIMPLIFY_DEVIATION = 0.05
 MAX_PIECES_PER_CELL = 12
+# Point-segment pairs per chunk of Fracture.signed_distance (its temporaries
+# take about 100 B a pair).
+DISTANCE_CHUNK = 1 << 19
 
 # Crack-tip treatment when the case does not choose one (see enrichment.py and
 # benchmarks/RESULTS.md): branch functions on the nodes within a radius of each
@@ -143,8 +146,25 @@ class Fracture:
         return J
 
     def signed_distance(self, pts: np.ndarray) -> np.ndarray:
-        """phi at points (n, 2) [m] (eq. 13)."""
+        """phi at points (n, 2) [m] (eq. 13).
+
+        Points x segments arrays are formed in chunks of at most
+        DISTANCE_CHUNK pairs, so the memory stays bounded for a polyline of
+        many segments; each point's value is that of a single pass.
+        """
         pts = np.atleast_2d(np.asarray(pts, dtype=float))
+        rows = max(1, DISTANCE_CHUNK // max(self.length.size, 1))
+        if pts.shape[0] <= rows:
+            return self._signed_distance(pts)
+        return np.concatenate(
+            [
+                self._signed_distance(pts[i : i + rows])
+                for i in range(0, pts.shape[0], rows)
+            ]
+        )
+
+    def _signed_distance(self, pts: np.ndarray) -> np.ndarray:
+        """signed_distance of one chunk of points (n, 2)."""
         a = self.points[:-1]
         d = self.points[1:] - a
         rel = pts[:, None, :] - a[None, :, :]
@@ -288,9 +308,9 @@ def _resolved(mesh, pts, key):
     if kept.size == len(pts):
         return pts
     out = pts[kept]
-    h_text = f"{h.min():.3g} m" if h.min() == h.max() else (
-        f"{h.min():.3g} to {h.max():.3g} m"
-    )  # fmt: skip
+    h_text = f"{h.min():.3g} m"
+    if f"{h.max():.3g}" != f"{h.min():.3g}":  # a graded mesh
+        h_text = f"{h.min():.3g} to {h.max():.3g} m"
     logger.warning(
         "%s: %s points simplified to %d below the mesh resolution (tolerance: "
         "segments of at least %g h, vertices within %g h of the line dropped; "

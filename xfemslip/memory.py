@@ -154,12 +154,14 @@ def case_footprint(spec) -> Footprint:
         for fr in spec.fractures
     )
     pieces = min(1.5 * length / h, float(n_cells))
+    entries = 64.0 * n_cells  # the enriched cells' wider blocks are not known yet
     return Footprint(
         n_nodes=n_nodes,
         n_cells=n_cells,
         n_dofs=n_dofs,
-        nnz=NNZ_PER_ENTRY * 64 * n_cells + 20.0 * (n_dofs - 2 * n_nodes),
+        nnz=NNZ_PER_ENTRY * entries + 20.0 * (n_dofs - 2 * n_nodes),
         steps=spec.loading.steps,
+        entries=entries,
         pore=spec.pore_pressure is not None,
         patches=_patches(spec, length, h, 4 * pieces),
         block=16.0,
