@@ -26,7 +26,8 @@ from xfemslip.cli import (
     type=click.FloatRange(min=0.0, min_open=True),
     default=None,
     help="Bisection tolerance on the critical pore-pressure change [Pa] "
-    "[default: 0.1 % of |pore_pressure.change|].",
+    "[default: 0.1 % of |pore_pressure.change|; a value below |change| x "
+    "solver.tolerance, what the load steps resolve, is raised to it].",
 )
 @click.option(
     "--plot",

@@ -41,6 +41,16 @@ logger = logging.getLogger(__name__)
 
 # Default bisection tolerance, relative to |pore_pressure.change|.
 DEFAULT_REL_TOLERANCE = 1.0e-3
+# The smallest meaningful tolerance, relative to |pore_pressure.change|: a
+# converged state at load factor lambda satisfies its equilibrium only to
+# solver.tolerance times the applied load, so whether a patch slips is decided
+# to about that fraction of the change; RESOLUTION_FLOOR stands for round-off
+# when the solver tolerance is set very small (the load factor itself resolves
+# 2.2e-16).  A smaller --tolerance is raised to this with a warning.
+RESOLUTION_FLOOR = 1.0e-12
+# Hard cap on the bisection solves of one fracture: a bracket of one load step
+# reaches the smallest tolerance above in at most log2(1 / 1e-12) = 40 halvings.
+MAX_BISECTIONS = 60
 
 
 @dataclass
@@ -274,9 +284,18 @@ def _bisect(solver, contact, onset, fi, bracket, tolerance, centres, change):
     lo, hi = bracket.lam0, bracket.lam1
     hi_res = solver.completed[-1].contact
     lo_res = bracket.res0
-    width = tolerance / abs(change) if change else 0.0
+    width = tolerance / abs(change)
     while hi - lo > width:
         mid = 0.5 * (lo + hi)
+        if onset.trials >= MAX_BISECTIONS or not lo < mid < hi:
+            logger.warning(
+                "fracture %d: bisection stopped after %d solves with the bracket "
+                "%.3g Pa wide (the load factor cannot be split further)",
+                onset.fracture,
+                onset.trials,
+                (hi - lo) * abs(change),
+            )
+            break
         res = _trial(solver, contact, bracket, mid)
         onset.trials += 1
         if _slipping(contact, res, fi).any():
@@ -305,6 +324,28 @@ def _bisect(solver, contact, onset, fi, bracket, tolerance, centres, change):
     return lo_res.pn, lo_res.pt
 
 
+def resolved_tolerance(spec, tolerance=None) -> float:
+    """Bisection tolerance [Pa] for a case: the default, or the one asked for,
+    raised with a warning to the smallest the load steps resolve
+    (RESOLUTION_FLOOR)."""
+    change = abs(spec.pore_pressure.change)
+    if tolerance is None:
+        return DEFAULT_REL_TOLERANCE * change
+    if not tolerance > 0.0:
+        raise UsageError(f"--tolerance must be > 0 Pa, got {tolerance!r}")
+    smallest = change * max(spec.solver.tolerance, RESOLUTION_FLOOR)
+    if tolerance < smallest:
+        logger.warning(
+            "--tolerance %.3g Pa is below what the load steps resolve "
+            "(|pore_pressure.change| x solver.tolerance = %.3g Pa); using %.3g Pa",
+            tolerance,
+            smallest,
+            smallest,
+        )
+        return smallest
+    return tolerance
+
+
 def deplete(spec, out_dir=None, *, tolerance=None, plot=False, overwrite=False):
     """Critical depletion of every fracture of a case; writes the outputs.
 
@@ -321,10 +362,12 @@ def deplete(spec, out_dir=None, *, tolerance=None, plot=False, overwrite=False):
     if not spec.fractures:
         raise UsageError(f"{spec.path}: xfemslip deplete needs at least one fracture")
     change = spec.pore_pressure.change
-    if tolerance is None:
-        tolerance = DEFAULT_REL_TOLERANCE * abs(change)
-    if not tolerance > 0.0:
-        raise UsageError(f"--tolerance must be > 0 Pa, got {tolerance!r}")
+    if change == 0.0:
+        raise UsageError(
+            f"{spec.path}: pore_pressure.change = 0: xfemslip deplete needs a "
+            "non-zero pore-pressure change to search for the first slip"
+        )
+    tolerance = resolved_tolerance(spec, tolerance)
     done = solve_and_write(
         spec,
         out_dir,

@@ -16,6 +16,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from xfemslip.errors import GeometryError
+from xfemslip.polyline import first_meeting, simplify
 
 logger = logging.getLogger(__name__)
 
@@ -23,6 +24,27 @@ logger = logging.getLogger(__name__)
 # inside a cell are ignored (they touch the cell at a node or an edge only), and
 # end points closer than this to the domain boundary are taken to lie on it.
 GEOMETRY_TOL = 1.0e-9
+
+# Fracture geometry below the mesh resolution (README, Method), in local cell
+# sizes h (the smaller side of the cell holding a vertex).  A clipped polyline
+# with a segment shorter than SIMPLIFY_MIN_SEGMENT h is simplified by
+# Douglas-Peucker with a shortest segment (polyline.simplify): it keeps the
+# vertices more than SIMPLIFY_DEVIATION h off the simplified line that lie at
+# least SIMPLIFY_MIN_SEGMENT h from their neighbours in it, and the end points
+# (on the domain boundary where the polyline is clipped).  A kink with arms
+# of a quarter cell or more stays; finer detail (a digitised trace, a zigzag
+# inside one cell) cannot be resolved by one enriched cell and would only
+# multiply the sub-cells and contact points.  No vertex moves by more than
+# h/4, about the error of standard XFEM's nodal level set, which makes each
+# cut straight inside a cell.  Pieces of one fracture in one cell beyond
+# MAX_PIECES_PER_CELL (a polyline folded many times inside a cell, with long
+# strokes) are refused: their sub-cells grow like the square of the count.
+SIMPLIFY_MIN_SEGMENT = 0.25
+SIMPLIFY_DEVIATION = 0.05
+MAX_PIECES_PER_CELL = 12
+# Point-segment pairs per chunk of Fracture.signed_distance (its temporaries
+# take about 100 B a pair).
+DISTANCE_CHUNK = 1 << 19
 
 # Crack-tip treatment when the case does not choose one (see enrichment.py and
 # benchmarks/RESULTS.md): branch functions on the nodes within a radius of each
@@ -124,8 +146,25 @@ class Fracture:
         return J
 
     def signed_distance(self, pts: np.ndarray) -> np.ndarray:
-        """phi at points (n, 2) [m] (eq. 13)."""
+        """phi at points (n, 2) [m] (eq. 13).
+
+        Points x segments arrays are formed in chunks of at most
+        DISTANCE_CHUNK pairs, so the memory stays bounded for a polyline of
+        many segments; each point's value is that of a single pass.
+        """
         pts = np.atleast_2d(np.asarray(pts, dtype=float))
+        rows = max(1, DISTANCE_CHUNK // max(self.length.size, 1))
+        if pts.shape[0] <= rows:
+            return self._signed_distance(pts)
+        return np.concatenate(
+            [
+                self._signed_distance(pts[i : i + rows])
+                for i in range(0, pts.shape[0], rows)
+            ]
+        )
+
+    def _signed_distance(self, pts: np.ndarray) -> np.ndarray:
+        """signed_distance of one chunk of points (n, 2)."""
         a = self.points[:-1]
         d = self.points[1:] - a
         rel = pts[:, None, :] - a[None, :, :]
@@ -254,6 +293,45 @@ def _clip_to_domain(points, box, tol, key):
     return pts[keep], s_offset
 
 
+def _cell_sizes(mesh, pts) -> np.ndarray:
+    """(k,) smaller side [m] of the cell holding each point (k, 2)."""
+    i = np.clip(np.searchsorted(mesh.x, pts[:, 0], side="right") - 1, 0, mesh.nx - 1)
+    j = np.clip(np.searchsorted(mesh.y, pts[:, 1], side="right") - 1, 0, mesh.ny - 1)
+    return np.minimum(np.diff(mesh.x)[i], np.diff(mesh.y)[j])
+
+
+def _resolved(mesh, pts, key):
+    """The clipped polyline pts (k, 2) at the mesh's resolution (see
+    SIMPLIFY_MIN_SEGMENT); logs a warning when vertices are dropped."""
+    h = _cell_sizes(mesh, pts)
+    kept = simplify(pts, h, SIMPLIFY_MIN_SEGMENT, SIMPLIFY_DEVIATION)
+    if kept.size == len(pts):
+        return pts
+    out = pts[kept]
+    h_text = f"{h.min():.3g} m"
+    if f"{h.max():.3g}" != f"{h.min():.3g}":  # a graded mesh
+        h_text = f"{h.min():.3g} to {h.max():.3g} m"
+    logger.warning(
+        "%s: %s points simplified to %d below the mesh resolution (tolerance: "
+        "segments of at least %g h, vertices within %g h of the line dropped; "
+        "h = %s)",
+        key,
+        f"{len(pts):,}",
+        len(out),
+        SIMPLIFY_MIN_SEGMENT,
+        SIMPLIFY_DEVIATION,
+        h_text,
+    )
+    pair = first_meeting(out)
+    if pair is not None:
+        raise GeometryError(
+            f"{key}: simplified below the mesh resolution ({len(pts):,} points to "
+            f"{len(out)}), the polyline crosses itself (segments {pair[0]} and "
+            f"{pair[1]}); smooth the polyline or refine the mesh"
+        )
+    return out
+
+
 def _on_boundary(p, box, tol):
     return (
         min(
@@ -298,6 +376,21 @@ def _cell_pieces(mesh, points, tol):
     )
 
 
+def _check_pieces_per_cell(mesh, piece_cell, key) -> None:
+    """Refuse a fracture folded into more than MAX_PIECES_PER_CELL pieces in
+    one cell (GeometryError naming the cell)."""
+    count = np.bincount(piece_cell)
+    c = int(np.argmax(count))
+    if count[c] > MAX_PIECES_PER_CELL:
+        b = mesh.bounds[c]
+        raise GeometryError(
+            f"{key}: {count[c]} pieces of the fracture in the cell [{b[0]:.4g}, "
+            f"{b[1]:.4g}] x [{b[2]:.4g}, {b[3]:.4g}], more than the "
+            f"{MAX_PIECES_PER_CELL} a cell can resolve; smooth the polyline or "
+            "refine the mesh"
+        )
+
+
 def build_fracture(
     mesh, spec, box, points=None, s_offset=0.0, junction_ends=(), reach=None
 ) -> Fracture:
@@ -313,6 +406,7 @@ def build_fracture(
     if points is None:
         raw = np.asarray(spec.points, dtype=float)
         pts, s_offset = _clip_to_domain(raw, box, tol, key)
+        pts = _resolved(mesh, pts, key)
     else:
         pts = np.asarray(points, dtype=float)
     if pts.shape[0] < 2:
@@ -327,6 +421,7 @@ def build_fracture(
     piece_cell, piece_seg, piece_t = _cell_pieces(mesh, pts, tol)
     if piece_cell.size == 0:
         raise GeometryError(f"{key}: no part of the fracture lies inside an element")
+    _check_pieces_per_cell(mesh, piece_cell, key)
     tips = []
     for end in (0, 1):
         p = pts[0] if end == 0 else pts[-1]
@@ -666,6 +761,7 @@ def build_fractures(mesh, specs, box) -> tuple[Fracture, ...]:
     clipped, offsets, free = [], [], []
     for spec, key in zip(specs, names, strict=True):
         pts, s_off = _clip_to_domain(np.asarray(spec.points, float), box, tol, key)
+        pts = _resolved(mesh, pts, key)
         clipped.append(pts.copy())
         offsets.append(s_off)
         free.append(

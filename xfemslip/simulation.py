@@ -23,7 +23,7 @@ from xfemslip.enrichment import EnrichedCells, build_enriched_cells, find_candid
 from xfemslip.errors import ConvergenceError, GeometryError, OutputError, UsageError
 from xfemslip.geometry import build_fractures
 from xfemslip.material import elasticity_matrix
-from xfemslip.memory import check_memory
+from xfemslip.memory import check_memory, enriched_footprint, model_footprint
 from xfemslip.mesh import Mesh, build_mesh
 from xfemslip.poro import (
     Materials,
@@ -115,6 +115,7 @@ def build_model(spec) -> Model:
     mat = spec.material
     D = elasticity_matrix(mat.E, mat.nu, mat.model)
     cand = find_candidates(mesh, fractures)
+    check_memory(spec, enriched_footprint(spec, mesh, fractures, cand))
     ec = build_enriched_cells(mesh, fractures, cand)
     kernel_backend = kernels.choose(spec.solver.kernels, kernel_work(ec))
     kernels.use(kernel_backend)
@@ -173,7 +174,7 @@ def build_model(spec) -> Model:
         ip.n,
         kernel_backend,
     )
-    return Model(
+    model = Model(
         spec=spec,
         mesh=mesh,
         D=D,
@@ -186,6 +187,8 @@ def build_model(spec) -> Model:
         materials=materials,
         pore=pore,
     )
+    check_memory(spec, model_footprint(model))  # before the LU and the steps
+    return model
 
 
 def newton_solver(model: Model) -> NewtonSolver:

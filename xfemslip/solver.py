@@ -33,6 +33,7 @@ import scipy.sparse as sp
 
 from xfemslip import kernels, local_branches
 from xfemslip.assembly import coo_block
+from xfemslip.case_specs import AUTO_PENALTY
 from xfemslip.contact import OPEN, SLIP, STICK, ContactResult, ContactSet
 from xfemslip.errors import ConvergenceError
 from xfemslip.linsolve import LinearSolver
@@ -42,6 +43,13 @@ logger = logging.getLogger(__name__)
 
 # kn*h/E above this is named in the message of a Newton failure as a likely cause.
 PENALTY_RATIO_HIGH = 1.0e5
+# Top of the penalty range where Newton was measured to converge on every
+# shipped case, kn = kt = 10^k E/h for k = -1..9 (benchmarks/penalty_range.py,
+# README "Known limits"): 0.1 to 1e6.  Above it the contact stiffness swamps
+# the bulk stiffness by that ratio and the residual stalls at round-off (eta
+# 1e-8 to 6e-8, stick/slip states settled), just above the default
+# tolerance; every Newton failure then names the penalty and this value.
+PENALTY_RATIO_MEASURED = 1.0e6
 # Step halvings tried by the line search before keeping the best trial.
 LINE_SEARCH_CUTS = 6
 # Ping-pong remedy: a contact point whose branch of the law (stick, slip +t,
@@ -593,7 +601,7 @@ class NewtonSolver:
         if sum(1 for n in switches[-5:] if n > 0) >= 4:
             why += "; the contact states keep switching between iterations (ping-pong)"
             ratio = self.p.penalty_ratio
-            if ratio > PENALTY_RATIO_HIGH:
+            if PENALTY_RATIO_HIGH < ratio <= PENALTY_RATIO_MEASURED:
                 why += (
                     f", and the penalty is very stiff (kn*h/E up to {ratio:.1e}; "
                     f"10 to 1e4 is usual): lower kn/kt, or use more load steps"
@@ -660,7 +668,27 @@ class NewtonSolver:
         err.retryable = False
         return err
 
+    def _penalty_note(self) -> str:
+        """Names a penalty above PENALTY_RATIO_MEASURED and the value to use
+        instead, or ''."""
+        ratio = self.p.penalty_ratio
+        if not ratio > PENALTY_RATIO_MEASURED:
+            return ""
+        c = self.p.contact
+        e_over_h = float(np.max(np.maximum(c.kn, c.kt))) / ratio  # [Pa/m]
+        kn, kt = (float(np.max(v)) / e_over_h for v in (c.kn, c.kt))
+        top = PENALTY_RATIO_MEASURED
+        return (
+            f"; the penalty is stiffer than the range where Newton was measured to "
+            f"converge (kn*h/E up to {kn:.1e}, kt*h/E up to {kt:.1e}; measured "
+            f"0.1 to {top:.0e}), where the residual stalls at round-off: lower "
+            f"kn/kt to at most {top * e_over_h:.3g} Pa/m ({top:.0e} E/h; the "
+            f"default {AUTO_PENALTY:.0f} E/h = {AUTO_PENALTY * e_over_h:.3g} Pa/m "
+            "moves the slip of the shipped cases by at most 0.04 % of its maximum)"
+        )
+
     def _fail(self, k, it, eta, flips, why):
+        why += self._penalty_note()
         return ConvergenceError(
             f"load step {k} did not converge: {why}; iteration {it}, residual eta = "
             f"{eta:.3e} "
