@@ -473,7 +473,14 @@ def _tip_enrichment(spec, key, tips, length, reach):
 # A junction on a mesh node or edge needs no special case: cell pieces are
 # split at the junction only where it lies strictly inside a piece.
 JUNCTION_SNAP_CELLS = 0.5
+# A snap turns an end segment by up to atan(snap / its length); below 10 deg
+# it would join fractures that run alongside each other (a near-parallel
+# pair, en echelon ends, a near copy) into a sliver a few cells long, which
+# the cells cannot resolve either way (benchmarks/RESULTS.md, "Buildable
+# fracture networks": the snaps this refuses and what they change).
 JUNCTION_MIN_ANGLE = 10.0  # [deg]
+# A snap may shorten an end segment (a trim, a V); it must not make it vanish
+# or leave a stub far below the cell size.
 JUNCTION_MIN_SEGMENT_CELLS = 0.1
 
 

@@ -58,8 +58,8 @@ MAIN = [[0.2, 0.5], [0.8, 0.5]]
 def _segment(center, length, degrees):
     """End points of a straight fracture [m]; angle from +x [deg]."""
     rad = math.radians(degrees)
-    c, d = np.asarray(center, float), 0.5 * length * np.array([math.cos(rad), 0.0])
-    d[1] = 0.5 * length * math.sin(rad)
+    c = np.asarray(center, float)
+    d = 0.5 * length * np.array([math.cos(rad), math.sin(rad)])
     return [list(c - d), list(c + d)]
 
 
@@ -222,7 +222,7 @@ def test_collinear_fractures_meeting_end_to_end_are_a_straight_v():
     _, found, fractures = _check([left, right])
     assert [k for k, *_ in found] == ["V"]
     sec = fractures[found[0][2]]
-    (cut,) = sec.arms[0]
+    assert len(sec.arms) == 1 and len(sec.arms[0]) == 1
     probes = np.array([[0.3, 0.52], [0.3, 0.48], [0.6, 0.52], [0.6, 0.48]])
     J = sec.junction_factor(0, probes, sec.side(probes))
     assert J[0] == J[2] and J[1] == J[3] and J[0] != J[1]
@@ -233,6 +233,8 @@ OVERLAPS = [
     pytest.param([[0.3, 0.5], [0.6, 0.5]], id="inside"),
     pytest.param([[0.7, 0.5], [0.3, 0.5]], id="inside-reversed"),
     pytest.param([[0.3, 0.5], [0.7, 0.5 + 1e-12]], id="within-tolerance"),
+    # not parallel to 1e-12, but within the geometric tolerance (1e-10 m)
+    pytest.param([[0.3, 0.5], [0.7, 0.5 + 5e-11]], id="tiny-angle"),
 ]
 
 
@@ -378,13 +380,17 @@ def _generated(document, seed):
 
 
 def _check_seeds(seeds):
+    """Each network over the seeds: builds, junctions consistent; they are
+    networks with junctions of every kind."""
     from xfemslip.simulation import check_geometry
 
     for name, document in _network_cases():
+        kinds = set()
         for seed in seeds:
             spec, found = _generated(document, seed)
             check_geometry(spec)  # builds, as xfemslip check does
-            assert found or name == "dfn", (name, seed)
+            kinds |= {k for k, *_ in found}
+        assert kinds == {"X", "T", "V"}, name
 
 
 def test_generated_networks_build_with_consistent_junctions():
@@ -415,8 +421,8 @@ STRESS = np.array([[-20.0e6, 5.0e6], [5.0e6, -40.0e6]])  # [Pa]
 def test_stuck_fractures_carry_the_uniform_traction(name):
     """Friction 0.3 everywhere and |tau| / |sigma_n| <= 0.2 on every fracture:
     all stick, so the body is nearly uncracked and each contact patch carries
-    sigma . n of the far field (within 5 % of |sigma_yy|, the perturbation of
-    the ramp tips), with the penalty jump p_T / k_T; no NaN."""
+    sigma . n of the far field (within 2.5 % of |sigma_yy|: the ramp tips
+    perturb it by up to 0.8 MPa), with the penalty jump p_T / k_T; no NaN."""
     from tests.verification.harness import case_text
     from xfemslip.kernels import STICK
     from xfemslip.simulation import build_model, newton_solver
@@ -450,6 +456,6 @@ def test_stuck_fractures_carry_the_uniform_traction(name):
     expected_pn = np.einsum("pk,pk->p", traction, n)
     expected_pt = np.einsum("pk,pk->p", traction, t)
     assert np.all(np.abs(expected_pt) <= 0.2 * np.abs(expected_pn))
-    np.testing.assert_allclose(c.pn, expected_pn, rtol=0, atol=0.05 * 40.0e6)
-    np.testing.assert_allclose(c.pt, expected_pt, rtol=0, atol=0.05 * 40.0e6)
+    np.testing.assert_allclose(c.pn, expected_pn, rtol=0, atol=0.025 * 40.0e6)
+    np.testing.assert_allclose(c.pt, expected_pt, rtol=0, atol=0.025 * 40.0e6)
     np.testing.assert_allclose(c.gt, c.pt / 5.0e12, rtol=1e-9, atol=0)
