@@ -637,9 +637,11 @@ class _Snapping:
     tol: float  # [m]
     min_segment: float  # [m]
     taken: list | None = None  # [bool, bool] per polyline: ends snapped
+    near: set | None = None  # (polyline, end) within snap of another one
 
     def __post_init__(self):
         self.taken = [[False, False] for _ in self.polylines]
+        self.near = set()
 
 
 def find_junctions(polylines, free_ends, names, h, tol):
@@ -674,6 +676,16 @@ def find_junctions(polylines, free_ends, names, h, tol):
     )
     for a, b in pairs:
         _snap_pair(state, a, b)
+    apart = sum(not state.taken[f][end] for f, end in state.near)
+    if apart:
+        logger.info(
+            "%d fracture end(s) within %.3g m (h/2) of another fracture left as "
+            "tips: the snap would meet it at under %g deg, part a crossing or "
+            "leave an end segment under h/10 (README, Fracture networks)",
+            apart,
+            snap,
+            JUNCTION_MIN_ANGLE,
+        )
     out = []
     for a, b in pairs:
         pa, pb = polylines[a], polylines[b]
@@ -798,6 +810,7 @@ def _snap_pair(state, a, b):
             dist, _, _, q = _closest_on_polyline(pg, p)
             if dist > snap:
                 continue
+            state.near.add((f, end))
             # the other's ends near p: a V, the secondary onto the main
             v_end = None
             for e2 in (0, 1):

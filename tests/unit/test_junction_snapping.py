@@ -23,6 +23,7 @@ the uniform traction sigma . n (the patch test), whatever their junctions.
 
 from __future__ import annotations
 
+import logging
 import math
 import tomllib
 from pathlib import Path
@@ -148,6 +149,14 @@ def test_near_parallel_pairs_stay_apart(gap, tilt):
     assert found == []
     np.testing.assert_array_equal(after[1], other)
     assert [len(f.tips) for f in fractures] == [2, 2]
+
+
+def test_ends_left_apart_are_counted_in_the_log(caplog):
+    caplog.set_level(logging.INFO, logger="xfemslip.geometry")
+    _check([MAIN, [[0.3, 0.51], [0.7, 0.515]]])
+    assert "2 fracture end(s) within 0.05 m (h/2) of another fracture left as " in (
+        caplog.text
+    )
 
 
 @pytest.mark.parametrize("degrees", [0.1, 0.2, 0.5, 1.0])
