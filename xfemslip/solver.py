@@ -172,9 +172,10 @@ class NewtonSolver:
         c = problem.contact
         self.c_dofs = np.where(c.dofs >= 0, self.reduced[np.maximum(c.dofs, 0)], -1)
         zero = c.evaluate(np.zeros(n), self.mode, c.pt_committed, c.gt_committed)
-        # the contact law at zero jump: what it admits of the in-situ traction
-        self.in_situ = zero
         self.f_c0 = c.in_situ_force(zero)
+        # the contact law at zero jump: what it admits of the in-situ traction
+        # (kept for the log and deplete; its tangent blocks are not needed)
+        self.in_situ = dataclasses.replace(zero, blocks=None)
         # the in-situ excess over the contact law (ContactSet.in_situ_force),
         # released from the first load step on: a load like lam F_ext, so it
         # is stacked into the reference of eta (None: nothing to release)
