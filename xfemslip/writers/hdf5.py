@@ -29,7 +29,9 @@ who think compression-positive; it is *named* so and never replaces
 When ``steps`` is empty (the first load step did not converge) the file holds
 the mesh and the root attributes only: no ``/fields``, ``/fractures`` or
 ``/steps``.  The file is written atomically (:mod:`xfemslip.writers.atomic`) and
-carries no timestamps, so the same input gives the same bytes.
+carries no timestamps, so the same input gives the same bytes.  The root
+attribute ``run_id`` (:func:`xfemslip.writers.run_id`, given by the caller)
+is the id that every file of its output set carries.
 """
 
 from __future__ import annotations
@@ -41,7 +43,7 @@ from pathlib import Path
 import h5py
 import numpy as np
 
-from xfemslip import __version__
+from xfemslip import __version__, interrupt
 from xfemslip.writers import FractureFields, StepFields
 from xfemslip.writers.atomic import atomic_path, refuse_non_finite
 
@@ -235,6 +237,7 @@ def _dataset(
     group: h5py.Group, name: str, value: np.ndarray, units: str
 ) -> h5py.Dataset:
     """Create one dataset without timestamps and tag it with its units."""
+    interrupt.checkpoint()  # between data sets: a deferred signal stops here
     refuse_non_finite(value, f"{group.name}/{name}")
     dataset = group.create_dataset(name, data=value, track_times=False)
     dataset.attrs["units"] = units
