@@ -56,7 +56,7 @@ import re
 import shutil
 import sys
 import time
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator, Mapping
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -300,6 +300,12 @@ def _check_target(final: Path, display: Path, overwrite: bool, results) -> None:
         return
     if not final.is_dir():
         raise UsageError(f"{display} exists and is not a directory")
+    if _holds_cwd(final):
+        raise UsageError(
+            f"{display} is (or holds) the current directory; an output folder "
+            "is replaced whole, so choose a folder of its own, e.g. -o "
+            f"{display / 'out'}"
+        )
     if os.path.ismount(final):
         raise UsageError(
             f"{display} is a mount point, which cannot be replaced; "
@@ -315,6 +321,16 @@ def _check_target(final: Path, display: Path, overwrite: bool, results) -> None:
             f"{display} already holds {', '.join(existing)}; "
             "use --overwrite to replace it or -o to choose another directory"
         )
+
+
+def _holds_cwd(final: Path) -> bool:
+    """Whether the current directory is ``final`` or inside it (swapping it
+    would leave this process in the deleted earlier folder)."""
+    try:
+        cwd = Path(os.getcwd())
+    except OSError:
+        return False
+    return cwd == final or final in cwd.parents
 
 
 def _make_staging(final: Path, display: Path) -> Path:
@@ -375,16 +391,23 @@ def _commit(stage: Staging, owned: frozenset[str]) -> None:
             os.rename(staging, final)
             stage.committed = True
             return
-        carried = _carry_over(final, staging, owned)
+        # the new set's names and earlier xfemslip outputs are not carried
+        replaced = owned | frozenset(os.listdir(staging))
+        carried = _carry_over(final, staging, replaced)
         old = _swap(staging, final)
         stage.committed = True
     except OSError as err:
         raise OutputError(f"cannot write {stage.display}: {_reason(err)}") from None
     pause_for_test("swapped")
-    _remove_old(old, final, carried, owned)
+    _remove_old(old, final, carried, replaced)
 
 
-def _carry_over(final: Path, staging: Path, owned) -> dict:
+def _replaced(name: str, replaced: frozenset[str]) -> bool:
+    """Whether the top-level entry ``name`` of DIR goes with the earlier set."""
+    return name in replaced or _TEMP_FILE.fullmatch(name) is not None
+
+
+def _carry_over(final: Path, staging: Path, replaced: frozenset[str]) -> dict:
     """Link the foreign entries of ``final`` into ``staging``.
 
     Returns {relative path: (st_dev, st_ino)} of every file carried, so that
@@ -393,7 +416,7 @@ def _carry_over(final: Path, staging: Path, owned) -> dict:
     carried: dict = {}
     with os.scandir(final) as entries:
         for entry in entries:
-            if entry.name in owned or _TEMP_FILE.fullmatch(entry.name):
+            if _replaced(entry.name, replaced):
                 continue
             _link_tree(Path(entry.path), staging / entry.name, carried, final)
     return carried
@@ -453,7 +476,7 @@ def _rename_exchange(a: Path, b: Path) -> None:
         raise OSError(code, os.strerror(code))
 
 
-def _remove_old(old: Path, new: Path, carried: dict, owned) -> None:
+def _remove_old(old: Path, new: Path, carried: dict, replaced) -> None:
     """Delete the earlier set at ``old``.  An entry that is neither an xfemslip
     output nor carried over (written into DIR while the swap ran) is moved
     into the new folder, never deleted."""
@@ -463,9 +486,7 @@ def _remove_old(old: Path, new: Path, carried: dict, owned) -> None:
         with os.scandir(src) as entries:
             for entry in entries:
                 path = Path(entry.path)
-                if src == old and (
-                    entry.name in owned or _TEMP_FILE.fullmatch(entry.name)
-                ):
+                if src == old and _replaced(entry.name, replaced):
                     _remove_tree(path)
                 elif entry.is_dir(follow_symlinks=False):
                     stack.append((path, dst / entry.name))
@@ -500,3 +521,63 @@ def _remove_tree(path: Path) -> None:
             os.unlink(path)
     if os.path.lexists(path):
         logger.warning("could not remove %s", path)
+
+
+# --------------------------------------------------------------------------- #
+# Sets of single files
+# --------------------------------------------------------------------------- #
+
+
+def replace_files(writes: Mapping[Path, Callable[[Path], None] | None]) -> list[Path]:
+    """Write a set of single files that may lie in different folders.
+
+    Parameters
+    ----------
+    writes : mapping of final path -> ``write(tmp_path)`` or None
+        Each function writes its file completely to the path it is given.  A
+        path mapped to None is no longer part of the set and is deleted.
+
+    Returns the paths written.  Each path is locked (``.NAME.lock``, as a
+    folder) while the set is written; every file is first written to a
+    temporary sibling, and only when all are complete are the earlier files of
+    the set deleted and the new ones renamed in.  So the names never show files
+    of two runs; a process killed in the microseconds between the first and
+    the last rename leaves part of the new set and none of the earlier one,
+    and no temporary file survives the next write of the set.
+
+    Raises
+    ------
+    UsageError
+        Another process is writing one of the paths.
+    OutputError
+        A file cannot be written; no file of the set has changed then.
+    """
+    finals = sorted(Path(path) for path in writes)
+    temps: dict[Path, Path] = {}
+    current = finals[0] if finals else None
+    try:
+        with contextlib.ExitStack() as stack:
+            for current in finals:
+                current.parent.mkdir(parents=True, exist_ok=True)
+                stack.enter_context(folder_lock(current, current))
+                _clean_leftovers(current)
+            with interrupt.deferred():
+                for current in finals:
+                    if writes[current] is not None:
+                        temps[current] = _sibling(current, "tmp", os.getpid())
+                        writes[current](temps[current])
+                        interrupt.checkpoint()
+                for current in finals:
+                    with contextlib.suppress(FileNotFoundError):
+                        os.unlink(current)
+                for current, tmp in temps.items():
+                    os.replace(tmp, current)
+    except OSError as err:
+        raise OutputError(f"cannot write {current}: {_reason(err)}") from None
+    except OutputError as err:  # from a writer that names its temporary file
+        err.args = (str(err).replace(str(temps.get(current)), str(current)),)
+        raise
+    finally:
+        for tmp in temps.values():
+            _remove_tree(tmp)
+    return list(temps)

@@ -17,6 +17,7 @@ data array ``run_id`` (1,) int64, the PVD as a comment.
 from __future__ import annotations
 
 import logging
+import re
 import shutil
 from collections.abc import Mapping, Sequence
 from pathlib import Path
@@ -291,3 +292,28 @@ def _add_field_data(src: Path, dst: Path, run_id: int) -> None:
         at = head.index(_GRID_TAG) + len(_GRID_TAG)
         fout.write(head[:at] + _FIELD_DATA.format(run_id).encode() + head[at:])
         shutil.copyfileobj(fin, fout, 1 << 20)
+
+
+_VTU_RUN_ID = re.compile(rb'Name="run_id" NumberOfTuples="1" format="ascii">\s*(\d+)')
+_PVD_RUN_ID = re.compile(rb"<!-- xfemslip run_id (\d+) -->")
+
+
+def read_run_id(path: Path | str) -> int | None:
+    """The ``run_id`` of a VTU or PVD file written here (None when it has none
+    or cannot be read); only the file's first 4 kB are read."""
+    path = Path(path)
+    pattern = _PVD_RUN_ID if path.suffix == ".pvd" else _VTU_RUN_ID
+    try:
+        with open(path, "rb") as fh:
+            match = pattern.search(fh.read(4096))
+    except OSError:
+        return None
+    return int(match[1]) if match else None
+
+
+def pvd_files(path: Path | str) -> list[str]:
+    """The data set files a PVD names (relative to it)."""
+    from xml.etree import ElementTree
+
+    root = ElementTree.parse(path).getroot()
+    return [item.get("file", "") for item in root.iter("DataSet")]
