@@ -106,7 +106,10 @@ def deferred() -> Iterator[None]:
     ends.  Outside ``sigterm_as_interrupt`` (a library caller) the block
     installs the handler itself, main thread only."""
     own = _in_main_thread() and signal.getsignal(signal.SIGINT) is not _handler
-    previous = {sig: signal.signal(sig, _handler) for sig in _SIGNALS} if own else {}
+    previous = {}
+    if own:  # a library caller: nothing was recorded before this block
+        _State.pending = None
+        previous = {sig: signal.signal(sig, _handler) for sig in _SIGNALS}
     _State.depth += 1
     try:
         yield

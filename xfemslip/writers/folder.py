@@ -37,7 +37,8 @@ renamed) is refused too.
 
 Test hook: with ``XFEMSLIP_TEST_PAUSE=<point>`` in the environment the
 process prints ``xfemslip: test pause at <point>`` to stderr and waits there
-(until a signal arrives, then goes on) at the named point: ``locked`` (lock
+until a signal arrives (which is then handled as anywhere else) at the named
+point: ``locked`` (lock
 taken, before any work), ``staged`` (the new set complete in the staging
 folder), ``swapped`` (after the exchange, before the earlier set is deleted),
 ``half-swapped`` (between the two renames of the fallback).  The fault tests
@@ -95,7 +96,7 @@ class Staging:
 
     display: Path  # the folder as the user named it (for messages)
     final: Path  # the same, resolved (symlinks followed)
-    path: Path  # the staging folder: write every file of the set here
+    path: Path | None  # the staging folder: write every file of the set here
     committed: bool = False  # the swap has happened
 
 
@@ -161,7 +162,6 @@ def folder_lock(final: Path, display: Path) -> Iterator[None]:
     try:
         os.ftruncate(fd, 0)
         os.pwrite(fd, f"{os.getpid()}\n".encode(), 0)
-        pause_for_test("locked")
         yield
     finally:
         with contextlib.suppress(OSError):
@@ -224,27 +224,34 @@ def output_folder(
     display = Path(folder)
     final = _resolve(display)
     created = _make_parents(final, display)
-    stage = None
+    stage = Staging(display, final, None)
     try:
         with folder_lock(final, display):
-            _clean_leftovers(final)
-            _check_target(final, display, overwrite, results)
-            stage = Staging(display, final, _make_staging(final, display))
             try:
+                pause_for_test("locked")
+                _clean_leftovers(final)
+                _check_target(final, display, overwrite, results)
+                stage.path = _make_staging(final, display)
                 yield stage
                 with interrupt.deferred():
                     _commit(stage, owned)
             except BaseException as exc:
-                if not stage.committed:
-                    _remove_tree(stage.path)
-                if isinstance(exc, KeyboardInterrupt):
-                    exc.add_note(_interrupted_note(stage, created))
-                if isinstance(exc, OutputError):  # name the file as the user will
-                    exc.args = (str(exc).replace(str(stage.path), str(display)),)
+                _unwind(stage, created, exc)
                 raise
     finally:
-        if stage is None or not stage.committed:
+        if not stage.committed:
             _remove_created(created)
+
+
+def _unwind(stage: Staging, created: list[Path], exc: BaseException) -> None:
+    """Delete the staging folder of a set that was not swapped in; let the
+    error say what the folder holds, in the user's name for it."""
+    if stage.path is not None and not stage.committed:
+        _remove_tree(stage.path)
+    if isinstance(exc, KeyboardInterrupt):
+        exc.add_note(_interrupted_note(stage, created))
+    if isinstance(exc, OutputError) and stage.path is not None:
+        exc.args = (str(exc).replace(str(stage.path), str(stage.display)),)
 
 
 def _interrupted_note(stage: Staging, created: list[Path]) -> str:
@@ -385,6 +392,7 @@ def _clean_leftovers(final: Path) -> None:
 def _commit(stage: Staging, owned: frozenset[str]) -> None:
     """Swap the complete staging folder into place; delete the earlier set."""
     pause_for_test("staged")
+    interrupt.checkpoint()  # a signal before the swap keeps the earlier set
     final, staging = stage.final, stage.path
     try:
         if not final.is_dir():
