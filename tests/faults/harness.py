@@ -197,6 +197,26 @@ class Scenario:
         assert proc.returncode == 0, proc.stderr
         return signature(out)
 
+    def write_time(self) -> float:
+        """Seconds from B's last converged load step to the end of its run
+        (the write phase; measured, since it depends on the machine's load)."""
+        out = self.work / "timing"
+        shutil.rmtree(out, ignore_errors=True)
+        proc = subprocess.Popen(
+            command("run", "-v", self.case_b, "-o", out),
+            env=self.env,
+            stdout=subprocess.DEVNULL,
+            stderr=subprocess.PIPE,
+            text=True,
+        )
+        last = f"step {self._steps_b}/{self._steps_b} iteration"
+        converged = None
+        for line in proc.stderr:
+            if line.startswith(last) and "iteration 0" not in line:
+                converged = time.monotonic()
+        proc.wait(timeout=TIMEOUT)
+        return time.monotonic() - converged
+
     def fresh_old(self, name: str) -> Path:
         """A folder ``<work>/<name>/out`` holding the complete old result."""
         out = self.work / name / "out"
@@ -287,15 +307,20 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     parser.add_argument("--trials", type=int, default=24)
     parser.add_argument("--code", type=Path, default=ROOT)
-    parser.add_argument("--window", type=float, default=0.45, help="s after solve")
     args = parser.parse_args()
     with tempfile.TemporaryDirectory() as tmp:
         scenario = Scenario(Path(tmp), args.code)
         trials = []
         for sig in (signal.SIGKILL, signal.SIGTERM, signal.SIGINT):
+            window = 1.2 * scenario.write_time()
+            print(f"{signal.Signals(sig).name}: delays 0 to {window:.2f} s", flush=True)
             for k in range(args.trials):
-                delay = args.window * k / max(args.trials - 1, 1)
+                delay = window * k / max(args.trials - 1, 1)
                 trials.append(scenario.kill_while_writing(f"{sig}-{k}", sig, delay))
+        for k in range(args.trials):  # the first milliseconds of writing
+            trial = scenario.kill_while_writing(f"fine-{k}", signal.SIGINT, 0.001 * k)
+            trial.kind = "SIGINT 0-23 ms"
+            trials.append(trial)
         for k in range(args.trials):
             overwrite = [(False, False), (True, True), (False, True), (True, False)]
             trials.append(scenario.race(f"race-{k}", overwrite[k % 4], 0.02 * (k // 4)))
