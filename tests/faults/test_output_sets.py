@@ -410,13 +410,16 @@ def test_exchange_unavailable_falls_back_to_two_renames(
 @pytest.mark.parametrize("staged", [True, False])
 def test_a_swap_cut_between_two_renames_is_finished(scenario, tmp_path, staged):
     """The fallback's window: DIR renamed away, the staging folder not yet
-    renamed in.  The next process to take the folder finishes the swap with
-    the complete staged set, or, without one, restores the earlier set."""
+    renamed in, the killed process's pid in the lock file.  The next process
+    to take the folder finishes the swap with the complete staged set, or,
+    without one, restores the earlier set."""
     out = tmp_path / "out"
     shutil.copytree(scenario.work / "ref-a", tmp_path / ".out.old-4242")
     if staged:
         shutil.copytree(scenario.work / "ref-b", tmp_path / ".out.tmp-4242")
-    folder_module._clean_leftovers(out)
+    (tmp_path / ".out.lock").write_text("4242\n")  # what the killed one left
+    with folder_lock(out, out):
+        pass
     expected = "new" if staged else "old"
     assert harness.classify(out, scenario.sig_a, scenario.sig_b) == expected
     assert harness.leftovers(out) == []

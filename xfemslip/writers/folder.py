@@ -9,9 +9,10 @@ member, ``plot``):
    second process is refused at once (``UsageError``, exit 2) naming that pid.
    The kernel drops the lock of a process that dies, so a stale lock file
    never blocks; the holder deletes it when it is done.
-2. **Leftovers.** Holding the lock, the process deletes what a killed process
-   left beside ``DIR`` (``.DIR.tmp-<pid>``, ``.DIR.old-<pid>``) and logs a
-   warning naming each.
+2. **Leftovers.** A lock file found with the lock free names a killed
+   process; holding the lock, the process deletes what that one left beside
+   ``DIR`` (``.DIR.tmp-<pid>``, ``.DIR.old-<pid>``) and logs a warning naming
+   each (the lock file names the pids, so no folder is searched).
 3. **Staging.** The new set is written into the fresh hidden sibling
    ``.DIR.tmp-<pid>``.
 4. **Swap.** Once every file of the set is complete, entries of ``DIR`` that
@@ -131,7 +132,12 @@ def _reason(err: OSError) -> str:
 
 @contextlib.contextmanager
 def folder_lock(final: Path, display: Path) -> Iterator[None]:
-    """Hold the exclusive lock of the folder ``final`` (``.NAME.lock`` beside it).
+    """Hold the exclusive lock of ``final`` (``.NAME.lock`` beside it).
+
+    The lock file names its holder's pid, followed by the pids of killed
+    holders whose leftovers are not cleaned yet.  A lock file that is there
+    when the lock is free was left by a killed process: its leftovers beside
+    ``final`` are cleaned first (:func:`_clean_leftovers`).
 
     Raises
     ------
@@ -149,24 +155,38 @@ def folder_lock(final: Path, display: Path) -> Iterator[None]:
         try:
             fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
         except BlockingIOError:
-            holder = os.pread(fd, 32, 0).decode("ascii", "replace").strip()
+            holder = (_pids(fd) or ["unknown"])[0]
             os.close(fd)
             raise UsageError(
                 f"{display} is being written by another xfemslip process "
-                f"(pid {holder or 'unknown'}); wait for it to end or choose "
-                "another output folder"
+                f"(pid {holder}); wait for it to end or choose another "
+                "output folder"
             ) from None
         if _same_file(fd, path):
             break
         os.close(fd)  # the holder deleted the file after we opened it: again
     try:
-        os.ftruncate(fd, 0)
-        os.pwrite(fd, f"{os.getpid()}\n".encode(), 0)
+        stale = _pids(fd)
+        _write_pids(fd, [os.getpid(), *stale])  # still listed if we are killed
+        _clean_leftovers(final, stale)
+        _write_pids(fd, [os.getpid()])
         yield
     finally:
         with contextlib.suppress(OSError):
             os.unlink(path)  # still holding the lock: see _same_file
         os.close(fd)
+
+
+def _pids(fd: int) -> list[int]:
+    """The pids a lock file lists (holder first)."""
+    text = os.pread(fd, 4096, 0).decode("ascii", "replace")
+    return [int(word) for word in text.split() if word.isdigit()]
+
+
+def _write_pids(fd: int, pids: list[int]) -> None:
+    data = (" ".join(str(pid) for pid in dict.fromkeys(pids)) + "\n").encode()
+    os.pwrite(fd, data, 0)
+    os.ftruncate(fd, len(data))
 
 
 def _same_file(fd: int, path: Path) -> bool:
@@ -229,7 +249,6 @@ def output_folder(
         with folder_lock(final, display):
             try:
                 pause_for_test("locked")
-                _clean_leftovers(final)
                 _check_target(final, display, overwrite, results)
                 stage.path = _make_staging(final, display)
                 yield stage
@@ -351,37 +370,29 @@ def _make_staging(final: Path, display: Path) -> Path:
     return staging
 
 
-def _clean_leftovers(final: Path) -> None:
-    """Delete (or finish) what killed processes left beside ``final``."""
-    pattern = re.compile(rf"\.{re.escape(final.name)}\.(old|tmp)-(\d+)")
-    found = []
-    with os.scandir(final.parent) as entries:
-        for entry in entries:
-            match = pattern.fullmatch(entry.name)
-            if match:
-                found.append((match[1], int(match[2]), Path(entry.path)))
-    for kind, pid, path in sorted(found):  # "old" before "tmp"
-        if not os.path.lexists(path):
-            continue
-        if kind == "old" and not os.path.lexists(final):
+def _clean_leftovers(final: Path, pids: list[int]) -> None:
+    """Delete (or finish) what the killed processes ``pids`` left beside
+    ``final``: staging folders, temporary files, a half-done swap."""
+    for pid in pids:
+        old, staging = _sibling(final, "old", pid), _sibling(final, "tmp", pid)
+        if os.path.lexists(old) and not os.path.lexists(final):
             # a two-rename swap cut between its renames: the staging folder of
             # that process was complete, so finish its swap
-            staging = _sibling(final, "tmp", pid)
-            os.rename(staging if staging.is_dir() else path, final)
+            os.rename(staging if staging.is_dir() else old, final)
             logger.warning(
                 "finished the swap of %s that an interrupted xfemslip process "
                 "(pid %d) had begun",
                 final,
                 pid,
             )
-            if not os.path.lexists(path):
-                continue
-        _remove_tree(path)
-        logger.warning(
-            "removed %s, left by an interrupted xfemslip process (pid %d)",
-            path,
-            pid,
-        )
+        for path in (old, staging):
+            if os.path.lexists(path):
+                _remove_tree(path)
+                logger.warning(
+                    "removed %s, left by an interrupted xfemslip process (pid %d)",
+                    path,
+                    pid,
+                )
 
 
 # --------------------------------------------------------------------------- #
@@ -568,7 +579,6 @@ def replace_files(writes: Mapping[Path, Callable[[Path], None] | None]) -> list[
             for current in finals:
                 current.parent.mkdir(parents=True, exist_ok=True)
                 stack.enter_context(folder_lock(current, current))
-                _clean_leftovers(current)
             with interrupt.deferred():
                 for current in finals:
                     if writes[current] is not None:

@@ -114,11 +114,12 @@ def write_result(
     # fails (a full disk) is then a plain OSError here, whereas a failure inside
     # the HDF5 library leaves identifiers it cannot close, which print errors
     # from their destructors and can crash the interpreter at exit.
-    image = io.BytesIO()
-    with h5py.File(image, "w", track_order=True) as h5:
-        _fill(h5, root_attrs, points, cells, steps, load_steps)
-    with atomic_path(Path(path)) as tmp, open(tmp, "wb") as fh:
-        fh.write(image.getbuffer())
+    with atomic_path(Path(path)) as tmp:
+        image = io.BytesIO()
+        with h5py.File(image, "w", track_order=True) as h5:
+            _fill(h5, root_attrs, points, cells, steps, load_steps)
+        with open(tmp, "wb") as fh:
+            fh.write(image.getbuffer())
 
 
 def _fill(h5, root_attrs, points, cells, steps, load_steps) -> None:
