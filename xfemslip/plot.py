@@ -381,10 +381,10 @@ def figure_mohr(results: Sequence[ResultData]) -> Figure:
 
 def _save_all(out_dir: Path, makers: dict, formats, dpi=DPI) -> list[Path]:
     """Write ``<out_dir>/<name>.<fmt>`` for each figure ``makers[name]()`` and
-    format, as one set (:func:`xfemslip.writers.folder.replace_files`: no
+    format, as one set (:func:`xfemslip.writers.fileset.replace_files`: no
     figure of an earlier command is left beside the new ones half-replaced);
     returns the paths in the order of ``makers`` and ``formats``."""
-    from xfemslip.writers.folder import replace_files
+    from xfemslip.writers.fileset import replace_files
 
     figures: dict[str, Figure] = {}
 

@@ -42,7 +42,8 @@ import numpy as np
 
 from xfemslip.errors import OutputError, UsageError, XfemslipError
 from xfemslip.sweep_dfn import DFN_SUMMARY, is_dfn_sweep, write_dfn_summary
-from xfemslip.writers.folder import folder_lock, replace_files
+from xfemslip.writers.fileset import replace_files
+from xfemslip.writers.lock import folder_lock
 
 logger = logging.getLogger(__name__)
 

@@ -86,7 +86,7 @@ CSV_FIELDS = (
 
 def write_outputs(report: Report, csv_path: Path | None, plot: Path | None) -> None:
     """``--csv`` and ``--plot``, written as one set (``replace_files``)."""
-    from xfemslip.writers.folder import replace_files
+    from xfemslip.writers.fileset import replace_files
 
     writes = {}
     if csv_path is not None:

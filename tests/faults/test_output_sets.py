@@ -26,7 +26,8 @@ from click.testing import CliRunner
 from tests.faults import harness
 from xfemslip.cli import cli
 from xfemslip.writers import folder as folder_module
-from xfemslip.writers.folder import folder_lock, replace_files
+from xfemslip.writers.fileset import replace_files
+from xfemslip.writers.lock import folder_lock
 
 
 @pytest.fixture(scope="module")

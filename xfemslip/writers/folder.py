@@ -2,13 +2,14 @@
 
 The rule (``output-format.md``, *Output folders*), for every command that
 writes a set of files into a folder ``DIR`` (``run``, ``deplete``, a sweep
-member, ``plot``):
+member); sets of single files are :mod:`xfemslip.writers.fileset`:
 
 1. **Lock.** The process takes an exclusive ``flock`` on ``.DIR.lock`` beside
    ``DIR`` (the file holds its pid) and keeps it until the set is in place.  A
    second process is refused at once (``UsageError``, exit 2) naming that pid.
    The kernel drops the lock of a process that dies, so a stale lock file
-   never blocks; the holder deletes it when it is done.
+   never blocks; the holder deletes it when it is done
+   (:mod:`xfemslip.writers.lock`).
 2. **Leftovers.** A lock file found with the lock free names a killed
    process; holding the lock, the process deletes what that one left beside
    ``DIR`` (``.DIR.tmp-<pid>``, ``.DIR.old-<pid>``) and logs a warning naming
@@ -36,14 +37,13 @@ it).  ``DIR`` itself is never written into, so a folder the user cannot
 write is refused before any work, and a mount point (which cannot be
 renamed) is refused too.
 
-Test hook: with ``XFEMSLIP_TEST_PAUSE=<point>`` in the environment the
-process prints ``xfemslip: test pause at <point>`` to stderr and waits there
-until a signal arrives (which is then handled as anywhere else) at the named
-point: ``locked`` (lock
-taken, before any work), ``staged`` (the new set complete in the staging
-folder), ``swapped`` (after the exchange, before the earlier set is deleted),
-``half-swapped`` (between the two renames of the fallback).  The fault tests
-use it to kill a process exactly between two renames.
+Test hook: with ``XFEMSLIP_TEST_PAUSE=<point>`` in the environment the process
+prints ``xfemslip: test pause at <point>`` to stderr and waits there until a
+signal arrives (which is then handled as anywhere else) at the named point:
+``locked`` (lock taken, before any work), ``staged`` (the new set complete in
+the staging folder), ``swapped`` (after the exchange, before the earlier set
+is deleted), ``half-swapped`` (between the two renames of the fallback). The
+fault tests use it to kill a process exactly between two renames.
 """
 
 from __future__ import annotations
@@ -51,19 +51,19 @@ from __future__ import annotations
 import contextlib
 import ctypes
 import errno
-import fcntl
 import logging
 import os
 import re
 import shutil
 import sys
 import time
-from collections.abc import Callable, Iterator, Mapping
+from collections.abc import Iterator
 from dataclasses import dataclass
 from pathlib import Path
 
 from xfemslip import interrupt
 from xfemslip.errors import OutputError, UsageError
+from xfemslip.writers.lock import folder_lock, reason, remove_tree, sibling
 
 logger = logging.getLogger(__name__)
 
@@ -113,92 +113,6 @@ def pause_for_test(point: str) -> None:
     if interrupt.deferring():  # a deferred signal is honoured when the block ends
         return
     interrupt.checkpoint()
-
-
-def _sibling(final: Path, kind: str, pid: int | None = None) -> Path:
-    """``.NAME.<kind>[-pid]`` beside ``final``."""
-    suffix = "" if pid is None else f"-{pid}"
-    return final.parent / f".{final.name}.{kind}{suffix}"
-
-
-def _reason(err: OSError) -> str:
-    return " ".join(str(err.strerror or err).split())
-
-
-# --------------------------------------------------------------------------- #
-# Lock
-# --------------------------------------------------------------------------- #
-
-
-@contextlib.contextmanager
-def folder_lock(final: Path, display: Path) -> Iterator[None]:
-    """Hold the exclusive lock of ``final`` (``.NAME.lock`` beside it).
-
-    The lock file names its holder's pid, followed by the pids of killed
-    holders whose leftovers are not cleaned yet.  A lock file that is there
-    when the lock is free was left by a killed process: its leftovers beside
-    ``final`` are cleaned first (:func:`_clean_leftovers`).
-
-    Raises
-    ------
-    UsageError
-        Another process holds it (the message names its pid).
-    OutputError
-        The lock file cannot be created (read-only or missing parent).
-    """
-    path = _sibling(final, "lock")
-    while True:
-        try:
-            fd = os.open(path, os.O_RDWR | os.O_CREAT | os.O_CLOEXEC, 0o644)
-        except OSError as err:
-            raise OutputError(f"cannot write {display}: {_reason(err)}") from None
-        try:
-            fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
-        except BlockingIOError:
-            holder = (_pids(fd) or ["unknown"])[0]
-            os.close(fd)
-            raise UsageError(
-                f"{display} is being written by another xfemslip process "
-                f"(pid {holder}); wait for it to end or choose another "
-                "output folder"
-            ) from None
-        if _same_file(fd, path):
-            break
-        os.close(fd)  # the holder deleted the file after we opened it: again
-    try:
-        stale = _pids(fd)
-        _write_pids(fd, [os.getpid(), *stale])  # still listed if we are killed
-        _clean_leftovers(final, stale)
-        _write_pids(fd, [os.getpid()])
-        yield
-    finally:
-        with contextlib.suppress(OSError):
-            os.unlink(path)  # still holding the lock: see _same_file
-        os.close(fd)
-
-
-def _pids(fd: int) -> list[int]:
-    """The pids a lock file lists (holder first)."""
-    text = os.pread(fd, 4096, 0).decode("ascii", "replace")
-    return [int(word) for word in text.split() if word.isdigit()]
-
-
-def _write_pids(fd: int, pids: list[int]) -> None:
-    data = (" ".join(str(pid) for pid in dict.fromkeys(pids)) + "\n").encode()
-    os.pwrite(fd, data, 0)
-    os.ftruncate(fd, len(data))
-
-
-def _same_file(fd: int, path: Path) -> bool:
-    """Whether ``path`` still names the file open as ``fd`` (a holder deletes
-    the lock file before it releases the lock, so a waiter that opened the
-    deleted file must not count it as taken)."""
-    try:
-        named = os.stat(path)
-    except FileNotFoundError:
-        return False
-    held = os.fstat(fd)
-    return (named.st_dev, named.st_ino) == (held.st_dev, held.st_ino)
 
 
 # --------------------------------------------------------------------------- #
@@ -266,7 +180,7 @@ def _unwind(stage: Staging, created: list[Path], exc: BaseException) -> None:
     """Delete the staging folder of a set that was not swapped in; let the
     error say what the folder holds, in the user's name for it."""
     if stage.path is not None and not stage.committed:
-        _remove_tree(stage.path)
+        remove_tree(stage.path)
     if isinstance(exc, KeyboardInterrupt):
         exc.add_note(_interrupted_note(stage, created))
     if isinstance(exc, OutputError) and stage.path is not None:
@@ -306,9 +220,9 @@ def _make_parents(final: Path, display: Path) -> list[Path]:
     except OSError as err:
         _remove_created(missing)
         if err.errno == errno.ENAMETOOLONG:
-            raise UsageError(f"{display}: {_reason(err)}") from None
+            raise UsageError(f"{display}: {reason(err)}") from None
         raise OutputError(
-            f"cannot create output directory {display}: {_reason(err)}"
+            f"cannot create output directory {display}: {reason(err)}"
         ) from None
     return missing
 
@@ -360,39 +274,14 @@ def _holds_cwd(final: Path) -> bool:
 
 
 def _make_staging(final: Path, display: Path) -> Path:
-    staging = _sibling(final, "tmp", os.getpid())
+    staging = sibling(final, "tmp", os.getpid())
     try:
         os.mkdir(staging)
     except OSError as err:
         if err.errno == errno.ENAMETOOLONG:
-            raise UsageError(f"{display}: {_reason(err)}") from None
-        raise OutputError(f"cannot write {display}: {_reason(err)}") from None
+            raise UsageError(f"{display}: {reason(err)}") from None
+        raise OutputError(f"cannot write {display}: {reason(err)}") from None
     return staging
-
-
-def _clean_leftovers(final: Path, pids: list[int]) -> None:
-    """Delete (or finish) what the killed processes ``pids`` left beside
-    ``final``: staging folders, temporary files, a half-done swap."""
-    for pid in pids:
-        old, staging = _sibling(final, "old", pid), _sibling(final, "tmp", pid)
-        if os.path.lexists(old) and not os.path.lexists(final):
-            # a two-rename swap cut between its renames: the staging folder of
-            # that process was complete, so finish its swap
-            os.rename(staging if staging.is_dir() else old, final)
-            logger.warning(
-                "finished the swap of %s that an interrupted xfemslip process "
-                "(pid %d) had begun",
-                final,
-                pid,
-            )
-        for path in (old, staging):
-            if os.path.lexists(path):
-                _remove_tree(path)
-                logger.warning(
-                    "removed %s, left by an interrupted xfemslip process (pid %d)",
-                    path,
-                    pid,
-                )
 
 
 # --------------------------------------------------------------------------- #
@@ -416,7 +305,7 @@ def _commit(stage: Staging, owned: frozenset[str]) -> None:
         old = _swap(staging, final)
         stage.committed = True
     except OSError as err:
-        raise OutputError(f"cannot write {stage.display}: {_reason(err)}") from None
+        raise OutputError(f"cannot write {stage.display}: {reason(err)}") from None
     pause_for_test("swapped")
     _remove_old(old, final, carried, replaced)
 
@@ -468,7 +357,7 @@ def _swap(staging: Path, final: Path) -> Path:
     except OSError as err:
         if err.errno not in _EXCHANGE_UNSUPPORTED:
             raise
-    old = _sibling(final, "old", os.getpid())
+    old = sibling(final, "old", os.getpid())
     os.rename(final, old)
     pause_for_test("half-swapped")
     try:
@@ -506,14 +395,14 @@ def _remove_old(old: Path, new: Path, carried: dict, replaced) -> None:
             for entry in entries:
                 path = Path(entry.path)
                 if src == old and _replaced(entry.name, replaced):
-                    _remove_tree(path)
+                    remove_tree(path)
                 elif entry.is_dir(follow_symlinks=False):
                     stack.append((path, dst / entry.name))
                 elif carried.get(path.relative_to(old)) == _identity(path):
                     path.unlink()
                 else:
                     _rescue(path, dst / entry.name)
-    _remove_tree(old)
+    remove_tree(old)
 
 
 def _identity(path: Path) -> tuple[int, int]:
@@ -528,74 +417,4 @@ def _rescue(path: Path, target: Path) -> None:
         os.replace(path, target)
         logger.warning("kept %s, written into the folder while it was replaced", target)
     except OSError as err:
-        logger.warning("could not keep %s: %s", path, _reason(err))
-
-
-def _remove_tree(path: Path) -> None:
-    """Delete a file or folder tree; a failure is logged, never raised."""
-    if os.path.isdir(path) and not os.path.islink(path):
-        shutil.rmtree(path, ignore_errors=True)
-    else:
-        with contextlib.suppress(OSError):
-            os.unlink(path)
-    if os.path.lexists(path):
-        logger.warning("could not remove %s", path)
-
-
-# --------------------------------------------------------------------------- #
-# Sets of single files
-# --------------------------------------------------------------------------- #
-
-
-def replace_files(writes: Mapping[Path, Callable[[Path], None] | None]) -> list[Path]:
-    """Write a set of single files that may lie in different folders.
-
-    Parameters
-    ----------
-    writes : mapping of final path -> ``write(tmp_path)`` or None
-        Each function writes its file completely to the path it is given.  A
-        path mapped to None is no longer part of the set and is deleted.
-
-    Returns the paths written.  Each path is locked (``.NAME.lock``, as a
-    folder) while the set is written; every file is first written to a
-    temporary sibling, and only when all are complete are the earlier files of
-    the set deleted and the new ones renamed in.  So the names never show files
-    of two runs; a process killed in the microseconds between the first and
-    the last rename leaves part of the new set and none of the earlier one,
-    and no temporary file survives the next write of the set.
-
-    Raises
-    ------
-    UsageError
-        Another process is writing one of the paths.
-    OutputError
-        A file cannot be written; no file of the set has changed then.
-    """
-    finals = sorted(Path(path) for path in writes)
-    temps: dict[Path, Path] = {}
-    current = finals[0] if finals else None
-    try:
-        with contextlib.ExitStack() as stack:
-            for current in finals:
-                current.parent.mkdir(parents=True, exist_ok=True)
-                stack.enter_context(folder_lock(current, current))
-            with interrupt.deferred():
-                for current in finals:
-                    if writes[current] is not None:
-                        temps[current] = _sibling(current, "tmp", os.getpid())
-                        writes[current](temps[current])
-                        interrupt.checkpoint()
-                for current in finals:
-                    with contextlib.suppress(FileNotFoundError):
-                        os.unlink(current)
-                for current, tmp in temps.items():
-                    os.replace(tmp, current)
-    except OSError as err:
-        raise OutputError(f"cannot write {current}: {_reason(err)}") from None
-    except OutputError as err:  # from a writer that names its temporary file
-        err.args = (str(err).replace(str(temps.get(current)), str(current)),)
-        raise
-    finally:
-        for tmp in temps.values():
-            _remove_tree(tmp)
-    return list(temps)
+        logger.warning("could not keep %s: %s", path, reason(err))
