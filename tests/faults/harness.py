@@ -190,6 +190,7 @@ class Scenario:
         proc = subprocess.run(
             command("run", "-q", case, "-o", out),
             env=self.env,
+            cwd=self.work,  # python -m would import a package in the cwd
             capture_output=True,
             text=True,
             timeout=TIMEOUT,
@@ -205,6 +206,7 @@ class Scenario:
         proc = subprocess.Popen(
             command("run", "-v", self.case_b, "-o", out),
             env=self.env,
+            cwd=self.work,  # python -m would import a package in the cwd
             stdout=subprocess.DEVNULL,
             stderr=subprocess.PIPE,
             text=True,
@@ -231,6 +233,7 @@ class Scenario:
         proc = subprocess.Popen(
             command("run", "-v", self.case_b, "-o", out, "--overwrite"),
             env=self.env,
+            cwd=self.work,  # python -m would import a package in the cwd
             stderr=subprocess.PIPE,
             stdout=subprocess.DEVNULL,
             text=True,
@@ -271,6 +274,7 @@ class Scenario:
                 subprocess.Popen(
                     command(*args),
                     env=self.env,
+                    cwd=self.work,
                     stdout=subprocess.DEVNULL,
                     stderr=subprocess.PIPE,
                     text=True,
