@@ -319,4 +319,7 @@ cli.add_command(dfn)
 
 def main() -> None:
     """Console-script entry point (``xfemslip``)."""
+    from xfemslip import interrupt
+
+    interrupt.for_process()
     cli(prog_name="xfemslip")

@@ -35,10 +35,24 @@ class Terminated(KeyboardInterrupt):
 
 
 class _State:
-    """The signal recorded and not yet raised, and the ``deferred`` depth."""
+    """The signal recorded and not yet raised, the ``deferred`` depth, and
+    whether the process is the command-line program (:func:`for_process`)."""
 
     pending: KeyboardInterrupt | None = None
     depth = 0
+    process = False
+
+
+def for_process() -> None:
+    """The process runs one command and exits (the console script): a signal
+    after the command has ended is ignored instead of killing the process in
+    its last milliseconds (by SIGTERM's default action, or as a Ctrl-C that
+    click reports as "Aborted!" with exit 1 after a complete result)."""
+    _State.process = True
+
+
+def _too_late(signum, frame):
+    """The command has ended and its output is complete: let it exit."""
 
 
 def _exception(signum: int) -> KeyboardInterrupt:
@@ -71,7 +85,7 @@ def sigterm_as_interrupt() -> Iterator[None]:
         checkpoint()
     finally:
         for sig, handler in previous.items():
-            signal.signal(sig, handler)
+            signal.signal(sig, _too_late if _State.process else handler)
 
 
 _SIGNALS = (signal.SIGINT, signal.SIGTERM)
