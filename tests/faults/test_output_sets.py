@@ -517,3 +517,18 @@ def test_result_h5_run_id_matches_every_file(scenario):
         stamped = int(f.attrs["run_id"])
     assert harness.run_ids(out) == {stamped}
     assert len(list(out.rglob("*.vtu"))) == 2 + 2 * 6  # premise: every VTU seen
+
+
+@pytest.mark.parametrize("length", [246, 250])
+def test_a_name_too_long_for_the_hidden_files_is_refused(
+    runner, scenario, tmp_path, length
+):
+    """A folder name that fits the file system but not with the lock or the
+    staging folder beside it (``.NAME.lock``, ``.NAME.tmp-<pid>``): exit 2,
+    one line, nothing written."""
+    out = tmp_path / ("x" * length)
+    result = runner.invoke(cli, ["run", "-q", str(scenario.case_a), "-o", str(out)])
+    assert result.exit_code == 2
+    (line,) = result.stderr.splitlines()
+    assert line.startswith(f"Error: {out}: ") and "too long" in line
+    assert list(tmp_path.iterdir()) == []

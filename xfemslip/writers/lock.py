@@ -14,6 +14,7 @@ opened the deleted file sees that and opens the new one.
 from __future__ import annotations
 
 import contextlib
+import errno
 import fcntl
 import logging
 import os
@@ -69,6 +70,11 @@ def folder_lock(final: Path, display: Path) -> Iterator[None]:
         try:
             fd = os.open(path, os.O_RDWR | os.O_CREAT | os.O_CLOEXEC, 0o644)
         except OSError as err:
+            if err.errno == errno.ENAMETOOLONG:  # the name is the user's input
+                raise UsageError(
+                    f"{display}: name too long for the hidden files beside it "
+                    f"({path.name!r}, {len(os.fsencode(path.name))} bytes)"
+                ) from None
             raise OutputError(f"cannot write {display}: {reason(err)}") from None
         try:
             fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
