@@ -79,7 +79,7 @@ def sigterm_as_interrupt() -> Iterator[None]:
         yield
         return
     _State.pending = None
-    previous = {sig: signal.signal(sig, _handler) for sig in _SIGNALS}
+    previous = _install()
     try:
         yield
         checkpoint()
@@ -89,6 +89,17 @@ def sigterm_as_interrupt() -> Iterator[None]:
 
 
 _SIGNALS = (signal.SIGINT, signal.SIGTERM)
+
+
+def _install() -> dict:
+    """Put ``_handler`` on SIGINT and SIGTERM; returns the handlers replaced.
+    A signal the process was started with ignored (``nohup``, a background
+    job of a script) stays ignored, as Python itself keeps it."""
+    previous = {}
+    for sig in _SIGNALS:
+        if signal.getsignal(sig) is not signal.SIG_IGN:
+            previous[sig] = signal.signal(sig, _handler)
+    return previous
 
 
 def checkpoint() -> None:
@@ -119,11 +130,13 @@ def deferred() -> Iterator[None]:
     recorded one at the next :func:`checkpoint` or when the outermost block
     ends.  Outside ``sigterm_as_interrupt`` (a library caller) the block
     installs the handler itself, main thread only."""
-    own = _in_main_thread() and signal.getsignal(signal.SIGINT) is not _handler
+    own = _in_main_thread() and all(
+        signal.getsignal(sig) is not _handler for sig in _SIGNALS
+    )
     previous = {}
     if own:  # a library caller: nothing was recorded before this block
         _State.pending = None
-        previous = {sig: signal.signal(sig, _handler) for sig in _SIGNALS}
+        previous = _install()
     _State.depth += 1
     try:
         yield

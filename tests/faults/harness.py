@@ -63,6 +63,12 @@ def command(*args: str) -> list[str]:
     return [sys.executable, "-m", "xfemslip", *map(str, args)]
 
 
+def interactive_signals() -> None:
+    """In the child before exec: SIGINT as in a terminal (a harness started
+    in the background inherits it ignored, and so would its children)."""
+    signal.signal(signal.SIGINT, signal.SIG_DFL)
+
+
 def environment(code: Path = ROOT, **extra: str) -> dict:
     env = dict(os.environ, PYTHONPATH=str(code), **extra)
     env.pop("XFEMSLIP_TEST_PAUSE", None)
@@ -191,6 +197,7 @@ class Scenario:
             command("run", "-q", case, "-o", out),
             env=self.env,
             cwd=self.work,  # python -m would import a package in the cwd
+            preexec_fn=interactive_signals,
             capture_output=True,
             text=True,
             timeout=TIMEOUT,
@@ -207,6 +214,7 @@ class Scenario:
             command("run", "-v", self.case_b, "-o", out),
             env=self.env,
             cwd=self.work,  # python -m would import a package in the cwd
+            preexec_fn=interactive_signals,
             stdout=subprocess.DEVNULL,
             stderr=subprocess.PIPE,
             text=True,
@@ -234,6 +242,7 @@ class Scenario:
             command("run", "-v", self.case_b, "-o", out, "--overwrite"),
             env=self.env,
             cwd=self.work,  # python -m would import a package in the cwd
+            preexec_fn=interactive_signals,
             stderr=subprocess.PIPE,
             stdout=subprocess.DEVNULL,
             text=True,
@@ -275,6 +284,7 @@ class Scenario:
                     command(*args),
                     env=self.env,
                     cwd=self.work,
+                    preexec_fn=interactive_signals,
                     stdout=subprocess.DEVNULL,
                     stderr=subprocess.PIPE,
                     text=True,

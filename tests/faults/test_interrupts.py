@@ -116,3 +116,28 @@ def test_sigterm_ends_every_command_in_one_line(tmp_path, args):
     assert last.startswith("Error: interrupted (SIGTERM)")
     assert "Traceback" not in err
     assert sorted(p.name for p in tmp_path.iterdir()) == []
+
+
+def test_a_signal_ignored_at_start_stays_ignored(tmp_path):
+    """A run started with SIGINT ignored (``nohup``, a background job of a
+    script, as Python itself keeps it) is not ended by SIGINT; SIGTERM still
+    ends it."""
+    case = harness.write_case(tmp_path, "case.toml", 8, 1)
+    proc = subprocess.Popen(
+        harness.command("run", "-q", case, "-o", tmp_path / "out"),
+        env=harness.environment(XFEMSLIP_TEST_PAUSE="locked"),
+        preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_IGN),
+        stdout=subprocess.DEVNULL,
+        stderr=subprocess.PIPE,
+        text=True,
+    )
+    assert proc.stderr.readline().startswith("xfemslip: test pause at locked")
+    proc.send_signal(signal.SIGINT)
+    with pytest.raises(subprocess.TimeoutExpired):  # still paused: ignored
+        proc.wait(timeout=1.0)
+    proc.send_signal(signal.SIGTERM)
+    _, err = proc.communicate(timeout=harness.TIMEOUT)
+    assert proc.returncode == 143
+    assert err.splitlines() == [
+        f"Error: interrupted (SIGTERM); nothing was written to {tmp_path / 'out'}"
+    ]

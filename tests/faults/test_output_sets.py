@@ -52,6 +52,7 @@ def _start(scenario, out: Path, point: str, *extra: str) -> subprocess.Popen:
     proc = subprocess.Popen(
         harness.command("run", "-q", scenario.case_b, "-o", out, *extra),
         env=env,
+        preexec_fn=harness.interactive_signals,
         stdout=subprocess.DEVNULL,
         stderr=subprocess.PIPE,
         text=True,
