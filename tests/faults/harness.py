@@ -184,6 +184,7 @@ class Scenario:
     """An old complete result (case A) in ``out`` and a new case B to run over it."""
 
     def __init__(self, work: Path, code: Path = ROOT, *, n=(10, 40), steps=(3, 20)):
+        work.mkdir(parents=True, exist_ok=True)
         self.work, self.code = work, code
         self.case_a = write_case(work, "a.toml", n[0], steps[0])
         self.case_b = write_case(work, "b.toml", n[1], steps[1])
@@ -233,13 +234,17 @@ class Scenario:
         shutil.copytree(self.work / "ref-a", out)
         return out
 
-    def kill_while_writing(self, name: str, sig: int, delay: float) -> Trial:
-        """Run B over A with --overwrite; ``sig`` ``delay`` s after B's last
-        load step converged (its write phase)."""
+    def kill_while_writing(
+        self, name: str, sig: int, delay: float, anchor: str = "converged"
+    ) -> Trial:
+        """Run B over A with --overwrite and send ``sig`` ``delay`` s after the
+        ``anchor``: ``converged`` (B's last load step converged: its write
+        phase begins) or ``h5`` (the temporary file of result.h5 appears, in
+        the folder or in the staging folder beside it)."""
         out = self.fresh_old(name)
-        last = f"step {self._steps_b}/{self._steps_b} iteration"
+        verbose = "-v" if anchor == "converged" else "-q"
         proc = subprocess.Popen(
-            command("run", "-v", self.case_b, "-o", out, "--overwrite"),
+            command("run", verbose, self.case_b, "-o", out, "--overwrite"),
             env=self.env,
             cwd=self.work,  # python -m would import a package in the cwd
             preexec_fn=interactive_signals,
@@ -247,11 +252,16 @@ class Scenario:
             stdout=subprocess.DEVNULL,
             text=True,
         )
-        lines = []
-        for line in proc.stderr:
-            lines.append(line)
-            if line.startswith(last) and "eta = " in line and "iteration 0" not in line:
-                break
+        if anchor == "converged":
+            last = f"step {self._steps_b}/{self._steps_b} iteration"
+            for line in proc.stderr:
+                if line.startswith(last) and "iteration 0" not in line:
+                    break
+        else:
+            temp = f".result.h5.tmp-{proc.pid}"
+            paths = (out / temp, out.parent / f".out.tmp-{proc.pid}" / temp)
+            while proc.poll() is None and not any(map(os.path.exists, paths)):
+                time.sleep(0.0001)
         time.sleep(delay)
         proc.send_signal(sig)
         rest = proc.stderr.read()
@@ -311,7 +321,7 @@ def tally(trials: list[Trial]) -> dict:
             table[t.kind]["leftovers"] += 1
         if not t.clean_exit:
             table[t.kind]["unclean exit"] += 1
-        if t.returncode == 0 and t.kind in ("SIGINT", "SIGTERM") and t.outcome != "new":
+        if t.returncode == 0 and t.kind.startswith("SIG") and t.outcome != "new":
             table[t.kind]["exit 0 without new result"] += 1
         table[t.kind][f"exit {t.returncode}"] += 1
     return table
@@ -321,27 +331,36 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     parser.add_argument("--trials", type=int, default=24)
     parser.add_argument("--code", type=Path, default=ROOT)
+    parser.add_argument(
+        "--parts", default="kills,h5,races", help="comma-separated: kills,h5,races"
+    )
     args = parser.parse_args()
+    parts = args.parts.split(",")
     with tempfile.TemporaryDirectory() as tmp:
-        scenario = Scenario(Path(tmp), args.code)
+        scenario = Scenario(Path(tmp) / "kills", args.code)
         trials = []
         for sig in (signal.SIGKILL, signal.SIGTERM, signal.SIGINT):
+            if "kills" not in parts:
+                break
             window = 1.2 * scenario.write_time()
             print(f"{signal.Signals(sig).name}: delays 0 to {window:.2f} s", flush=True)
             for k in range(args.trials):
                 delay = window * k / max(args.trials - 1, 1)
                 trials.append(scenario.kill_while_writing(f"{sig}-{k}", sig, delay))
-        for k in range(args.trials):  # the first milliseconds of writing
-            trial = scenario.kill_while_writing(f"fine-{k}", signal.SIGINT, 0.001 * k)
-            trial.kind = "SIGINT 0-23 ms"
+        for k in range(args.trials if "h5" in parts else 0):
+            # Ctrl-C in the first milliseconds of writing result.h5
+            delay = 0.0005 * k
+            trial = scenario.kill_while_writing(f"h5-{k}", signal.SIGINT, delay, "h5")
+            trial.kind = f"SIGINT 0-{0.5 * (args.trials - 1):g} ms into result.h5"
             trials.append(trial)
-        for k in range(args.trials):
+        # two runs of about the same size, so that their writes overlap
+        racing = Scenario(Path(tmp) / "races", args.code, n=(40, 40), steps=(19, 20))
+        for k in range(args.trials if "races" in parts else 0):
             overwrite = [(False, False), (True, True), (False, True), (True, False)]
-            trials.append(scenario.race(f"race-{k}", overwrite[k % 4], 0.02 * (k // 4)))
+            trials.append(racing.race(f"race-{k}", overwrite[k % 4], 0.01 * (k // 4)))
         for kind, counts in tally(trials).items():
             print(
-                f"{kind:8s} "
-                + ", ".join(f"{k}: {v}" for k, v in sorted(counts.items()))
+                f"{kind}: " + ", ".join(f"{k}: {v}" for k, v in sorted(counts.items()))
             )
 
 
