@@ -45,14 +45,10 @@ class _State:
 
 def for_process() -> None:
     """The process runs one command and exits (the console script): a signal
-    after the command has ended is ignored instead of killing the process in
-    its last milliseconds (by SIGTERM's default action, or as a Ctrl-C that
-    click reports as "Aborted!" with exit 1 after a complete result)."""
+    after the command has ended (its output complete) is ignored instead of
+    killing the process in its last milliseconds (by SIGTERM's default action,
+    or as a Ctrl-C that click reports as "Aborted!" with exit 1)."""
     _State.process = True
-
-
-def _too_late(signum, frame):
-    """The command has ended and its output is complete: let it exit."""
 
 
 def _exception(signum: int) -> KeyboardInterrupt:
@@ -85,7 +81,9 @@ def sigterm_as_interrupt() -> Iterator[None]:
         checkpoint()
     finally:
         for sig, handler in previous.items():
-            signal.signal(sig, _too_late if _State.process else handler)
+            # SIG_IGN, not a Python handler: the interpreter's finalization
+            # puts SIG_DFL back in place of Python handlers, not of SIG_IGN
+            signal.signal(sig, signal.SIG_IGN if _State.process else handler)
 
 
 _SIGNALS = (signal.SIGINT, signal.SIGTERM)

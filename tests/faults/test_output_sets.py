@@ -152,10 +152,10 @@ def test_sigterm_into_a_fresh_folder_writes_nothing(scenario, tmp_path):
 # ------------------------------------------------------------ kill delays
 
 
-def _delay_sweep(scenario, sig: int, delays) -> list[harness.Trial]:
+def _delay_sweep(scenario, sig: int, delays, tag: str) -> list[harness.Trial]:
     trials = []
     for k, delay in enumerate(delays):
-        trial = scenario.kill_while_writing(f"{sig}-{k}-{delay}", sig, delay)
+        trial = scenario.kill_while_writing(f"{tag}-{sig}-{k}", sig, delay)
         assert trial.outcome in ("old", "new"), (delay, trial)
         assert trial.clean_exit, (delay, trial.stderr)
         if sig != signal.SIGKILL:
@@ -169,7 +169,7 @@ def _delay_sweep(scenario, sig: int, delays) -> list[harness.Trial]:
 
 def test_sigkill_over_the_write_phase(scenario):
     """Four SIGKILLs spread over the write phase: old or new, never mixed."""
-    trials = _delay_sweep(scenario, signal.SIGKILL, [0.0, 0.03, 0.08, 0.15])
+    trials = _delay_sweep(scenario, signal.SIGKILL, [0.0, 0.03, 0.08, 0.15], "few")
     assert {t.outcome for t in trials} <= {"old", "new"}
 
 
@@ -182,7 +182,7 @@ def test_signals_over_the_write_phase(scenario, sig):
     measured on this machine now."""
     window = 1.2 * scenario.write_time()
     delays = [k * 0.001 for k in range(12)] + [window * k / 12 for k in range(1, 13)]
-    trials = _delay_sweep(scenario, sig, delays)
+    trials = _delay_sweep(scenario, sig, delays, "many")
     if sig != signal.SIGKILL:
         assert any(t.returncode == 128 + sig for t in trials)  # premise: it hit
 
@@ -215,9 +215,9 @@ def test_a_second_run_into_a_folder_being_written_is_refused(scenario):
     assert harness.leftovers(out) == []
 
 
-def _races(scenario, overwrite, staggers) -> None:
+def _races(scenario, overwrite, staggers, tag: str) -> None:
     for k, stagger in enumerate(staggers):
-        name = f"race-{overwrite}-{k}"
+        name = f"{tag}-race-{overwrite}-{k}"
         trial = scenario.race(name, overwrite, stagger)
         assert trial.outcome in ("old", "new"), trial
         assert trial.leftovers == [], trial
@@ -235,7 +235,7 @@ def _races(scenario, overwrite, staggers) -> None:
 def test_racing_runs_leave_one_whole_run(scenario, overwrite):
     """Two runs started together into a fresh folder: exactly one whole run
     is there, every file with its run_id; a refused run says why in one line."""
-    _races(scenario, overwrite, [0.0])
+    _races(scenario, overwrite, [0.0], "once")
 
 
 @pytest.mark.slow
@@ -243,7 +243,7 @@ def test_racing_runs_leave_one_whole_run(scenario, overwrite):
     "overwrite", [(False, False), (True, True), (False, True), (True, False)]
 )
 def test_racing_runs_at_many_offsets(scenario, overwrite):
-    _races(scenario, overwrite, [0.005 * k for k in range(8)])
+    _races(scenario, overwrite, [0.005 * k for k in range(8)], "offsets")
 
 
 def test_stale_lock_of_a_dead_process_does_not_block(scenario, tmp_path):
