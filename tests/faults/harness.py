@@ -258,10 +258,17 @@ class Scenario:
                 if line.startswith(last) and "iteration 0" not in line:
                     break
         else:
-            temp = f".result.h5.tmp-{proc.pid}"
-            paths = (out / temp, out.parent / f".out.tmp-{proc.pid}" / temp)
+            temp, staging = f".result.h5.tmp-{proc.pid}", f".out.tmp-{proc.pid}"
+            paths = (out / temp, out.parent / staging / temp)
+            staged = out.parent / staging / "result.h5"  # renamed, not swapped
             while proc.poll() is None and not any(map(os.path.exists, paths)):
+                if staged.exists():
+                    break
                 time.sleep(0.0001)
+            else:
+                if proc.poll() is not None:  # it ended before the anchor was seen
+                    proc.wait()
+                    return Trial("missed", "missed", proc.returncode, [], "")
         time.sleep(delay)
         proc.send_signal(sig)
         rest = proc.stderr.read()
