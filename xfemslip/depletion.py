@@ -20,7 +20,8 @@ already slipped below the bracket, which breaks the linearity).
 Outputs (in ``out_dir``): ``result.h5`` (and VTU) of the steps as ``run``
 writes them, ``critical_depletion.csv``, ``slip_vs_depletion.csv``, and with
 ``plot=True`` ``slip_vs_depletion.png`` and ``depletion_field.png``
-(matplotlib imported only then).
+(matplotlib imported only then); all of them one output set, swapped into
+``out_dir`` whole (:mod:`xfemslip.writers.folder`).
 """
 
 from __future__ import annotations
@@ -36,6 +37,7 @@ import numpy as np
 from xfemslip.contact import SLIP
 from xfemslip.errors import ConvergenceError, UsageError
 from xfemslip.simulation import solve_and_write
+from xfemslip.writers.atomic import atomic_path
 
 logger = logging.getLogger(__name__)
 
@@ -368,6 +370,27 @@ def deplete(spec, out_dir=None, *, tolerance=None, plot=False, overwrite=False):
             "non-zero pore-pressure change to search for the first slip"
         )
     tolerance = resolved_tolerance(spec, tolerance)
+    report = DepletionReport(onsets=[], tolerance=tolerance)
+
+    def finish(done, folder: Path) -> None:
+        """The tables and figures, into the output set before it is swapped in."""
+        # a failed step keeps what converged, as `run` does
+        report.onsets = (
+            done.value
+            if done.value is not None
+            else getattr(done.failure, "onsets", [])
+        )
+        report.rows = _table_rows(done.model, done.results, change)
+        report.out_dir = done.out_dir
+        names = write_tables(report, folder)
+        if plot:
+            from xfemslip.plot_depletion import plot_field, plot_slip_vs_depletion
+
+            names.append(plot_slip_vs_depletion(report, folder))
+            if done.results:
+                names.append(plot_field(done.model, done.results[-1], folder))
+        report.written = [done.out_dir / Path(name).name for name in names]
+
     done = solve_and_write(
         spec,
         out_dir,
@@ -375,38 +398,18 @@ def deplete(spec, out_dir=None, *, tolerance=None, plot=False, overwrite=False):
         lambda solver, model: critical_depletion(
             solver, model, spec.loading.steps, tolerance
         )[0],
+        finish,
     )
-    model, results, failure, out_dir = (
-        done.model,
-        done.results,
-        done.failure,
-        done.out_dir,
-    )
-    # a failed step keeps what converged, as `run` does
-    onsets = done.value if failure is None else failure.onsets
-    report = DepletionReport(
-        onsets=onsets,
-        rows=_table_rows(model, results, change),
-        tolerance=tolerance,
-        out_dir=out_dir,
-    )
-    report.written = write_tables(report, out_dir)
-    if plot:
-        from xfemslip.plot_depletion import plot_field, plot_slip_vs_depletion
-
-        report.written.append(plot_slip_vs_depletion(report, out_dir))
-        if results:
-            report.written.append(plot_field(model, results[-1], out_dir))
     report.wall_time_s = time.perf_counter() - start
-    if failure is not None:
-        raise failure
+    if done.failure is not None:
+        raise done.failure
     return report
 
 
 def write_tables(report: DepletionReport, out_dir: Path) -> list:
     """critical_depletion.csv and slip_vs_depletion.csv; returns their paths."""
     crit = out_dir / "critical_depletion.csv"
-    with crit.open("w", newline="") as fh:
+    with atomic_path(crit) as tmp, tmp.open("w", newline="") as fh:
         w = csv.writer(fh)
         w.writerow(
             [
@@ -434,7 +437,7 @@ def write_tables(report: DepletionReport, out_dir: Path) -> list:
                 ]
             )
     table = out_dir / "slip_vs_depletion.csv"
-    with table.open("w", newline="") as fh:
+    with atomic_path(table) as tmp, tmp.open("w", newline="") as fh:
         w = csv.writer(fh)
         n = len(report.onsets)
         head = ["step", "load_factor", "dp_Pa"]
