@@ -242,8 +242,12 @@ def _read_name(root: _Table, path: Path) -> str | None:
     name = root.string("name", path.stem)
     if name is None or not root.has("name"):
         return name
-    if any(c in "/\\" or ord(c) < 32 for c in name):
-        message = "must not contain a path separator or a control character"
+    if any(c in "/\\" or ord(c) < 32 for c in name) or name in (".", ".."):
+        message = (
+            "must not be . or .."
+            if name in (".", "..")
+            else "must not contain a path separator or a control character"
+        )
         root.error("name", f"{message}, got {name!r} (it names the output directory)")
         return None
     size = len(name.encode("utf-8", "surrogatepass"))

@@ -7,6 +7,7 @@ validated); import the public names from ``xfemslip.case``, not from here.
 
 from __future__ import annotations
 
+import math
 from typing import Any
 
 import numpy as np
@@ -23,6 +24,7 @@ from xfemslip.case_specs import (
     SolverSpec,
 )
 from xfemslip.case_tables import _fmt
+from xfemslip.screen import coulomb_margin, plane_stresses
 
 
 def _with_unit(value: Any, unit: str) -> str:
@@ -93,6 +95,47 @@ def _describe_fracture(spec: FractureSpec) -> list[str]:
         f"      {params}",
         f"      tip: {tip}",
     ]
+
+
+def in_situ_margin(spec: CaseSpec, fracture: FractureSpec) -> tuple[float, float]:
+    """(Coulomb margin [Pa], effective normal traction [Pa]) of the in-situ
+    stress on the fracture's least stable segment.
+
+    margin = c + f max(0, -sigma_n') - |tau| (xfemslip.screen), with
+    sigma_n' = sigma_n + p0 on the faces (Terzaghi); the segment with the
+    smallest margin counts, and a segment in tension (sigma_n' > 0) before any
+    other.  (nan, nan) without ``loading.initial_stress``.
+    """
+    stress = spec.loading.initial_stress
+    if stress is None:
+        return math.nan, math.nan
+    p0 = spec.pore_pressure.initial if spec.pore_pressure is not None else 0.0
+    seg = np.diff(fracture.points, axis=0)
+    angles = np.degrees(np.arctan2(seg[:, 1], seg[:, 0]))
+    sigma_n, tau = plane_stresses(stress, angles)
+    sigma_n = sigma_n + p0
+    margin = coulomb_margin(sigma_n, tau, fracture.friction, fracture.cohesion)
+    worst = int(np.argmax(sigma_n)) if np.any(sigma_n > 0.0) else int(np.argmin(margin))
+    return float(margin[worst]), float(sigma_n[worst])
+
+
+def _margin_text(spec: CaseSpec, fracture: FractureSpec) -> str:
+    """What the in-situ stress does to the fracture, for ``check``."""
+    margin, sigma_n = in_situ_margin(spec, fracture)
+    if math.isnan(margin):
+        return ""
+    if sigma_n > 0.0:
+        return (
+            f"in-situ: in tension across it (sigma_n' = {_fmt(sigma_n / 1e6)} MPa): "
+            "it opens in load step 1"
+        )
+    text = f"in-situ Coulomb margin {_fmt(margin / 1e6)} MPa"
+    if margin < 0.0:
+        return text + (
+            " (shear above the friction limit: the excess is released and the "
+            "fracture slips in load step 1)"
+        )
+    return text + " (stable)"
 
 
 def _describe_edge(name: str, edge: EdgeSpec) -> str:
@@ -193,6 +236,10 @@ def describe(spec: CaseSpec) -> str:
     ]
     for fracture in spec.fractures:
         lines += _describe_fracture(fracture)
+        margin = _margin_text(spec, fracture)
+        if margin:
+            lines[-1] += f"; {margin}" if fracture.source else ""
+            lines += [] if fracture.source else [f"      {margin}"]
     steps = spec.loading.steps
     lines += [
         f"loading: stress {_describe_stress(spec.loading.stress)}; "

@@ -12,44 +12,14 @@ import numpy as np
 
 from xfemslip.case_grid import _Grid
 from xfemslip.case_tables import _exact, _fmt, _Table
+from xfemslip.polyline import first_meeting
 
 
-def _orientation(a: np.ndarray, b: np.ndarray, c: np.ndarray) -> np.ndarray:
-    """Sign of the cross product (b - a) x (c - a); arrays (..., 2)."""
-    ab, ac = b - a, c - a
-    return np.sign(ab[..., 0] * ac[..., 1] - ab[..., 1] * ac[..., 0])
-
-
-def _in_box(a: np.ndarray, b: np.ndarray, c: np.ndarray) -> np.ndarray:
-    """Whether c lies in the bounding box of segment a-b; arrays (..., 2)."""
-    return np.all((np.minimum(a, b) <= c) & (c <= np.maximum(a, b)), axis=-1)
-
-
-@np.errstate(over="ignore", invalid="ignore")
 def _self_intersection(points: np.ndarray) -> tuple[int, int] | None:
-    """First pair (i, j) of segments that cross, touch or fold back, else None."""
-    a, b = points[:-1], points[1:]
-    n = len(a)
-    for i in range(n - 1):
-        # Adjacent segments share b[i]; they overlap only if the path turns back.
-        turn = b[i] - a[i], b[i + 1] - a[i + 1]
-        if _orientation(a[i], b[i], b[i + 1]) == 0 and float(np.dot(*turn)) < 0.0:
-            return i, i + 1
-        p, q, r, s = a[i], b[i], a[i + 2 :], b[i + 2 :]
-        if not len(r):
-            continue
-        o1, o2 = _orientation(p, q, r), _orientation(p, q, s)
-        o3, o4 = _orientation(r, s, p), _orientation(r, s, q)
-        hit = (
-            ((o1 * o2) < 0) & ((o3 * o4) < 0)
-            | (o1 == 0) & _in_box(p, q, r)
-            | (o2 == 0) & _in_box(p, q, s)
-            | (o3 == 0) & _in_box(r, s, p)
-            | (o4 == 0) & _in_box(r, s, q)
-        )
-        if hit.any():
-            return i, i + 2 + int(np.flatnonzero(hit)[0])
-    return None
+    """First pair (i, j) of segments that cross, touch or fold back, else None
+    (a sweep over the segments' boxes: the cost follows the pairs that come
+    close, not all pairs)."""
+    return first_meeting(points)
 
 
 def _segment_meets_box(a: np.ndarray, b: np.ndarray, lo, hi) -> bool:

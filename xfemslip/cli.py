@@ -13,7 +13,7 @@ Exit codes:
   ``xfemslip.errors.UsageError``, a missing case file, bad command-line
   options);
 - 130: interrupted (Ctrl-C, SIGINT); 143: terminated (SIGTERM, see
-  ``xfemslip.interrupt``).
+  ``xfemslip.interrupt``); the line says what the output folder holds.
 
 A library error is reported as one line ``Error: <message>`` on stderr; the
 traceback is shown only with ``--debug``.  Any other exception is a bug and
@@ -102,9 +102,11 @@ def _one_line(err: BaseException) -> str:
 
 @contextlib.contextmanager
 def _reported_errors(debug: bool) -> Iterator[None]:
-    """Turn library errors and Ctrl-C into ``Error: ...`` and an exit code."""
+    """Turn library errors, Ctrl-C and SIGTERM into ``Error: ...`` and an exit
+    code (``xfemslip.interrupt``: a signal always ends the command)."""
     try:
-        yield
+        with sigterm_as_interrupt():
+            yield
     except XfemslipError as err:
         if debug:
             click.secho(traceback.format_exc().rstrip(), err=True, dim=True)
@@ -115,9 +117,12 @@ def _reported_errors(debug: bool) -> Iterator[None]:
         if debug:
             click.secho(traceback.format_exc().rstrip(), err=True, dim=True)
         term = isinstance(err, Terminated)
+        # the notes say what each output folder holds (xfemslip.writers.folder)
+        left = "; ".join(getattr(err, "__notes__", ())) or (
+            "no partial file is left under a final name"
+        )
         click.echo(
-            f"Error: interrupted ({'SIGTERM' if term else 'SIGINT'}); a file being "
-            "written was removed, no partial file is left under a final name",
+            f"Error: interrupted ({'SIGTERM' if term else 'SIGINT'}); {left}",
             err=True,
         )
         raise click.exceptions.Exit(
@@ -239,8 +244,11 @@ def cli() -> None:
     """XFEM frictional contact on 2D fractures, driven by TOML case files."""
     from xfemslip.cli_env import check_environment
 
-    with _reported_errors(debug=False):
+    try:  # not inside _reported_errors: the command installs the signal handlers
         check_environment()
+    except UsageError as err:
+        click.echo(f"Error: {_one_line(err)}", err=True)
+        raise click.exceptions.Exit(EXIT_USAGE) from None
 
 
 def _solve_options(command):
@@ -289,7 +297,7 @@ def run(
     debug: bool,
 ) -> None:
     """Run the case file CASE and write its results."""
-    with _reported_errors(debug), sigterm_as_interrupt():
+    with _reported_errors(debug):
         _configure_logging(verbose, quiet)
         spec = _load(case)
         from xfemslip.simulation import run_case
@@ -411,4 +419,7 @@ cli.add_command(dfn)
 
 def main() -> None:
     """Console-script entry point (``xfemslip``)."""
+    from xfemslip import interrupt
+
+    interrupt.for_process()
     cli(prog_name="xfemslip")

@@ -74,8 +74,9 @@ def sweep(sweep_file, output, jobs, scheduler, force, verbose, debug) -> None:
     """Run the cases of the sweep file SWEEP (base case + varied parameters).
 
     Each case writes into <folder>/<case id>/; cases with a converged result
-    of the same case text are skipped.  A table of the results is printed
-    and written to <folder>/summary.csv.  Exit 1 if a case failed.
+    of the same case text are skipped, cases that cannot be built are
+    reported and not run.  A table of the results is printed and written to
+    <folder>/summary.csv.  Exit 1 if a case failed or was refused.
     """
     with _reported_errors(debug):
         _configure_logging(verbose, not verbose)
@@ -111,15 +112,16 @@ def sweep(sweep_file, output, jobs, scheduler, force, verbose, debug) -> None:
             )
         click.echo(format_table(spec.keys, rows))
         _print_dfn_aggregate(spec.keys, rows)
-        failed = [r for r in rows if r.status == "failed"]
+        failed = sum(r.status == "failed" for r in rows)
+        refused = sum(r.status == "refused" for r in rows)
         skipped = sum(r.status == "skipped" for r in rows)
         click.echo(
-            f"summary: {folder / 'summary.csv'} ({len(rows) - len(failed)} "
+            f"summary: {folder / 'summary.csv'} ({len(rows) - failed - refused} "
             f"done, {skipped} of them skipped as already done, "
-            f"{len(failed)} failed)",
+            f"{failed} failed, {refused} refused)",
             err=True,
         )
-        if failed:
+        if failed or refused:
             raise click.exceptions.Exit(EXIT_FAILURE)
 
 

@@ -168,6 +168,38 @@ class ContactSet:
     def tangent_matrix(self, result: ContactResult):
         return coo_block(self.dofs, result.blocks, self.n_dofs)
 
+    def in_situ_force(self, zero: ContactResult) -> np.ndarray:
+        """Contact force (n_dofs,) [N/m] of the in-situ traction sigma0 . n
+        carried at zero jump, whether or not the contact law admits it.
+
+        The bulk starts in equilibrium with the initial stress, and so do the
+        faces with the traction sigma0 . n: this force is the reference state
+        that the Newton residual subtracts.  ``zero`` is the law at zero
+        jump.  Where the in-situ traction is admissible the law carries it
+        (STICK) and this is ``zero.force`` itself, bit for bit.  Where it is
+        not (shear above c - f p_N, or tension across the fracture) the law
+        carries less, and the difference, ``in_situ_force - zero.force``, is
+        the excess that the first load step releases: the fracture slips or
+        opens by what it drives, as if the same stress had been applied from
+        zero to the body with the fracture already in it.
+        """
+        bad = zero.state != STICK
+        if not bad.any():
+            return zero.force
+        # the stick traction at zero jump, as the kernel forms it:
+        # p_T = k_T (g_T - g_T^p) with g_T = 0, p_N = k_N g_N + p_N0 = p_N0
+        pt = self.kt[bad] * (0.0 - self.slip_committed[bad])
+        dpn = self.pn0[bad] - zero.pn[bad]
+        dpt = pt - zero.pt[bad]
+        excess = (
+            dpn[:, None] * self.normal[bad] + dpt[:, None] * self.tangent[bad]
+        )  # (b, 2) [Pa]
+        w = self.weight[bad][:, None] * self.coef[bad]  # (b, J) [m]
+        f = np.empty((w.shape[0], 2 * w.shape[1]))
+        f[:, 0::2] = w * excess[:, 0:1]
+        f[:, 1::2] = w * excess[:, 1:2]
+        return zero.force + scatter_vector(self.dofs[bad], f, self.n_dofs)
+
     def commit(self, result: ContactResult) -> None:
         self.slip_committed = result.slip_plastic.copy()
         self.state_committed = result.state.copy()

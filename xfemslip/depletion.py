@@ -20,7 +20,8 @@ already slipped below the bracket, which breaks the linearity).
 Outputs (in ``out_dir``): ``result.h5`` (and VTU) of the steps as ``run``
 writes them, ``critical_depletion.csv``, ``slip_vs_depletion.csv``, and with
 ``plot=True`` ``slip_vs_depletion.png`` and ``depletion_field.png``
-(matplotlib imported only then).
+(matplotlib imported only then); all of them one output set, swapped into
+``out_dir`` whole (:mod:`xfemslip.writers.folder`).
 """
 
 from __future__ import annotations
@@ -36,11 +37,22 @@ import numpy as np
 from xfemslip.contact import SLIP
 from xfemslip.errors import ConvergenceError, UsageError
 from xfemslip.simulation import solve_and_write
+from xfemslip.writers.atomic import atomic_path
 
 logger = logging.getLogger(__name__)
 
 # Default bisection tolerance, relative to |pore_pressure.change|.
 DEFAULT_REL_TOLERANCE = 1.0e-3
+# The smallest meaningful tolerance, relative to |pore_pressure.change|: a
+# converged state at load factor lambda satisfies its equilibrium only to
+# solver.tolerance times the applied load, so whether a patch slips is decided
+# to about that fraction of the change; RESOLUTION_FLOOR stands for round-off
+# when the solver tolerance is set very small (the load factor itself resolves
+# 2.2e-16).  A smaller --tolerance is raised to this with a warning.
+RESOLUTION_FLOOR = 1.0e-12
+# Hard cap on the bisection solves of one fracture: a bracket of one load step
+# reaches the smallest tolerance above in at most log2(1 / 1e-12) = 40 halvings.
+MAX_BISECTIONS = 60
 
 
 @dataclass
@@ -170,6 +182,8 @@ def _step_and_bisect(solver, model, steps, tolerance, onsets) -> None:
     found = [False] * n_frac
     centres = _patch_centres(model)
     pn0, pt0 = contact.pn0.copy(), contact.pt_committed.copy()
+    for fi in range(n_frac):
+        found[fi] = _slips_in_situ(solver.in_situ, contact, onsets[fi], fi, centres)
     u = np.zeros(model.problem.n_dofs)
     lam0 = 0.0
     prev_res = None
@@ -198,6 +212,28 @@ def _step_and_bisect(solver, model, steps, tolerance, onsets) -> None:
         _restore(contact, after)
         prev_res = res
         lam0 = lam1
+
+
+def _slips_in_situ(zero, contact, onset, fi, centres) -> bool:
+    """A fracture whose in-situ shear is already above the friction limit
+    slips at dp = 0 (the first load step releases the excess: see
+    ContactSet.in_situ_force); its onset is the initial state, found without
+    bisection, at the patch with the largest excess.  Returns whether it does."""
+    over = np.nonzero(_slipping(contact, zero, fi))[0]
+    if over.size == 0:
+        return False
+    excess = np.abs(contact.kt[over] * contact.slip_committed[over]) - np.abs(
+        zero.pt[over]
+    )
+    onset.dp_lower = onset.dp_upper = onset.dp_linear = 0.0
+    onset.x, onset.y = (float(v) for v in centres[over[np.argmax(excess)]])
+    logger.info(
+        "fracture %d: slips in situ, before any depletion (its initial shear "
+        "traction is above the friction limit on %d patch(es))",
+        onset.fracture,
+        over.size,
+    )
+    return True
 
 
 def _drop_nonlinear(onsets) -> None:
@@ -250,9 +286,18 @@ def _bisect(solver, contact, onset, fi, bracket, tolerance, centres, change):
     lo, hi = bracket.lam0, bracket.lam1
     hi_res = solver.completed[-1].contact
     lo_res = bracket.res0
-    width = tolerance / abs(change) if change else 0.0
+    width = tolerance / abs(change)
     while hi - lo > width:
         mid = 0.5 * (lo + hi)
+        if onset.trials >= MAX_BISECTIONS or not lo < mid < hi:
+            logger.warning(
+                "fracture %d: bisection stopped after %d solves with the bracket "
+                "%.3g Pa wide (the load factor cannot be split further)",
+                onset.fracture,
+                onset.trials,
+                (hi - lo) * abs(change),
+            )
+            break
         res = _trial(solver, contact, bracket, mid)
         onset.trials += 1
         if _slipping(contact, res, fi).any():
@@ -281,6 +326,28 @@ def _bisect(solver, contact, onset, fi, bracket, tolerance, centres, change):
     return lo_res.pn, lo_res.pt
 
 
+def resolved_tolerance(spec, tolerance=None) -> float:
+    """Bisection tolerance [Pa] for a case: the default, or the one asked for,
+    raised with a warning to the smallest the load steps resolve
+    (RESOLUTION_FLOOR)."""
+    change = abs(spec.pore_pressure.change)
+    if tolerance is None:
+        return DEFAULT_REL_TOLERANCE * change
+    if not tolerance > 0.0:
+        raise UsageError(f"--tolerance must be > 0 Pa, got {tolerance!r}")
+    smallest = change * max(spec.solver.tolerance, RESOLUTION_FLOOR)
+    if tolerance < smallest:
+        logger.warning(
+            "--tolerance %.3g Pa is below what the load steps resolve "
+            "(|pore_pressure.change| x solver.tolerance = %.3g Pa); using %.3g Pa",
+            tolerance,
+            smallest,
+            smallest,
+        )
+        return smallest
+    return tolerance
+
+
 def deplete(spec, out_dir=None, *, tolerance=None, plot=False, overwrite=False):
     """Critical depletion of every fracture of a case; writes the outputs.
 
@@ -297,10 +364,33 @@ def deplete(spec, out_dir=None, *, tolerance=None, plot=False, overwrite=False):
     if not spec.fractures:
         raise UsageError(f"{spec.path}: xfemslip deplete needs at least one fracture")
     change = spec.pore_pressure.change
-    if tolerance is None:
-        tolerance = DEFAULT_REL_TOLERANCE * abs(change)
-    if not tolerance > 0.0:
-        raise UsageError(f"--tolerance must be > 0 Pa, got {tolerance!r}")
+    if change == 0.0:
+        raise UsageError(
+            f"{spec.path}: pore_pressure.change = 0: xfemslip deplete needs a "
+            "non-zero pore-pressure change to search for the first slip"
+        )
+    tolerance = resolved_tolerance(spec, tolerance)
+    report = DepletionReport(onsets=[], tolerance=tolerance)
+
+    def finish(done, folder: Path) -> None:
+        """The tables and figures, into the output set before it is swapped in."""
+        # a failed step keeps what converged, as `run` does
+        report.onsets = (
+            done.value
+            if done.value is not None
+            else getattr(done.failure, "onsets", [])
+        )
+        report.rows = _table_rows(done.model, done.results, change)
+        report.out_dir = done.out_dir
+        names = write_tables(report, folder)
+        if plot:
+            from xfemslip.plot_depletion import plot_field, plot_slip_vs_depletion
+
+            names.append(plot_slip_vs_depletion(report, folder))
+            if done.results:
+                names.append(plot_field(done.model, done.results[-1], folder))
+        report.written = [done.out_dir / Path(name).name for name in names]
+
     done = solve_and_write(
         spec,
         out_dir,
@@ -308,38 +398,18 @@ def deplete(spec, out_dir=None, *, tolerance=None, plot=False, overwrite=False):
         lambda solver, model: critical_depletion(
             solver, model, spec.loading.steps, tolerance
         )[0],
+        finish,
     )
-    model, results, failure, out_dir = (
-        done.model,
-        done.results,
-        done.failure,
-        done.out_dir,
-    )
-    # a failed step keeps what converged, as `run` does
-    onsets = done.value if failure is None else failure.onsets
-    report = DepletionReport(
-        onsets=onsets,
-        rows=_table_rows(model, results, change),
-        tolerance=tolerance,
-        out_dir=out_dir,
-    )
-    report.written = write_tables(report, out_dir)
-    if plot:
-        from xfemslip.plot_depletion import plot_field, plot_slip_vs_depletion
-
-        report.written.append(plot_slip_vs_depletion(report, out_dir))
-        if results:
-            report.written.append(plot_field(model, results[-1], out_dir))
     report.wall_time_s = time.perf_counter() - start
-    if failure is not None:
-        raise failure
+    if done.failure is not None:
+        raise done.failure
     return report
 
 
 def write_tables(report: DepletionReport, out_dir: Path) -> list:
     """critical_depletion.csv and slip_vs_depletion.csv; returns their paths."""
     crit = out_dir / "critical_depletion.csv"
-    with crit.open("w", newline="") as fh:
+    with atomic_path(crit) as tmp, tmp.open("w", newline="") as fh:
         w = csv.writer(fh)
         w.writerow(
             [
@@ -367,7 +437,7 @@ def write_tables(report: DepletionReport, out_dir: Path) -> list:
                 ]
             )
     table = out_dir / "slip_vs_depletion.csv"
-    with table.open("w", newline="") as fh:
+    with atomic_path(table) as tmp, tmp.open("w", newline="") as fh:
         w = csv.writer(fh)
         n = len(report.onsets)
         head = ["step", "load_factor", "dp_Pa"]

@@ -11,11 +11,13 @@ distance along the outward tip direction d_k (positive ahead of the tip).
 from __future__ import annotations
 
 import logging
+import math
 from dataclasses import dataclass, replace
 
 import numpy as np
 
 from xfemslip.errors import GeometryError
+from xfemslip.polyline import first_meeting, simplify
 
 logger = logging.getLogger(__name__)
 
@@ -23,6 +25,27 @@ logger = logging.getLogger(__name__)
 # inside a cell are ignored (they touch the cell at a node or an edge only), and
 # end points closer than this to the domain boundary are taken to lie on it.
 GEOMETRY_TOL = 1.0e-9
+
+# Fracture geometry below the mesh resolution (README, Method), in local cell
+# sizes h (the smaller side of the cell holding a vertex).  A clipped polyline
+# with a segment shorter than SIMPLIFY_MIN_SEGMENT h is simplified by
+# Douglas-Peucker with a shortest segment (polyline.simplify): it keeps the
+# vertices more than SIMPLIFY_DEVIATION h off the simplified line that lie at
+# least SIMPLIFY_MIN_SEGMENT h from their neighbours in it, and the end points
+# (on the domain boundary where the polyline is clipped).  A kink with arms
+# of a quarter cell or more stays; finer detail (a digitised trace, a zigzag
+# inside one cell) cannot be resolved by one enriched cell and would only
+# multiply the sub-cells and contact points.  No vertex moves by more than
+# h/4, about the error of standard XFEM's nodal level set, which makes each
+# cut straight inside a cell.  Pieces of one fracture in one cell beyond
+# MAX_PIECES_PER_CELL (a polyline folded many times inside a cell, with long
+# strokes) are refused: their sub-cells grow like the square of the count.
+SIMPLIFY_MIN_SEGMENT = 0.25
+SIMPLIFY_DEVIATION = 0.05
+MAX_PIECES_PER_CELL = 12
+# Point-segment pairs per chunk of Fracture.signed_distance (its temporaries
+# take about 100 B a pair).
+DISTANCE_CHUNK = 1 << 19
 
 # Crack-tip treatment when the case does not choose one (see enrichment.py and
 # benchmarks/RESULTS.md): branch functions on the nodes within a radius of each
@@ -124,8 +147,25 @@ class Fracture:
         return J
 
     def signed_distance(self, pts: np.ndarray) -> np.ndarray:
-        """phi at points (n, 2) [m] (eq. 13)."""
+        """phi at points (n, 2) [m] (eq. 13).
+
+        Points x segments arrays are formed in chunks of at most
+        DISTANCE_CHUNK pairs, so the memory stays bounded for a polyline of
+        many segments; each point's value is that of a single pass.
+        """
         pts = np.atleast_2d(np.asarray(pts, dtype=float))
+        rows = max(1, DISTANCE_CHUNK // max(self.length.size, 1))
+        if pts.shape[0] <= rows:
+            return self._signed_distance(pts)
+        return np.concatenate(
+            [
+                self._signed_distance(pts[i : i + rows])
+                for i in range(0, pts.shape[0], rows)
+            ]
+        )
+
+    def _signed_distance(self, pts: np.ndarray) -> np.ndarray:
+        """signed_distance of one chunk of points (n, 2)."""
         a = self.points[:-1]
         d = self.points[1:] - a
         rel = pts[:, None, :] - a[None, :, :]
@@ -254,6 +294,45 @@ def _clip_to_domain(points, box, tol, key):
     return pts[keep], s_offset
 
 
+def _cell_sizes(mesh, pts) -> np.ndarray:
+    """(k,) smaller side [m] of the cell holding each point (k, 2)."""
+    i = np.clip(np.searchsorted(mesh.x, pts[:, 0], side="right") - 1, 0, mesh.nx - 1)
+    j = np.clip(np.searchsorted(mesh.y, pts[:, 1], side="right") - 1, 0, mesh.ny - 1)
+    return np.minimum(np.diff(mesh.x)[i], np.diff(mesh.y)[j])
+
+
+def _resolved(mesh, pts, key):
+    """The clipped polyline pts (k, 2) at the mesh's resolution (see
+    SIMPLIFY_MIN_SEGMENT); logs a warning when vertices are dropped."""
+    h = _cell_sizes(mesh, pts)
+    kept = simplify(pts, h, SIMPLIFY_MIN_SEGMENT, SIMPLIFY_DEVIATION)
+    if kept.size == len(pts):
+        return pts
+    out = pts[kept]
+    h_text = f"{h.min():.3g} m"
+    if f"{h.max():.3g}" != f"{h.min():.3g}":  # a graded mesh
+        h_text = f"{h.min():.3g} to {h.max():.3g} m"
+    logger.warning(
+        "%s: %s points simplified to %d below the mesh resolution (tolerance: "
+        "segments of at least %g h, vertices within %g h of the line dropped; "
+        "h = %s)",
+        key,
+        f"{len(pts):,}",
+        len(out),
+        SIMPLIFY_MIN_SEGMENT,
+        SIMPLIFY_DEVIATION,
+        h_text,
+    )
+    pair = first_meeting(out)
+    if pair is not None:
+        raise GeometryError(
+            f"{key}: simplified below the mesh resolution ({len(pts):,} points to "
+            f"{len(out)}), the polyline crosses itself (segments {pair[0]} and "
+            f"{pair[1]}); smooth the polyline or refine the mesh"
+        )
+    return out
+
+
 def _on_boundary(p, box, tol):
     return (
         min(
@@ -298,6 +377,21 @@ def _cell_pieces(mesh, points, tol):
     )
 
 
+def _check_pieces_per_cell(mesh, piece_cell, key) -> None:
+    """Refuse a fracture folded into more than MAX_PIECES_PER_CELL pieces in
+    one cell (GeometryError naming the cell)."""
+    count = np.bincount(piece_cell)
+    c = int(np.argmax(count))
+    if count[c] > MAX_PIECES_PER_CELL:
+        b = mesh.bounds[c]
+        raise GeometryError(
+            f"{key}: {count[c]} pieces of the fracture in the cell [{b[0]:.4g}, "
+            f"{b[1]:.4g}] x [{b[2]:.4g}, {b[3]:.4g}], more than the "
+            f"{MAX_PIECES_PER_CELL} a cell can resolve; smooth the polyline or "
+            "refine the mesh"
+        )
+
+
 def build_fracture(
     mesh, spec, box, points=None, s_offset=0.0, junction_ends=(), reach=None
 ) -> Fracture:
@@ -313,6 +407,7 @@ def build_fracture(
     if points is None:
         raw = np.asarray(spec.points, dtype=float)
         pts, s_offset = _clip_to_domain(raw, box, tol, key)
+        pts = _resolved(mesh, pts, key)
     else:
         pts = np.asarray(points, dtype=float)
     if pts.shape[0] < 2:
@@ -327,6 +422,7 @@ def build_fracture(
     piece_cell, piece_seg, piece_t = _cell_pieces(mesh, pts, tol)
     if piece_cell.size == 0:
         raise GeometryError(f"{key}: no part of the fracture lies inside an element")
+    _check_pieces_per_cell(mesh, piece_cell, key)
     tips = []
     for end in (0, 1):
         p = pts[0] if end == 0 else pts[-1]
@@ -431,30 +527,71 @@ def _tip_enrichment(spec, key, tips, length, reach):
 
 # ------------------------------------------------------------------ junctions
 #
-# Tolerance rules (JUNCTION_SNAP_CELLS, relative to the smallest cell size h):
-# - an end of a fracture (not on the domain boundary) closer than snap = 0.5 h
-#   to another fracture ENDS ON IT (T): the end is moved onto that fracture,
-#   either back to the crossing point when it overshoots by less than snap
-#   measured along the fracture (trimmed), or to the nearest point when it
-#   stops short (extended).  An overshoot longer than snap is an X.
-#   A dangling arm shorter than half a cell cannot be resolved by the mesh
-#   (its tip enrichment would sit in the junction cell), so it is not an X;
-# - two ends closer than snap to each other are a shared end point (V): the
-#   secondary's end is moved onto the main's;
-# - every other crossing is an X; fractures overlapping along a common line
-#   (parallel and closer than the geometric tolerance) are refused.
+# Junction rules (h: the smallest cell size, snap = JUNCTION_SNAP_CELLS h,
+# tol = GEOMETRY_TOL h).
+#
+# 0. Fractures that overlap as given (within tol of each other along a common
+#    stretch longer than tol: collinear, at whatever tiny angle) are refused
+#    with one line naming both.
+# 1. Snapping.  An end of a fracture (not on the domain boundary) closer than
+#    snap to another fracture is moved onto it, each end at most once, pairs
+#    in listing order:
+#    - two ends closer than snap to each other are a shared end point (V):
+#      the secondary's end (the shorter fracture's) moves onto the main's;
+#    - an end closer than snap to the other's body ends on it (T/Y): trimmed
+#      back to the crossing if it overshoots by less than snap measured along
+#      itself (a longer overshoot is an X), else moved to the nearest point.
+#      A dangling arm shorter than half a cell cannot be resolved by the mesh
+#      (its tip enrichment would sit in the junction cell), so it is not an X.
+#    A move is made only if afterwards
+#    - the end segment is at least JUNCTION_MIN_SEGMENT_CELLS h long, and
+#      still meets every fracture it met before (snapping joins fractures,
+#      it never parts them);
+#    - for a move that turns the end segment (a V, a move to the nearest
+#      point; a trim keeps the fracture's own direction): that segment makes
+#      an angle of at least JUNCTION_MIN_ANGLE with every segment of another
+#      fracture leaving the junction point, and lies along no other fracture.
+#    So snapping never lays a fracture onto another nor makes it meet one
+#    tangentially: an end of a near-parallel fracture (or of a narrow V)
+#    stays where it is, a tip beside the other fracture.  The angle is that
+#    of the smallest wedge a snap may create; smaller ones occur only where
+#    the fractures are drawn so.
+# 2. Junctions are then found on the snapped polylines, within tol only:
+#    where two fractures meet at an end of both it is a V, at an end of one
+#    a T (that one is the secondary), elsewhere an X (the secondary is the
+#    lower-ranked, _rank_key).  So every junction point lies on both
+#    fractures, and two fractures that meet have a junction.
+# A junction at any angle can be built: the cut of an arm (Cut) needs only
+# the side of the main's line the arm lies on, defined wherever two fractures
+# meet without overlapping (for two collinear fractures meeting end to end,
+# the side where the junction function is not constant).
 # A junction on a mesh node or edge needs no special case: cell pieces are
 # split at the junction only where it lies strictly inside a piece.
 JUNCTION_SNAP_CELLS = 0.5
+# A snap turns an end segment by up to atan(snap / its length); below 10 deg
+# it would join fractures that run alongside each other (a near-parallel
+# pair, en echelon ends, a near copy) into a sliver a few cells long, which
+# the cells cannot resolve either way (benchmarks/RESULTS.md, "Buildable
+# fracture networks": the snaps this refuses and what they change).
+JUNCTION_MIN_ANGLE = 10.0  # [deg]
+# A snap may shorten an end segment (a trim, a V); it must not make it vanish
+# or leave a stub far below the cell size.
+JUNCTION_MIN_SEGMENT_CELLS = 0.1
 
 
-def _closest_on_polyline(pts, p):
-    """Distance, segment, parameter and point of the polyline nearest to p."""
+def _to_segments(pts, p):
+    """Distances (m,), parameters (m,) and nearest points (m, 2) of the
+    polyline's m segments to the point p."""
     a = pts[:-1]
     d = pts[1:] - a
     t = np.clip(np.einsum("mk,mk->m", p - a, d) / np.einsum("mk,mk->m", d, d), 0, 1)
     q = a + t[:, None] * d
-    dist = np.linalg.norm(q - p, axis=1)
+    return np.linalg.norm(q - p, axis=1), t, q
+
+
+def _closest_on_polyline(pts, p):
+    """Distance, segment, parameter and point of the polyline nearest to p."""
+    dist, t, q = _to_segments(pts, p)
     j = int(np.argmin(dist))
     return float(dist[j]), j, float(t[j]), q[j]
 
@@ -465,40 +602,97 @@ def _arc(pts, seg, t):
     return float(seg_len[:seg].sum() + t * seg_len[seg])
 
 
+def _overlap(p0, p1, q0, q1, tol):
+    """Whether segments p0-p1 and q0-q1 ((2,) float sequences) lie within tol
+    of each other along a common stretch longer than tol (a collinear
+    overlap, at whatever tiny angle)."""
+    dx, dy = p1[0] - p0[0], p1[1] - p0[1]
+    length = math.hypot(dx, dy)
+    ux, uy = dx / length, dy / length
+    ax, ay, bx, by = q0[0] - p0[0], q0[1] - p0[1], q1[0] - p0[0], q1[1] - p0[1]
+    s0, s1 = ax * ux + ay * uy, bx * ux + by * uy  # q's ends along p
+    lo, hi = max(min(s0, s1), 0.0), min(max(s0, s1), length)
+    if hi - lo <= tol:
+        return False
+    # q's offset from p's line is linear along the stretch: check its two ends
+    h0, h1 = ax * uy - ay * ux, bx * uy - by * ux
+    slope = (h1 - h0) / (s1 - s0)
+    return max(abs(h0 + slope * (lo - s0)), abs(h0 + slope * (hi - s0))) <= tol
+
+
+def _apart(p0, p1, q0, q1, tol):
+    """Whether the boxes of two segments are further apart than tol."""
+    return (
+        max(p0[0], p1[0]) < min(q0[0], q1[0]) - tol
+        or max(q0[0], q1[0]) < min(p0[0], p1[0]) - tol
+        or max(p0[1], p1[1]) < min(q0[1], q1[1]) - tol
+        or max(q0[1], q1[1]) < min(p0[1], p1[1]) - tol
+    )
+
+
+def _segment_crossing(p0, p1, q0, q1, tol):
+    """Parameters [(ta, tb)] where segments p0-p1 and q0-q1 ((2,) float
+    sequences, not overlapping) meet: their crossing, or the end points of
+    one lying within tol of the other (a T, a shared end, a near miss); []
+    where they are further apart than tol."""
+    d1x, d1y, d2x, d2y = p1[0] - p0[0], p1[1] - p0[1], q1[0] - q0[0], q1[1] - q0[1]
+    l1, l2 = math.hypot(d1x, d1y), math.hypot(d2x, d2y)
+    cross = d1x * d2y - d1y * d2x
+    if abs(cross) > 1e-12 * l1 * l2:
+        rx, ry = q0[0] - p0[0], q0[1] - p0[1]
+        ta = (rx * d2y - ry * d2x) / cross
+        tb = (rx * d1y - ry * d1x) / cross
+        if 0.0 <= ta <= 1.0 and 0.0 <= tb <= 1.0:
+            return [(ta, tb)]
+    hits = []
+    for ta, p in ((0.0, p0), (1.0, p1)):
+        tb = _nearest_parameter(q0, d2x, d2y, p)
+        if math.dist(p, (q0[0] + tb * d2x, q0[1] + tb * d2y)) <= tol:
+            hits.append((ta, tb))
+    for tb, q in ((0.0, q0), (1.0, q1)):
+        ta = _nearest_parameter(p0, d1x, d1y, q)
+        if math.dist(q, (p0[0] + ta * d1x, p0[1] + ta * d1y)) <= tol:
+            hits.append((ta, tb))
+    return hits
+
+
+def _nearest_parameter(a, dx, dy, p):
+    """Parameter in [0, 1] of the point of segment a + t (dx, dy) nearest p."""
+    t = ((p[0] - a[0]) * dx + (p[1] - a[1]) * dy) / (dx * dx + dy * dy)
+    return min(max(t, 0.0), 1.0)
+
+
+def _refuse_overlap(pa, pb, tol, names):
+    """GeometryError naming both if two polylines overlap along a stretch."""
+    A, B = pa.tolist(), pb.tolist()
+    for i in range(len(A) - 1):
+        for j in range(len(B) - 1):
+            if _apart(A[i], A[i + 1], B[j], B[j + 1], tol):
+                continue
+            if _overlap(A[i], A[i + 1], B[j], B[j + 1], tol) or _overlap(
+                B[j], B[j + 1], A[i], A[i + 1], tol
+            ):
+                raise GeometryError(
+                    f"{names[0]} and {names[1]} overlap along a common line "
+                    f"(segments {i} and {j}); merge them into one fracture "
+                    "or move one"
+                )
+
+
 def _crossings(pa, pb, tol, names):
     """Crossing points of two polylines: list of (arc_a, arc_b, point).
 
     Fractures overlapping along a common line raise GeometryError.
     """
+    _refuse_overlap(pa, pb, tol, names)
     out = []
-    for i in range(len(pa) - 1):
-        d1 = pa[i + 1] - pa[i]
-        l1 = np.linalg.norm(d1)
-        for j in range(len(pb) - 1):
-            d2 = pb[j + 1] - pb[j]
-            l2 = np.linalg.norm(d2)
-            r = pb[j] - pa[i]
-            cross = d1[0] * d2[1] - d1[1] * d2[0]
-            if abs(cross) <= 1e-12 * l1 * l2:
-                # parallel: refuse a collinear overlap
-                off = abs(r[0] * d1[1] - r[1] * d1[0]) / l1
-                if off <= tol:
-                    u0 = (r @ d1) / l1
-                    u1 = ((pb[j + 1] - pa[i]) @ d1) / l1
-                    lo, hi = max(min(u0, u1), 0.0), min(max(u0, u1), l1)
-                    if hi - lo > tol:
-                        raise GeometryError(
-                            f"{names[0]} and {names[1]} overlap along a common line "
-                            f"(segments {i} and {j}); merge them into one fracture "
-                            "or move one"
-                        )
+    A, B = pa.tolist(), pb.tolist()
+    for i in range(len(A) - 1):
+        for j in range(len(B) - 1):
+            if _apart(A[i], A[i + 1], B[j], B[j + 1], tol):
                 continue
-            ta = (r[0] * d2[1] - r[1] * d2[0]) / cross
-            tb = (r[0] * d1[1] - r[1] * d1[0]) / cross
-            ea, eb = tol / l1, tol / l2
-            if -ea <= ta <= 1 + ea and -eb <= tb <= 1 + eb:
-                ta, tb = min(max(ta, 0.0), 1.0), min(max(tb, 0.0), 1.0)
-                x = pa[i] + ta * d1
+            for ta, tb in _segment_crossing(A[i], A[i + 1], B[j], B[j + 1], tol):
+                x = pa[i] + ta * (pa[i + 1] - pa[i])
                 if all(np.linalg.norm(x - q[2]) > tol for q in out):
                     out.append((_arc(pa, i, ta), _arc(pb, j, tb), x))
     return out
@@ -512,6 +706,39 @@ def _rank_key(pts, h):
     return (-round(length / (1e-6 * h)), ends[0], ends[1])
 
 
+def _pairs_near(polylines, margin):
+    """Pairs (a, b), a < b, of polylines whose boxes grown by margin meet."""
+    lo = np.array([p.min(axis=0) for p in polylines]) - margin
+    hi = np.array([p.max(axis=0) for p in polylines]) + margin
+    out = []
+    for a in range(len(polylines) - 1):
+        near = np.nonzero(
+            np.all(lo[a + 1 :] <= hi[a], 1) & np.all(hi[a + 1 :] >= lo[a], 1)
+        )[0]
+        out += [(a, b) for b in (near + a + 1).tolist()]
+    return out
+
+
+@dataclass
+class _Snapping:
+    """State of rule 1 over a set of polylines (find_junctions)."""
+
+    polylines: list  # (k, 2) arrays, moved in place
+    free_ends: list  # [bool, bool] per polyline
+    names: list
+    rank: list
+    neighbours: list  # polylines that may come within snap of each one
+    snap: float  # [m]
+    tol: float  # [m]
+    min_segment: float  # [m]
+    taken: list | None = None  # [bool, bool] per polyline: ends snapped
+    near: set | None = None  # (polyline, end) within snap of another one
+
+    def __post_init__(self):
+        self.taken = [[False, False] for _ in self.polylines]
+        self.near = set()
+
+
 def find_junctions(polylines, free_ends, names, h, tol):
     """Junctions between clipped polylines; snaps ends in place (see above).
 
@@ -520,93 +747,70 @@ def find_junctions(polylines, free_ends, names, h, tol):
     Returns a list of (kind, main, secondary, point).
     """
     snap = JUNCTION_SNAP_CELLS * h
-    n = len(polylines)
-    if n < 2:
+    if len(polylines) < 2:
         return []
-    lo = np.array([p.min(axis=0) for p in polylines]) - snap
-    hi = np.array([p.max(axis=0) for p in polylines]) + snap
+    for a, b in _pairs_near(polylines, tol):  # as given, before any snapping
+        _refuse_overlap(polylines[a], polylines[b], tol, (names[a], names[b]))
     rank = [_rank_key(p, h) for p in polylines]
-    taken = [[False, False] for _ in range(n)]  # ends already on a fracture
-    out = []
-    for a in range(n):
-        near = np.nonzero(
-            np.all(lo[a + 1 :] <= hi[a], 1) & np.all(hi[a + 1 :] >= lo[a], 1)
+    # ends move by at most snap: the boxes as given, grown by snap, meet for
+    # every pair that may come near or meet after snapping
+    pairs = _pairs_near(polylines, snap)
+    neighbours = [[] for _ in polylines]
+    for a, b in pairs:
+        neighbours[a].append(b)
+        neighbours[b].append(a)
+    state = _Snapping(
+        polylines,
+        free_ends,
+        names,
+        rank,
+        neighbours,
+        snap,
+        tol,
+        JUNCTION_MIN_SEGMENT_CELLS * h,
+    )
+    for a, b in pairs:
+        _snap_pair(state, a, b)
+    apart = sum(not state.taken[f][end] for f, end in state.near)
+    if apart:
+        logger.info(
+            "%d fracture end(s) within %.3g m (h/2) of another fracture left as "
+            "tips: the snap would meet it at under %g deg, part a crossing or "
+            "leave an end segment under h/10 (README, Fracture networks)",
+            apart,
+            snap,
+            JUNCTION_MIN_ANGLE,
         )
-        for b in (near[0] + a + 1).tolist():
-            out += _pair_junctions(
-                a, b, polylines, free_ends, taken, rank, names, snap, tol
-            )
-    return out
-
-
-def _pair_junctions(a, b, polylines, free_ends, taken, rank, names, snap, tol):
-    pa, pb = polylines[a], polylines[b]
-    cross = _crossings(pa, pb, tol, (names[a], names[b]))
-    la = float(np.linalg.norm(np.diff(pa, axis=0), axis=1).sum())
-    lb = float(np.linalg.norm(np.diff(pb, axis=0), axis=1).sum())
-    used = [False] * len(cross)
     out = []
-    # ends on the other fracture (T), shared ends (V)
-    for f, g, pf, pg, lf, _lg, arc_k in (
-        (a, b, pa, pb, la, lb, 0),
-        (b, a, pb, pa, lb, la, 1),
-    ):
-        for end in (0, 1):
-            if not free_ends[f][end] or taken[f][end]:
-                continue
-            p = pf[0] if end == 0 else pf[-1]
-            dist, _, _, q = _closest_on_polyline(pg, p)
-            if dist > snap:
-                continue
-            # the other's ends near p: a V
-            v_end = None
-            for e2 in (0, 1):
-                pe = pg[0] if e2 == 0 else pg[-1]
-                if (
-                    free_ends[g][e2]
-                    and not taken[g][e2]
-                    and np.linalg.norm(pe - p) <= snap
-                ):
-                    v_end = e2
-            end_arc = 0.0 if end == 0 else lf
-            if v_end is not None:
-                main, sec = (g, f) if rank[g] <= rank[f] else (f, g)
-                sec_end = end if sec == f else v_end
-                main_end = v_end if sec == f else end
-                pm = polylines[main]
-                target = (pm[0] if main_end == 0 else pm[-1]).copy()
-                _move_end(polylines[sec], sec_end, target)
-                taken[f][end] = taken[g][v_end] = True
-                for k, c in enumerate(cross):  # the crossing at the shared end
-                    if np.linalg.norm(c[2] - target) <= snap:
-                        used[k] = True
-                out.append(("V", main, sec, target))
-                continue
-            # an overshoot (a crossing on the end segment) is trimmed back to
-            # the crossing if the stub is shorter than snap along the fracture,
-            # else it is an X; a gap is closed at the nearest point
-            seg_len = np.linalg.norm(pf[1] - pf[0] if end == 0 else pf[-1] - pf[-2])
-            over = [
-                (abs(c[arc_k] - end_arc), k)
-                for k, c in enumerate(cross)
-                if abs(c[arc_k] - end_arc) <= seg_len
-            ]
-            target = q
-            if over:
-                along, k = min(over)
-                if along > snap:
-                    continue
-                target = cross[k][2]
-                used[k] = True
-            _move_end(pf, end, target.copy())
-            taken[f][end] = True
-            out.append(("T", g, f, target.copy()))
-    for k, c in enumerate(cross):
-        if used[k]:
-            continue
-        main, sec = (a, b) if rank[a] <= rank[b] else (b, a)
-        out.append(("X", main, sec, c[2].copy()))
+    for a, b in pairs:
+        pa, pb = polylines[a], polylines[b]
+        for _, _, x in _crossings(pa, pb, tol, (names[a], names[b])):
+            end_a, end_b = _end_at(pa, x, tol), _end_at(pb, x, tol)
+            if end_a is not None and end_b is not None:
+                main, sec = (a, b) if rank[a] <= rank[b] else (b, a)
+                end = end_a if main == a else end_b
+                out.append(("V", main, sec, _end_point(polylines[main], end)))
+            elif end_a is not None:
+                out.append(("T", b, a, _end_point(pa, end_a)))
+            elif end_b is not None:
+                out.append(("T", a, b, _end_point(pb, end_b)))
+            else:
+                main, sec = (a, b) if rank[a] <= rank[b] else (b, a)
+                out.append(("X", main, sec, x.copy()))
     return out
+
+
+def _end_point(pts, end):
+    """A copy of the polyline's first (end 0) or last (end 1) point."""
+    return (pts[0] if end == 0 else pts[-1]).copy()
+
+
+def _end_at(pts, x, tol):
+    """The end of the polyline at x (0 first, 1 last; within tol), or None."""
+    for end in (0, 1):
+        if np.linalg.norm(_end_point(pts, end) - x) <= tol:
+            return end
+    return None
 
 
 def _move_end(pts, end, target):
@@ -616,11 +820,150 @@ def _move_end(pts, end, target):
         pts[-1] = target
 
 
-def _junction_cut(main, sec, point, direction, far):
-    """Cut of the secondary's arm lying in ``direction`` from the junction."""
-    _, j, _, _ = _closest_on_polyline(main.points, point)
+def _leaving(pts, x, tol):
+    """Unit directions (m, 2) of the polyline's segments leaving the point x:
+    both ways inside a segment, one way at an end; none if x is off it."""
+    out = []
+    for j in range(len(pts) - 1):
+        d = pts[j + 1] - pts[j]
+        length = float(np.linalg.norm(d))
+        t = float(np.clip((x - pts[j]) @ d / length**2, 0.0, 1.0))
+        if np.linalg.norm(pts[j] + t * d - x) > tol:
+            continue
+        if t * length > tol:
+            out.append(-d / length)
+        if (1.0 - t) * length > tol:
+            out.append(d / length)
+    return np.array(out).reshape(-1, 2)
+
+
+def _may_move(state, f, end, target, turns):
+    """Whether the end of polyline f may move to target (rule 1 above).
+
+    The end segment after the move must keep min_segment of length and
+    still meet every fracture it met before (snapping joins fractures, it
+    never parts them); if the move turns it (turns = True), it must make at
+    least JUNCTION_MIN_ANGLE with every segment of another fracture leaving
+    the target, and lie along none of the others.
+    """
+    pf = state.polylines[f]
+    inner = pf[1] if end == 0 else pf[-2]
+    d = inner - target
+    length = float(np.linalg.norm(d))
+    if length < state.min_segment:
+        return False
+    old = (inner.tolist(), _end_point(pf, end).tolist())
+    new = (inner.tolist(), target.tolist())
+    cos_min = np.cos(np.radians(JUNCTION_MIN_ANGLE))
+    for g in state.neighbours[f]:
+        pg = state.polylines[g]
+        pts = pg.tolist()
+        segments = list(zip(pts[:-1], pts[1:], strict=True))
+        if _meets(old, segments, state.tol) and not _meets(new, segments, state.tol):
+            return False
+        if not turns:  # along its own line: no new angle, no new overlap
+            continue
+        if np.any(_leaving(pg, target, state.tol) @ (d / length) >= cos_min):
+            return False
+        if any(
+            _overlap(*new, a, b, state.tol) or _overlap(a, b, *new, state.tol)
+            for a, b in segments
+        ):
+            return False
+    return True
+
+
+def _meets(segment, segments, tol):
+    """Whether a segment meets (crosses or touches, within tol) any of the
+    others ((2,) float sequences)."""
+    return any(
+        not _apart(*segment, a, b, tol) and _segment_crossing(*segment, a, b, tol)
+        for a, b in segments
+    )
+
+
+def _snap_pair(state, a, b):
+    """Snap the free ends of fractures a and b onto each other (rule 1)."""
+    polylines, free_ends, taken, rank = (
+        state.polylines,
+        state.free_ends,
+        state.taken,
+        state.rank,
+    )
+    snap = state.snap
+    pa, pb = polylines[a], polylines[b]
+    cross = None  # crossings of a and b, found once an end is near the other
+    for f, g, arc_k in ((a, b, 0), (b, a, 1)):
+        pf, pg = polylines[f], polylines[g]
+        lo, hi = pg.min(axis=0) - snap, pg.max(axis=0) + snap
+        for end in (0, 1):
+            if not free_ends[f][end] or taken[f][end]:
+                continue
+            p = _end_point(pf, end)
+            if np.any(p < lo) or np.any(p > hi):
+                continue
+            dist, _, _, q = _closest_on_polyline(pg, p)
+            if dist > snap:
+                continue
+            state.near.add((f, end))
+            # the other's ends near p: a V, the secondary onto the main
+            v_end = None
+            for e2 in (0, 1):
+                if (
+                    free_ends[g][e2]
+                    and not taken[g][e2]
+                    and np.linalg.norm(_end_point(pg, e2) - p) <= snap
+                ):
+                    v_end = e2
+            if v_end is not None:
+                sec, main = (f, g) if rank[g] <= rank[f] else (g, f)
+                sec_end = end if sec == f else v_end
+                main_end = v_end if sec == f else end
+                target = _end_point(polylines[main], main_end)
+                if _may_move(state, sec, sec_end, target, turns=True):
+                    _move_end(polylines[sec], sec_end, target)
+                    taken[f][end] = taken[g][v_end] = True
+                    cross = None
+                    continue
+            # an overshoot (a crossing on the end segment) is trimmed back to
+            # the crossing if the stub is shorter than snap along the fracture,
+            # else it is an X; a gap is closed at the nearest point
+            if cross is None:
+                cross = _crossings(pa, pb, state.tol, (state.names[a], state.names[b]))
+            total = float(np.linalg.norm(np.diff(pf, axis=0), axis=1).sum())
+            end_arc = 0.0 if end == 0 else total
+            seg_len = np.linalg.norm(pf[1] - pf[0] if end == 0 else pf[-1] - pf[-2])
+            over = [
+                (abs(c[arc_k] - end_arc), k)
+                for k, c in enumerate(cross)
+                if abs(c[arc_k] - end_arc) <= seg_len
+            ]
+            target, turns = q, True
+            if over:
+                along, k = min(over)
+                if along > snap:
+                    continue
+                target, turns = cross[k][2], False
+            if _may_move(state, f, end, target, turns):
+                _move_end(pf, end, target.copy())
+                taken[f][end] = True
+                cross = None
+
+
+def _junction_cut(main, sec, point, direction, far, straight=0.0):
+    """Cut of the secondary's arm lying in ``direction`` from the junction.
+
+    The main's segment at the junction is the one the arm is furthest from
+    tangent to (at a kink of the main the point lies on two).  ``straight``:
+    the side to take when the arm continues the main's line (a V of two
+    collinear fractures meeting end to end); 0 where that cannot be.
+    """
+    dist = _to_segments(main.points, np.asarray(point, float))[0]
+    tol = GEOMETRY_TOL * float(main.length.min())
+    near = np.flatnonzero(dist <= max(tol, float(dist.min())))
+    j = int(near[np.argmax(np.abs(main.normal[near] @ direction))])
     nrm = main.normal[j]
-    side = float(np.sign(direction @ nrm))
+    side = float(np.sign(direction @ nrm)) or straight
     if side == 0.0:
         raise GeometryError(
             f"fractures[{sec.index}] meets fractures[{main.index}] tangentially"
@@ -666,6 +1009,7 @@ def build_fractures(mesh, specs, box) -> tuple[Fracture, ...]:
     clipped, offsets, free = [], [], []
     for spec, key in zip(specs, names, strict=True):
         pts, s_off = _clip_to_domain(np.asarray(spec.points, float), box, tol, key)
+        pts = _resolved(mesh, pts, key)
         clipped.append(pts.copy())
         offsets.append(s_off)
         free.append(
@@ -725,6 +1069,12 @@ def build_fractures(mesh, specs, box) -> tuple[Fracture, ...]:
             body = fm.tangent[0] if mend == 0 else -fm.tangent[-1]
             nrm_s = fs.normal[0] if end == 0 else fs.normal[-1]
             far = -float(np.sign(body @ nrm_s)) or -1.0
+            # end to end on one line, the wedge is the half-plane on which
+            # H of the secondary is -far (J then jumps along both)
+            nrm_m = fm.normal[0] if mend == 0 else fm.normal[-1]
+            straight = -far * float(np.sign(nrm_m @ nrm_s))
+            end_cuts[sec][end] = _junction_cut(fm, fs, point, inward, far, straight)
+            continue
         end_cuts[sec][end] = _junction_cut(fm, fs, point, inward, far)
     out = []
     for f, fr in enumerate(fracs):

@@ -1,14 +1,43 @@
-"""Memory estimate of a run, checked before anything large is allocated.
+"""Memory estimate of a run, checked before each large allocation.
 
-The estimate comes from the number of dofs (2 per node plus the enriched dofs
-of the fractures) and the fill of the sparse LU factorisation, which grows like
-n_dofs * log2(n_dofs) for a 2D mesh with a fill-reducing ordering:
+The peak resident memory of a run is modelled from the sizes that set it
+(a ``Footprint``), term by term, in bytes:
 
-    bytes ~ BASE_BYTES + BYTES_PER_DOF_LOG * n_dofs * log2(n_dofs)
+- ``base``: the interpreter with NumPy, SciPy, h5py and meshio (BASE_NUMPY),
+  plus Numba and its compiled kernels when the Numba backend runs
+  (BASE_NUMBA);
+- ``enriched``: the enriched-cell quadrature (enrichment.EnrichedCells), per
+  quadrature point its position and weight and, per slot, F and grad F, and
+  per sub-triangle the vertex values: about QP_BYTES + QP_SLOT_BYTES * S
+  per point, S the slots of the widest cell (the arrays are padded to it);
+- ``assembly``, while the stiffness is assembled: the padded element
+  matrices of the enriched cells, (8 + 2 S)^2 doubles each, the COO
+  triplets of every cell's entries with their conversion to CSR
+  (TRIPLET_BYTES per entry) and, on the NumPy kernels, the shape-function
+  gradients of all quadrature points at once (NUMPY_QP_FUNCTION_BYTES per
+  point and function, 4 + S functions);
+- ``solver``: the stiffness (12 B per non-zero) and its sparse LU factors,
+  whose fill grows like nnz * log2(n_dofs) with a fill-reducing ordering
+  (LU_BYTES per non-zero and per factor log2);
+- ``steps``: every converged load step is kept until the output is written:
+  the displacement, the contact force and the displacement of the last
+  contact evaluation (3 x 8 B per dof), the contact tangent blocks of every
+  patch (padded to the widest, 8 B per entry), and the written fields (per
+  node 16 B, per cell 48 B, 80 B more with pore pressure, per contact point
+  80 B).
 
-Calibrated on the reservoir case (peak resident memory of the whole process,
-``ru_maxrss``): 47k dofs 341 MB, 183k dofs 835 MB, measured; the formula gives
-420 MB and 1.0 GB, about 25 % above (an estimate that errs on the safe side).
+peak = base + enriched + max(assembly, solver + steps x per_step).
+
+It is evaluated three times, each before what it guards: from the case alone
+(``check_memory(spec)``, before the mesh: a lower estimate of the enrichment),
+from the fractures and their node enrichments (``enriched_footprint``, before
+the enriched cells are built: the slots per cell exactly, their quadrature
+points estimated), and from the built model (``model_footprint``, before the
+first solve: everything but the LU fill exact).  Measured against the peak
+resident memory (ru_maxrss) of whole runs by benchmarks/memory_estimate.py
+(table in the README, *Memory*): the last two estimates lie between 0.94
+and 1.26 times the measured peak on shipped cases, crowded networks, long
+runs and large meshes.
 
 The limit is the machine's physical memory (``SC_PHYS_PAGES * SC_PAGE_SIZE``),
 or the environment variable ``XFEMSLIP_MEMORY_LIMIT`` in bytes (suffixes k, M,
@@ -20,42 +49,206 @@ from __future__ import annotations
 import logging
 import math
 import os
+from dataclasses import dataclass
+
+import numpy as np
 
 from xfemslip.errors import MeshError, UsageError
 
 logger = logging.getLogger(__name__)
 
 ENV_LIMIT = "XFEMSLIP_MEMORY_LIMIT"
-BASE_BYTES = 200e6  # Python, NumPy, SciPy, Numba and the compiled kernels [B]
-BYTES_PER_DOF_LOG = 250.0  # per dof and per factor log2(n_dofs) [B]
-# Enriched dofs per unit fracture length / h: a cut cell enriches ~2 nodes
-# with 2 dofs each, ~1.4 cut cells per h of length; the tip functions add
-# 4 functions x 2 dofs on ~50 nodes (radius 4 cells).
+BASE_NUMPY = 90e6  # measured 85 MB: a 10 x 10 case on the NumPy kernels [B]
+BASE_NUMBA = 200e6  # measured 191 MB: the same case on the Numba kernels [B]
+QP_BYTES = 48.0  # per enriched-cell quadrature point: xy, w, triangle share [B]
+QP_SLOT_BYTES = 28.0  # per point and slot: F, grad F (24 B), vertex values [B]
+TRIPLET_BYTES = 48.0  # per COO entry: rows, cols, values and the CSR copy [B]
+# per enriched-cell quadrature point and shape function, NumPy kernels only:
+# gradients, weighted gradients and their gathered cell data [B]
+NUMPY_QP_FUNCTION_BYTES = 56.0
+LU_BYTES = 7.0  # per stiffness non-zero and per factor log2(n_dofs) [B]
+NNZ_PER_ENTRY = 0.56  # CSR non-zeros per COO entry (shared nodes summed)
+# Enriched-cell quadrature points, estimated before the cells are cut: a
+# cell crossed by p fracture pieces has about QP_CELL + QP_PIECE p +
+# QP_PIECE2 p^2 points (its sub-triangles times 7), a cell near a branch
+# enriched tip QP_BRANCH more (the collapsed Duffy rule); measured 20, 38, 63,
+# 96, 146 points for p = 0..4 on a 200-fracture network, 109 near a tip.
+QP_CELL, QP_PIECE, QP_PIECE2, QP_BRANCH = 20.0, 20.0, 5.0, 90.0
+# Before the mesh is built: enriched dofs per unit fracture length / h (a cut
+# cell enriches ~2 nodes with 2 dofs each, ~1.4 cut cells per h of length;
+# the tip functions add 4 functions x 2 dofs on ~50 nodes, radius 4 cells).
 _ENRICHED_PER_CELL_LENGTH = 8.0
 _TIP_DOFS = 400
 _SUFFIX = {"": 1.0, "k": 1e3, "m": 1e6, "g": 1e9, "t": 1e12}
 
 
+@dataclass(frozen=True)
+class Footprint:
+    """The sizes that set a run's peak memory (counts, not bytes)."""
+
+    n_nodes: int
+    n_cells: int
+    n_dofs: int
+    nnz: float  # stiffness non-zeros
+    steps: int  # kept load steps
+    numba: bool = False  # the Numba kernels are loaded
+    pore: bool = False  # pore-pressure fields are written
+    enriched_cells: int = 0
+    slots: int = 0  # enrichment slots of the widest enriched cell (padding)
+    entries: float = 0.0  # COO entries of all cells, sum of (8 + 2 s)^2
+    qp: float = 0.0  # enriched-cell quadrature points
+    patches: float = 0.0  # contact patches
+    block: float = 0.0  # dofs of the widest patch's tangent block (2 J)
+    points: float = 0.0  # contact integration points
+
+
+def estimate_terms(fp: Footprint) -> dict[str, float]:
+    """The terms of the module docstring [B] and their ``total``."""
+    base = BASE_NUMBA if fp.numba else BASE_NUMPY
+    enriched = fp.qp * (QP_BYTES + QP_SLOT_BYTES * fp.slots)
+    gradients = 0.0 if fp.numba else NUMPY_QP_FUNCTION_BYTES * fp.qp * (4 + fp.slots)
+    assembly = fp.enriched_cells * (8 + 2 * fp.slots) ** 2 * 8.0
+    assembly += max(gradients, TRIPLET_BYTES * fp.entries)  # one after the other
+    solver = fp.nnz * (12.0 + LU_BYTES * math.log2(max(fp.n_dofs, 2)))
+    per_step = (
+        24.0 * fp.n_dofs
+        + 8.0 * fp.patches * (fp.block**2 + 8)
+        + 16.0 * fp.n_nodes
+        + (128.0 if fp.pore else 48.0) * fp.n_cells
+        + 80.0 * fp.points
+    )
+    steps = fp.steps * per_step
+    total = base + enriched + max(assembly, solver + steps)
+    return {
+        "total": total,
+        "base": base,
+        "enriched cells": enriched,
+        "assembly": assembly,
+        "solver": solver,
+        "steps": steps,
+    }
+
+
 def estimate_dofs(spec) -> int:
     """Upper estimate of the number of dofs of a validated case."""
     nx, ny = spec.mesh.x.size - 1, spec.mesh.y.size - 1
-    h = float(min(min(_diffs(spec.mesh.x)), min(_diffs(spec.mesh.y))))
+    h = float(min(np.diff(spec.mesh.x).min(), np.diff(spec.mesh.y).min()))
     enriched = 0.0
     for fr in spec.fractures:
-        seg = fr.points[1:] - fr.points[:-1]
-        length = float(sum(math.hypot(float(a), float(b)) for a, b in seg))
+        length = float(np.linalg.norm(np.diff(fr.points, axis=0), axis=1).sum())
         enriched += _ENRICHED_PER_CELL_LENGTH * (length / h + 2.0) + 2 * _TIP_DOFS
     enriched = min(enriched, 16.0 * (nx + 1) * (ny + 1))
     return int(2 * (nx + 1) * (ny + 1) + enriched)
 
 
-def _diffs(coords):
-    return [float(b - a) for a, b in zip(coords[:-1], coords[1:], strict=True)]
+def case_footprint(spec) -> Footprint:
+    """From the case alone (before the mesh): the standard part exactly, the
+    enrichment from the fracture lengths (no slots, no quadrature: a lower
+    estimate for crowded fractures, which enriched_footprint refines)."""
+    nx, ny = spec.mesh.x.size - 1, spec.mesh.y.size - 1
+    n_nodes, n_cells = (nx + 1) * (ny + 1), nx * ny
+    n_dofs = estimate_dofs(spec)
+    h = float(min(np.diff(spec.mesh.x).min(), np.diff(spec.mesh.y).min()))
+    length = sum(
+        float(np.linalg.norm(np.diff(fr.points, axis=0), axis=1).sum())
+        for fr in spec.fractures
+    )
+    pieces = min(1.5 * length / h, float(n_cells))
+    entries = 64.0 * n_cells  # the enriched cells' wider blocks are not known yet
+    return Footprint(
+        n_nodes=n_nodes,
+        n_cells=n_cells,
+        n_dofs=n_dofs,
+        nnz=NNZ_PER_ENTRY * entries + 20.0 * (n_dofs - 2 * n_nodes),
+        steps=spec.loading.steps,
+        entries=entries,
+        pore=spec.pore_pressure is not None,
+        patches=_patches(spec, length, h, 4 * pieces),
+        block=16.0,
+        points=4 * pieces,
+    )
 
 
-def estimate_bytes(n_dofs: int) -> float:
-    """Estimated peak memory [B] of a run with n_dofs unknowns."""
-    return BASE_BYTES + BYTES_PER_DOF_LOG * n_dofs * math.log2(max(n_dofs, 2))
+def _patches(spec, length, h, points) -> float:
+    """Contact patches: one per contact_patch cells of fracture, or per point."""
+    cells = spec.solver.contact_patch
+    return points if cells <= 0 else min(points, length / (cells * h) + 2.0)
+
+
+def enriched_footprint(spec, mesh, fractures, cand) -> Footprint:
+    """From the built fractures and their node enrichments (enrichment.
+    Candidates), before the enriched cells are cut: the enriched cells and
+    their slots exactly (the cells around each enriched node, as
+    enrichment.build_enriched_cells takes them), the quadrature points from
+    the fracture pieces per cell (QP_CELL ...)."""
+    from xfemslip.enrichment import HEAVISIDE
+    from xfemslip.kernels import choose
+
+    nx = mesh.nx
+    i, j = cand.node % (nx + 1), cand.node // (nx + 1)
+    di, dj = np.array([-1, 0, -1, 0]), np.array([-1, -1, 0, 0])
+    ci, cj = i[:, None] + di, j[:, None] + dj
+    inside = (ci >= 0) & (ci < nx) & (cj >= 0) & (cj < mesh.ny)
+    cell = (cj * nx + ci)[inside]
+    slots = np.bincount(cell, minlength=mesh.n_cells)
+    branch = np.zeros(mesh.n_cells, bool)
+    branch[(cj * nx + ci)[inside & (cand.func != HEAVISIDE)[:, None]]] = True
+    pieces = np.zeros(mesh.n_cells)
+    for fr in fractures:
+        np.add.at(pieces, np.unique(fr.piece_cell), 1.0)
+    enr = slots > 0
+    p = pieces[enr]
+    qp = float(
+        np.sum(QP_CELL + QP_PIECE * p + QP_PIECE2 * p * p + QP_BRANCH * branch[enr])
+    )
+    S = int(slots.max(initial=0))
+    entries = 64.0 * (mesh.n_cells - enr.sum()) + float(
+        np.sum((8.0 + 2.0 * slots[enr]) ** 2)
+    )
+    n_points = 4.0 * sum(fr.piece_cell.size for fr in fractures)
+    length = sum(float(fr.length.sum()) for fr in fractures)
+    return Footprint(
+        n_nodes=mesh.n_nodes,
+        n_cells=mesh.n_cells,
+        n_dofs=2 * mesh.n_nodes + 2 * cand.node.size,
+        nnz=NNZ_PER_ENTRY * entries,
+        steps=spec.loading.steps,
+        numba=choose(spec.solver.kernels, qp * (8 + 2 * S) ** 2) == "numba",
+        pore=spec.pore_pressure is not None,
+        enriched_cells=int(enr.sum()),
+        slots=S,
+        entries=entries,
+        qp=qp,
+        patches=_patches(spec, length, mesh.h_min, n_points),
+        block=2.0 * S,
+        points=n_points,
+    )
+
+
+def model_footprint(model) -> Footprint:
+    """From the built model, before the first solve: exact but for the LU
+    fill (the assembly, already done, is counted as it was)."""
+    ec, contact = model.ec, model.contact
+    S = ec.slot_node.shape[1]
+    used = np.count_nonzero(ec.slot_cand >= 0, axis=1)
+    entries = 64.0 * (model.mesh.n_cells - ec.cells.size)
+    entries += float(np.sum((8.0 + 2.0 * used) ** 2))
+    return Footprint(
+        n_nodes=model.mesh.n_nodes,
+        n_cells=model.mesh.n_cells,
+        n_dofs=model.problem.n_dofs,
+        nnz=float(model.problem.K.nnz),
+        steps=model.spec.loading.steps,
+        numba=contact.kernels == "numba",
+        pore=model.pore is not None,
+        enriched_cells=int(ec.cells.size),
+        slots=S,
+        entries=entries,
+        qp=float(ec.qp_w.size),
+        patches=float(contact.dofs.shape[0]),
+        block=float(contact.dofs.shape[1]),
+        points=float(model.ip.n),
+    )
 
 
 def available_bytes() -> tuple[float, str]:
@@ -89,17 +282,56 @@ def _parse_bytes(text: str) -> float | None:
     return value if math.isfinite(value) and value > 0 else None
 
 
-def check_memory(spec) -> None:
-    """Refuse a case whose memory estimate exceeds the limit (MeshError)."""
-    n_dofs = estimate_dofs(spec)
-    need = estimate_bytes(n_dofs)
+def _gb(value: float) -> str:
+    return f"{value / 1e9:.3g} GB"
+
+
+def check_memory(spec, footprint: Footprint | None = None) -> None:
+    """Refuse a case whose memory estimate exceeds the limit (MeshError, one
+    line naming the estimate, its largest terms and the limit).
+
+    footprint : the sizes known so far (default: case_footprint(spec)).
+    """
+    fp = case_footprint(spec) if footprint is None else footprint
+    terms = estimate_terms(fp)
+    need = terms.pop("total")
     limit, source = available_bytes()
-    logger.debug("memory estimate %.3g GB for ~%d dofs", need / 1e9, n_dofs)
-    if need > limit:
-        nx, ny = spec.mesh.x.size - 1, spec.mesh.y.size - 1
-        raise MeshError(
-            f"{spec.path}: mesh: {nx} x {ny} elements, ~{n_dofs} dofs, need an "
-            f"estimated {need / 1e9:.3g} GB of memory, more than the "
-            f"{limit / 1e9:.3g} GB available ({source}); use fewer elements, or set "
-            f"{ENV_LIMIT} (bytes) to allow more"
-        )
+    logger.debug(
+        "memory estimate %s for ~%d dofs (%s)",
+        _gb(need),
+        fp.n_dofs,
+        ", ".join(f"{k} {_gb(v)}" for k, v in terms.items()),
+    )
+    if need <= limit:
+        return
+    nx, ny = spec.mesh.x.size - 1, spec.mesh.y.size - 1
+    if terms["assembly"] < terms["solver"] + terms["steps"]:
+        del terms["assembly"]
+    else:
+        del terms["solver"], terms["steps"]
+    largest = [kv for kv in sorted(terms.items(), key=lambda kv: -kv[1]) if kv[1]]
+    largest = largest[:3]
+    parts = ", ".join(
+        f"{fp.steps} kept load steps {_gb(v)}" if k == "steps" else f"{k} {_gb(v)}"
+        for k, v in largest
+    )
+    raise MeshError(
+        f"{spec.path}: mesh: {nx} x {ny} elements, {len(spec.fractures)} "
+        f"fracture(s), ~{fp.n_dofs} dofs, {fp.steps} load step(s): need an "
+        f"estimated {_gb(need)} of memory ({parts}), more than the "
+        f"{_gb(limit)} available ({source}); use fewer elements, fractures or "
+        f"load steps, or set {ENV_LIMIT} (bytes) to allow more"
+    )
+
+
+__all__ = [
+    "ENV_LIMIT",
+    "Footprint",
+    "available_bytes",
+    "case_footprint",
+    "check_memory",
+    "enriched_footprint",
+    "estimate_dofs",
+    "estimate_terms",
+    "model_footprint",
+]

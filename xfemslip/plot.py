@@ -32,7 +32,7 @@ from matplotlib.colors import Normalize
 from matplotlib.figure import Figure
 from matplotlib.tri import Triangulation
 
-from xfemslip.errors import OutputError, UsageError
+from xfemslip.errors import UsageError
 from xfemslip.plot_data import ResultData, read_result
 from xfemslip.plot_mohr import add_legend, draw_mohr, mohr_figsize
 
@@ -379,24 +379,30 @@ def figure_mohr(results: Sequence[ResultData]) -> Figure:
 # --------------------------------------------------------------------------- #
 
 
-def _save(fig: Figure, out_dir: Path, name: str, formats, dpi=DPI) -> list[Path]:
-    """Write ``<out_dir>/<name>.<fmt>`` for each format."""
-    paths = []
-    for fmt in formats:
-        path = out_dir / f"{name}.{fmt}"
-        try:
-            fig.savefig(path, dpi=dpi, bbox_inches="tight")
-        except OSError as exc:
-            raise OutputError(f"cannot write {path}: {exc.strerror or exc}") from None
-        paths.append(path)
-    return paths
+def _save_all(out_dir: Path, makers: dict, formats, dpi=DPI) -> list[Path]:
+    """Write ``<out_dir>/<name>.<fmt>`` for each figure ``makers[name]()`` and
+    format, as one set (:func:`xfemslip.writers.fileset.replace_files`: no
+    figure of an earlier command is left beside the new ones half-replaced);
+    returns the paths in the order of ``makers`` and ``formats``."""
+    from xfemslip.writers.fileset import replace_files
 
+    figures: dict[str, Figure] = {}
 
-def _make_dir(out_dir: Path) -> None:
-    try:
-        out_dir.mkdir(parents=True, exist_ok=True)
-    except OSError as exc:
-        raise OutputError(f"cannot create {out_dir}: {exc.strerror}") from None
+    def writer(name: str, fmt: str):
+        def write(tmp: Path) -> None:
+            if name not in figures:
+                figures[name] = makers[name]()
+            figures[name].savefig(tmp, format=fmt, dpi=dpi, bbox_inches="tight")
+
+        return write
+
+    paths = {
+        Path(out_dir) / f"{name}.{fmt}": writer(name, fmt)
+        for name in makers
+        for fmt in formats
+    }
+    written = set(replace_files(paths))
+    return [path for path in paths if path in written]
 
 
 def plot_screen(
@@ -410,8 +416,19 @@ def plot_screen(
 ) -> list[Path]:
     """The Mohr diagram of ``xfemslip screen``: ``<out_dir>/mohr.<fmt>``;
     ``fractures`` = [(label, theta [deg], f, c)]."""
-    out_dir = Path(out_dir)
-    _make_dir(out_dir)
+    return _save_all(
+        Path(out_dir),
+        {
+            "mohr": lambda: _screen_figure(
+                stress, pore_pressure, friction, cohesion, fractures
+            )
+        },
+        formats,
+    )
+
+
+def _screen_figure(stress, pore_pressure, friction, cohesion, fractures) -> Figure:
+    """The Mohr diagram of :func:`plot_screen`."""
     fig = Figure(figsize=mohr_figsize(stress, pore_pressure), layout="constrained")
     ax = fig.subplots()
     if not fractures:
@@ -428,7 +445,7 @@ def plot_screen(
         fontsize=9,
     )
     add_legend(fig)
-    return _save(fig, out_dir, "mohr", formats)
+    return fig
 
 
 def plot_results(
@@ -451,8 +468,6 @@ def plot_results(
     results = [
         read_result(p, labels[i] if labels else None) for i, p in enumerate(paths)
     ]
-    out_dir = Path(out_dir)
-    _make_dir(out_dir)
     makers = {
         "displacement": lambda: figure_displacement(results),
         "principal_stress": lambda: figure_principal(results),
@@ -462,10 +477,10 @@ def plot_results(
         # not in KINDS (asked for by name): one figure per result
         "network": lambda: figure_network(results[0], scale),
     }
-    written = []
+    drawn = {}
     for kind in kinds:
         if kind in ("slip", "mohr") and not any(r.fractures for r in results):
             logger.info("no fracture: %s figure skipped", kind)
             continue
-        written += _save(makers[kind](), out_dir, kind, formats, dpi)
-    return written
+        drawn[kind] = makers[kind]
+    return _save_all(Path(out_dir), drawn, formats, dpi)

@@ -184,16 +184,23 @@ def _warn_unaligned(mesh, reservoir, fractures=()) -> None:
     """Log a warning for each region edge inside the domain off the mesh
     lines, unless a fracture covers it (its cut cells are split per QP)."""
     tol = ALIGN_TOL * mesh.h_min
+    off = []
     for name, p, q in edges(reservoir):
         if _on_mesh_line(mesh, p, q):
             continue
         part = _clip_to_domain(mesh, p, q)
         if part is None or _on_fracture(fractures, *part, tol):
             continue
+        off.append(name)
+    # a polygon may have thousands of edges: one line names the first few
+    subjects = [f"{name} is" for name in off]
+    if len(off) > 4:
+        subjects = [f"{', '.join(off[:3])} and {len(off) - 3:,} more edges are"]
+    for subject in subjects:
         logger.warning(
-            "reservoir %s is not on a mesh line; the cells whose centre is "
+            "reservoir %s not on a mesh line; the cells whose centre is "
             "inside the region form the reservoir",
-            name,
+            subject,
         )
 
 

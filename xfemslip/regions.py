@@ -10,6 +10,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from xfemslip.polyline import first_meeting
+
 
 def in_boxes(xy: np.ndarray, boxes: np.ndarray) -> np.ndarray:
     """(n,) bool: points strictly inside one of the boxes (k, 4) [x0, y0, x1, y1]."""
@@ -20,19 +22,45 @@ def in_boxes(xy: np.ndarray, boxes: np.ndarray) -> np.ndarray:
     return inside
 
 
+# Point-edge pairs tested at once by in_polygon (bounds a chunk's memory).
+_PAIR_CHUNK = 1 << 20
+
+
 def in_polygon(xy: np.ndarray, polygon: np.ndarray) -> np.ndarray:
     """(n,) bool: points inside the polygon (k, 2) [m] (even-odd crossings of a
-    ray towards +x)."""
+    ray towards +x).
+
+    An edge P-Q can only cross the ray of a point whose y lies in
+    [min(P_y, Q_y), max(P_y, Q_y)); with the points sorted by y those points
+    are a contiguous run, so only these (point, edge) pairs are formed, in
+    chunks: the work follows the number of edges a horizontal line meets, not
+    points x edges.
+    """
     xy = np.asarray(xy, float).reshape(-1, 2)
     P = np.asarray(polygon, float)
     Q = np.roll(P, -1, axis=0)
-    x, y = xy[:, 0:1], xy[:, 1:2]
-    straddles = (P[None, :, 1] > y) != (Q[None, :, 1] > y)
-    with np.errstate(divide="ignore", invalid="ignore"):
-        x_cross = P[None, :, 0] + (y - P[None, :, 1]) * (
-            Q[None, :, 0] - P[None, :, 0]
-        ) / (Q[None, :, 1] - P[None, :, 1])
-    crossings = np.count_nonzero(straddles & (x < x_cross), axis=1)
+    order = np.argsort(xy[:, 1], kind="stable")
+    ys = xy[order, 1]
+    first = np.searchsorted(ys, np.minimum(P[:, 1], Q[:, 1]), side="left")
+    stop = np.searchsorted(ys, np.maximum(P[:, 1], Q[:, 1]), side="left")
+    count = stop - first
+    crossings = np.zeros(xy.shape[0], np.int64)
+    edge = 0
+    while edge < len(P):
+        end = edge + max(
+            1, int(np.searchsorted(np.cumsum(count[edge:]), _PAIR_CHUNK, "right"))
+        )
+        block = count[edge:end]
+        e = np.repeat(np.arange(edge, end), block)
+        pos = np.repeat(first[edge:end] - np.cumsum(block) + block, block)
+        pt = order[pos + np.arange(e.size)]
+        x, y = xy[pt, 0], xy[pt, 1]
+        with np.errstate(divide="ignore", invalid="ignore"):
+            x_cross = P[e, 0] + (y - P[e, 1]) * (Q[e, 0] - P[e, 0]) / (
+                Q[e, 1] - P[e, 1]
+            )
+        crossings += np.bincount(pt[x < x_cross], minlength=xy.shape[0])
+        edge = end
     return crossings % 2 == 1
 
 
@@ -59,43 +87,19 @@ def edges(reservoir) -> list[tuple[str, np.ndarray, np.ndarray]]:
     return out
 
 
-def _cross(o, a, b) -> float:
-    """z of (a - o) x (b - o)."""
-    return (a[0] - o[0]) * (b[1] - o[1]) - (a[1] - o[1]) * (b[0] - o[0])
-
-
-def _segments_meet(p1, p2, q1, q2) -> bool:
-    """Whether the closed segments p1-p2 and q1-q2 share a point."""
-    d1, d2 = _cross(q1, q2, p1), _cross(q1, q2, p2)
-    d3, d4 = _cross(p1, p2, q1), _cross(p1, p2, q2)
-    if ((d1 > 0) != (d2 > 0)) and ((d3 > 0) != (d4 > 0)) and 0 not in (d1, d2, d3, d4):
-        return True
-
-    def on(a, b, c):  # c collinear with a-b and within its box
-        return (
-            _cross(a, b, c) == 0
-            and min(a[0], b[0]) <= c[0] <= max(a[0], b[0])
-            and min(a[1], b[1]) <= c[1] <= max(a[1], b[1])
-        )
-
-    return on(q1, q2, p1) or on(q1, q2, p2) or on(p1, p2, q1) or on(p1, p2, q2)
-
-
 def polygon_problem(polygon: np.ndarray) -> str | None:
     """Why the polygon (k >= 3, 2) is not simple, or None: zero area, or two
     edges that meet other than at their shared vertex."""
     P = np.asarray(polygon, float)
     k = len(P)
     area = 0.5 * np.sum(P[:, 0] * np.roll(P[:, 1], -1) - np.roll(P[:, 0], -1) * P[:, 1])
-    for i in range(k):
-        if np.all(P[i] == P[(i + 1) % k]):
-            return f"repeats vertex {i} (vertices {i} and {(i + 1) % k} coincide)"
-    for i in range(k):
-        for j in range(i + 1, k):
-            if j == i + 1 or (i == 0 and j == k - 1):
-                continue  # neighbours share a vertex
-            if _segments_meet(P[i], P[(i + 1) % k], P[j], P[(j + 1) % k]):
-                return f"is not simple: edges {i} and {j} cross or touch"
+    repeated = np.flatnonzero(np.all(P == np.roll(P, -1, axis=0), axis=1))
+    if repeated.size:
+        i = int(repeated[0])
+        return f"repeats vertex {i} (vertices {i} and {(i + 1) % k} coincide)"
+    pair = first_meeting(P, closed=True)
+    if pair is not None:
+        return f"is not simple: edges {pair[0]} and {pair[1]} cross or touch"
     if area == 0.0:
         return "has zero area"
     return None

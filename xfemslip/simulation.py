@@ -2,7 +2,8 @@
 
 Testable without the CLI.  Output files follow ``output-format.md``; when a
 load step fails, the steps already converged are written (``converged =
-False``) before the ConvergenceError is passed on.
+False``) before the ConvergenceError is passed on.  The files of a run are one
+set, swapped into the output folder whole (:mod:`xfemslip.writers.folder`).
 """
 
 from __future__ import annotations
@@ -15,15 +16,15 @@ from pathlib import Path
 
 import numpy as np
 
-from xfemslip import __version__, kernels
+from xfemslip import __version__, interrupt, kernels
 from xfemslip.assembly import BulkSystem, assemble_bulk
 from xfemslip.boundary import dirichlet, hold_enriched, traction_load
-from xfemslip.contact import ContactSet, build_contact
+from xfemslip.contact import OPEN, SLIP, STICK, ContactSet, build_contact
 from xfemslip.enrichment import EnrichedCells, build_enriched_cells, find_candidates
-from xfemslip.errors import ConvergenceError, GeometryError, OutputError, UsageError
+from xfemslip.errors import ConvergenceError, GeometryError
 from xfemslip.geometry import build_fractures
 from xfemslip.material import elasticity_matrix
-from xfemslip.memory import check_memory
+from xfemslip.memory import check_memory, enriched_footprint, model_footprint
 from xfemslip.mesh import Mesh, build_mesh
 from xfemslip.poro import (
     Materials,
@@ -115,6 +116,7 @@ def build_model(spec) -> Model:
     mat = spec.material
     D = elasticity_matrix(mat.E, mat.nu, mat.model)
     cand = find_candidates(mesh, fractures)
+    check_memory(spec, enriched_footprint(spec, mesh, fractures, cand))
     ec = build_enriched_cells(mesh, fractures, cand)
     kernel_backend = kernels.choose(spec.solver.kernels, kernel_work(ec))
     kernels.use(kernel_backend)
@@ -173,7 +175,7 @@ def build_model(spec) -> Model:
         ip.n,
         kernel_backend,
     )
-    return Model(
+    model = Model(
         spec=spec,
         mesh=mesh,
         D=D,
@@ -186,12 +188,14 @@ def build_model(spec) -> Model:
         materials=materials,
         pore=pore,
     )
+    check_memory(spec, model_footprint(model))  # before the LU and the steps
+    return model
 
 
 def newton_solver(model: Model) -> NewtonSolver:
     """The Newton solver of a model, with the options of its [solver] table."""
     opt = model.spec.solver
-    return NewtonSolver(
+    solver = NewtonSolver(
         model.problem,
         opt.tolerance,
         opt.max_iterations,
@@ -199,6 +203,44 @@ def newton_solver(model: Model) -> NewtonSolver:
         opt.linear_solver,
         max_step_cuts=opt.max_step_cuts,
     )
+    _log_in_situ_release(model, solver.in_situ)
+    return solver
+
+
+def _log_in_situ_release(model: Model, zero) -> None:
+    """Say, per fracture, where the in-situ traction is not admissible (shear
+    above the friction limit, or tension) and how much of it the first load
+    step releases (ContactSet.in_situ_force)."""
+    c = model.contact
+    if model.spec.loading.initial_stress is None or not np.any(zero.state != STICK):
+        return
+    pt_in_situ = c.kt * (0.0 - c.slip_committed)
+    for fi, fr in enumerate(model.fractures):
+        mine = c.fracture == fi
+        slips = mine & (zero.state == SLIP)
+        opens = mine & (zero.state == OPEN)
+        total = float(c.weight[mine].sum())
+        if slips.any():
+            excess = np.abs(pt_in_situ[slips]) - np.abs(zero.pt[slips])
+            logger.info(
+                "fractures[%d]: the initial stress exceeds the friction limit on "
+                "%.4g m of its %.4g m, by up to %.4g MPa of shear; the excess is "
+                "released in load step 1 (the fracture slips by what it drives)",
+                fr.index,
+                float(c.weight[slips].sum()),
+                total,
+                float(excess.max()) / 1e6,
+            )
+        if opens.any():
+            logger.info(
+                "fractures[%d]: the initial stress pulls it open on %.4g m of its "
+                "%.4g m, with up to %.4g MPa of tension; released in load step 1 "
+                "(the fracture opens)",
+                fr.index,
+                float(c.weight[opens].sum()),
+                total,
+                float(c.pn0[opens].max()) / 1e6,
+            )
 
 
 def floating_parts(mesh, fractures, contact, bc):
@@ -256,17 +298,6 @@ def step_fields(model: Model, r: StepResult) -> StepFields:
     )
 
 
-def _check_out_dir(out_dir: Path, overwrite: bool) -> None:
-    existing = [name for name in OUTPUT_FILES if (out_dir / name).exists()]
-    if existing and not overwrite:
-        raise UsageError(
-            f"{out_dir} already holds {', '.join(existing)}; "
-            "use --overwrite to replace it or -o to choose another directory"
-        )
-    if out_dir.exists() and not out_dir.is_dir():
-        raise UsageError(f"{out_dir} exists and is not a directory")
-
-
 def run_case(
     spec, out_dir: Path | None = None, *, overwrite: bool = False
 ) -> RunSummary:
@@ -305,44 +336,54 @@ class Written:
     failure: ConvergenceError | None
 
 
-def solve_and_write(spec, out_dir, overwrite, drive) -> Written:
-    """The frame of every command that solves a case: check the output folder,
-    build the model and its Newton solver, run ``drive(solver, model)``, and
-    write the converged steps (also after a ConvergenceError, which is
-    returned, not raised, with converged = False in result.h5)."""
+def solve_and_write(spec, out_dir, overwrite, drive, finish=None) -> Written:
+    """The frame of every command that solves a case: take the output folder
+    (:func:`xfemslip.writers.folder.output_folder`: locked, refused when it
+    holds results and not ``overwrite``), build the model and its Newton
+    solver, run ``drive(solver, model)``, and write the converged steps (also
+    after a ConvergenceError, which is returned, not raised, with converged =
+    False in result.h5).  ``finish(written, folder)`` may add files of its own
+    to the set in ``folder``; the set replaces the folder's content whole."""
+    from xfemslip.writers.folder import output_folder
+
     start = time.perf_counter()
     out_dir = Path(out_dir) if out_dir is not None else Path(spec.output.directory)
-    _check_out_dir(out_dir, overwrite)
-    model = build_model(spec)
-    solver = newton_solver(model)
-    value = failure = None
-    try:
-        value = drive(solver, model)
-    except ConvergenceError as exc:
-        failure = exc
-    results = solver.completed
-    write_output(
-        model,
-        results,
-        out_dir,
-        converged=failure is None,
-        wall=time.perf_counter() - start,
-        iterations=[r.iterations for r in results],
-    )
-    return Written(out_dir, model, results, value, failure)
+    with output_folder(out_dir, overwrite=overwrite, results=OUTPUT_FILES) as stage:
+        model = build_model(spec)
+        solver = newton_solver(model)
+        value = failure = None
+        try:
+            value = drive(solver, model)
+        except ConvergenceError as exc:
+            failure = exc
+        interrupt.checkpoint()  # a signal swallowed while solving ends it here
+        results = solver.completed
+        with interrupt.deferred():
+            failure = (
+                write_output(
+                    model,
+                    results,
+                    stage.path,
+                    converged=failure is None,
+                    wall=time.perf_counter() - start,
+                    iterations=[r.iterations for r in results],
+                )
+                or failure
+            )
+            done = Written(out_dir, model, results, value, failure)
+            if finish is not None:
+                finish(done, stage.path)
+    return done
 
 
 def write_output(model: Model, results, out_dir: Path, *, converged, wall, iterations):
-    """Write result.h5 (+ VTU/PVD) of the converged steps."""
-    from xfemslip.writers import hdf5, vtu
+    """Write result.h5 (+ VTU/PVD) of the converged steps into ``out_dir``
+    (the staging folder of the set).  Returns a ConvergenceError when a step
+    holds NaN or inf: the finite steps before it are written, converged =
+    False."""
+    from xfemslip.writers import hdf5, run_id
 
     spec = model.spec
-    try:
-        out_dir.mkdir(parents=True, exist_ok=True)
-    except OSError as exc:
-        raise OutputError(
-            f"cannot create output directory {out_dir}: {exc.strerror}"
-        ) from None
     fields = [step_fields(model, r) for r in results]
     bad = _first_non_finite(fields)
     if bad is not None:  # never write NaN/inf: keep the finite steps only
@@ -366,6 +407,7 @@ def write_output(model: Model, results, out_dir: Path, *, converged, wall, itera
         "kernels": model.contact.kernels,
         "status_codes": STATE_CODES,
     }
+    attrs["run_id"] = run_id(attrs, model.mesh.nodes, model.mesh.cells, fields)
     hdf5.write_result(
         out_dir / "result.h5",
         points=model.mesh.nodes,
@@ -374,22 +416,21 @@ def write_output(model: Model, results, out_dir: Path, *, converged, wall, itera
         attrs=attrs,
         load_steps=spec.loading.steps,
     )
-    written = {out_dir / "result.h5"}
     if "vtu" in spec.output.formats and fields:
-        written |= _write_vtu(
-            model, results, fields, out_dir, spec.loading.steps > 1, vtu
+        _write_vtu(
+            model, results, fields, out_dir, spec.loading.steps > 1, attrs["run_id"]
         )
-    _remove_stale(out_dir, written)
-    if bad is not None:
-        step = bad[0] + 1
-        raise ConvergenceError(
-            f"load step {step} gave a non-finite {bad[1]} (NaN or inf), which is "
-            f"not written; {len(fields)} finite step(s) kept. Lower the penalty "
-            "stiffnesses kn/kt or use more load steps",
-            step=step,
-            iteration=0,
-            residual=float("nan"),
-        )
+    if bad is None:
+        return None
+    step = bad[0] + 1
+    return ConvergenceError(
+        f"load step {step} gave a non-finite {bad[1]} (NaN or inf), which is "
+        f"not written; {len(fields)} finite step(s) kept. Lower the penalty "
+        "stiffnesses kn/kt or use more load steps",
+        step=step,
+        iteration=0,
+        residual=float("nan"),
+    )
 
 
 def _first_non_finite(fields):
@@ -410,29 +451,14 @@ def _first_non_finite(fields):
     return None
 
 
-def _remove_stale(out_dir: Path, written: set) -> None:
-    """Remove output files of an earlier run (--overwrite) that this run did not
-    write, e.g. result.pvd and steps/ after a rerun with one load step, so the
-    folder never mixes two runs."""
-    old = [out_dir / name for name in OUTPUT_FILES]
-    steps = out_dir / "steps"
-    if steps.is_dir():
-        old += sorted(steps.glob("result_*.vtu")) + sorted(
-            steps.glob("fractures_*.vtu")
-        )
-    for path in old:
-        if path.exists() and path not in written:
-            path.unlink()
-            logger.info("removed %s of an earlier run", path)
-    if steps.is_dir() and not any(steps.iterdir()):
-        steps.rmdir()
+def _write_vtu(model, results, fields, out_dir, series, set_id) -> None:
+    """Write the VTU (and PVD) files of the converged steps into ``out_dir``,
+    each stamped with the set's ``run_id``."""
+    from xfemslip.writers import vtu
 
-
-def _write_vtu(model, results, fields, out_dir, series, vtu) -> set:
-    """Write the VTU (and PVD) files; returns the paths written."""
-    written = set()
     entries = []
     for r, f in zip(results, fields, strict=True):
+        interrupt.checkpoint()  # between files: a deferred signal stops here
         vis = vis_mesh(model.mesh, model.ec, model.bulk, r.u)
         cell_data = {
             "stress": f.stress,
@@ -443,24 +469,16 @@ def _write_vtu(model, results, fields, out_dir, series, vtu) -> set:
             cell_data["effective_stress"] = f.effective_stress
             cell_data["pore_pressure"] = f.pore_pressure
         fr = [(model.fractures[i].index, ff) for i, ff in enumerate(f.fractures)]
-        is_last = r is results[-1]
+        names = []
         if series:
-            name = f"steps/result_{r.step:04d}.vtu"
             (out_dir / "steps").mkdir(exist_ok=True)
-            vtu.write_bulk(out_dir / name, vis, cell_data)
-            written.add(out_dir / name)
+            names.append(f"steps/%s_{r.step:04d}.vtu")
+            entries.append((r.load_factor, f"steps/result_{r.step:04d}.vtu"))
+        if r is results[-1]:
+            names.append("%s.vtu")
+        for name in names:
+            vtu.write_bulk(out_dir / (name % "result"), vis, cell_data, run_id=set_id)
             if fr:
-                frac_name = out_dir / f"steps/fractures_{r.step:04d}.vtu"
-                vtu.write_fractures(frac_name, fr)
-                written.add(frac_name)
-            entries.append((r.load_factor, name))
-        if is_last:
-            vtu.write_bulk(out_dir / "result.vtu", vis, cell_data)
-            written.add(out_dir / "result.vtu")
-            if fr:
-                vtu.write_fractures(out_dir / "fractures.vtu", fr)
-                written.add(out_dir / "fractures.vtu")
+                vtu.write_fractures(out_dir / (name % "fractures"), fr, run_id=set_id)
     if series:
-        vtu.write_pvd(out_dir / "result.pvd", entries)
-        written.add(out_dir / "result.pvd")
-    return written
+        vtu.write_pvd(out_dir / "result.pvd", entries, run_id=set_id)

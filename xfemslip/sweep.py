@@ -24,8 +24,13 @@ the first key varying slowest; ``zip`` pairs the i-th values of every key.
 
 Every generated case is validated by the normal case loader
 (:func:`xfemslip.case.loads_case`) and checked against its mesh before
-anything runs; a problem is reported as ONE ``CaseError`` naming the sweep
-file, the ``vary`` key or the case, and what was expected (exit 2).
+anything runs.  A problem of the sweep file itself (its keys, the ``[vary]``
+table, a key path the base case does not have) is ONE ``CaseError`` naming
+the sweep file, the key and what was expected (exit 2), as is a sweep none of
+whose cases can be built.  A generated case that cannot be built while
+others can is *refused*: it stays in ``SweepSpec.cases`` with the reason in
+``SweepCase.refused`` (and no spec), and :mod:`xfemslip.sweep_run` reports
+it and runs the others.
 
 Public: ``load_sweep(path) -> SweepSpec``, ``loads_sweep(text, path)``.
 The ``[vary]`` table (key paths, ranges) is read by :mod:`xfemslip.sweep_vary`;
@@ -83,14 +88,22 @@ MAX_SWEEP_TEXT_BYTES = 256e6
 
 @dataclass(frozen=True)
 class SweepCase:
-    """One generated case: its id (folder name), parameters, TOML text, spec."""
+    """One generated case: its id (folder name), parameters, TOML text, spec;
+    a case that cannot be built has no spec and says why in ``refused``."""
 
     index: int
     case_id: str
     params: tuple[tuple[str, object], ...]  # (key path, value) in vary order
-    text: str  # the case file's text (TOML)
+    text: str  # the case file's text (TOML); "" if it cannot be written
     path: Path  # the path the case is loaded as (CSV files relative to it)
-    spec: object  # CaseSpec
+    spec: object  # CaseSpec, or None when refused
+    refused: str = ""  # one line: why the case cannot be built
+
+    @property
+    def label(self) -> str:
+        """``case 003_seed=4 (network.generate.seed = 4)``."""
+        values = ", ".join(f"{k} = {v!r}" for k, v in self.params)
+        return f"case {self.case_id} ({values})"
 
 
 @dataclass(frozen=True)
@@ -143,7 +156,8 @@ def _combinations(vary: list, combine: str) -> list[tuple[tuple[str, object], ..
 
 
 def _build_case(base: dict, base_name: str, index: int, n: int, params, path: Path):
-    """(case_id, TOML text) of one parameter set, or (case_id, problems)."""
+    """(case_id, TOML text, why it cannot be written, problems of the sweep
+    file: vary keys the base case cannot take)."""
     cid = case_id(index, n, params)
     document = copy.deepcopy(base)
     problems = []
@@ -157,18 +171,18 @@ def _build_case(base: dict, base_name: str, index: int, n: int, params, path: Pa
     if isinstance(output, dict):
         output.pop("directory", None)  # the sweep chooses the folder
     if problems:
-        return cid, problems
+        return cid, "", "", problems
     try:
-        return cid, tomli_w.dumps(document)
+        return cid, tomli_w.dumps(document), "", []
     except (TypeError, ValueError) as exc:  # e.g. mixed-type arrays
-        return cid, [(f"case {cid}", f"cannot be written as TOML: {exc}")]
+        return cid, "", f"cannot be written as TOML: {exc}", []
 
 
-def _validate_case(cid: str, text: str, path: Path, params):
-    """(spec, problems): the case loader, then the geometry check."""
+def _validate_case(text: str, path: Path):
+    """(spec, "") or (None, one-line reason): the case loader, then the
+    geometry check."""
     from xfemslip.simulation import check_geometry
 
-    label = f"case {cid} (" + ", ".join(f"{k} = {v!r}" for k, v in params) + ")"
     try:
         spec = loads_case(text, path)
         logging.disable(logging.WARNING)  # the run logs its warnings once
@@ -177,12 +191,10 @@ def _validate_case(cid: str, text: str, path: Path, params):
         finally:
             logging.disable(logging.NOTSET)
     except CaseError as err:
-        return None, [
-            (label, "; ".join(f"{k}: {m}" if k else m for k, m in err.problems))
-        ]
+        return None, "; ".join(f"{k}: {m}" if k else m for k, m in err.problems)
     except (GeometryError, MeshError) as err:
-        return None, [(label, str(err).replace(f"{path}: ", "", 1))]
-    return spec, []
+        return None, " ".join(str(err).replace(f"{path}: ", "", 1).split())
+    return spec, ""
 
 
 # --------------------------------------------------------------------------- #
@@ -240,6 +252,8 @@ def loads_sweep(text: str, path: str | Path = "<string>") -> SweepSpec:
     _check_volume(base, vary, combine, path)  # read_vary has bounded the count
     combos = _combinations(vary, combine)
     cases = _generate(base, base_name, case_path, combos, problems)
+    if not problems and all(case.refused for case in cases):  # nothing to run
+        problems = [(case.label, case.refused) for case in cases]
     if problems:
         shown = problems[:MAX_PROBLEMS]
         if len(problems) > MAX_PROBLEMS:
@@ -277,17 +291,20 @@ def _check_volume(base: dict, vary: list, combine: str, path: Path) -> None:
 
 
 def _generate(base, base_name, case_path, combos, problems) -> list[SweepCase]:
-    """Build and validate every case; problems are appended."""
+    """Build and validate every case; problems of the sweep file are appended,
+    a case that cannot be built is kept with its reason (``refused``)."""
     cases = []
     for index, params in enumerate(combos):
-        cid, built = _build_case(base, base_name, index, len(combos), params, case_path)
-        if isinstance(built, list):
-            problems += built
-            continue
-        spec, found = _validate_case(cid, built, case_path, params)
+        cid, text, reason, found = _build_case(
+            base, base_name, index, len(combos), params, case_path
+        )
         problems += found
-        if spec is not None:
-            cases.append(SweepCase(index, cid, params, built, case_path, spec))
+        if found:
+            continue
+        spec = None
+        if not reason and not problems:  # else the sweep is refused anyway
+            spec, reason = _validate_case(text, case_path)
+        cases.append(SweepCase(index, cid, params, text, case_path, spec, reason))
     return cases
 
 

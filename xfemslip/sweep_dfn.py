@@ -4,7 +4,7 @@ A sweep whose ``[vary]`` holds a ``network.*`` key (typically
 ``network.generate.seed``) gets, besides ``summary.csv``, one row per metric
 over the cases that have a result (status ok or skipped): the number of
 realizations, mean, standard deviation (ddof = 1; 0 for one realization),
-min, median and max.  Failed cases are left out and counted.
+min, median and max.  Failed and refused cases are left out and counted.
 """
 
 from __future__ import annotations

@@ -10,14 +10,18 @@ Each case of a :class:`~xfemslip.sweep.SweepSpec` runs in its own folder
   ``dask.distributed`` scheduler.  The workers need xfemslip installed and the
   sweep folder on a file system they share with this machine.
 
-A case whose ``result.h5`` exists, says ``converged = true`` and holds the same
-case text is skipped (results are written atomically, so an existing file is
-complete); any other case runs (again).  A failed case is reported in its row
-and the others go on.  ``summary.csv`` has one row per case: the parameters,
-max |slip| [m], slipping length [m], share of contact points in slip,
-converged, Newton iterations, wall time [s], the number of fractures, how
-many have a point in slip, that fraction, the mean over those of their
-length-weighted mean |slip| [m], status and error.  A sweep that varies a
+A case whose folder holds a whole converged result of the same case text
+(:func:`is_done`) is skipped; any other case runs (again). Each member's
+folder is written as one set (:mod:`xfemslip.writers.folder`), the sweep
+folder is locked while a sweep runs, and ``summary.csv`` with
+``dfn_summary.csv`` are replaced together (``replace_files``). A failed case
+is reported in its row and the others go on; so is a case the sweep refused
+(it cannot be built: ``SweepCase.refused``), which is logged and not run.
+``summary.csv`` has one row per case: the parameters, max |slip| [m],
+slipping length [m], share of contact points in slip, converged, Newton
+iterations, wall time [s], the number of fractures, how many have a point in
+slip, that fraction, the mean over those of their length-weighted mean |slip|
+[m], status (ok, skipped, failed, refused) and error. A sweep that varies a
 ``network.*`` key also gets ``dfn_summary.csv`` (:mod:`xfemslip.sweep_dfn`).
 """
 
@@ -26,6 +30,7 @@ from __future__ import annotations
 import csv
 import logging
 import math
+import os
 import traceback
 from collections.abc import Callable, Iterable
 from concurrent.futures import ProcessPoolExecutor, as_completed
@@ -38,7 +43,8 @@ import numpy as np
 
 from xfemslip.errors import OutputError, UsageError, XfemslipError
 from xfemslip.sweep_dfn import DFN_SUMMARY, is_dfn_sweep, write_dfn_summary
-from xfemslip.writers.atomic import atomic_path
+from xfemslip.writers.fileset import replace_files
+from xfemslip.writers.lock import folder_lock
 
 logger = logging.getLogger(__name__)
 
@@ -75,7 +81,7 @@ class CaseRow:
 
     case_id: str
     params: tuple = ()
-    status: str = "ok"  # ok | skipped | failed
+    status: str = "ok"  # ok | skipped | failed | refused
     metrics: dict = field(default_factory=dict)
     error: str = ""
 
@@ -161,18 +167,47 @@ def result_metrics(h5_path: Path, spec) -> dict:
     }
 
 
-def is_done(out_dir: Path, text: str) -> bool:
-    """Whether ``out_dir/result.h5`` is a converged result of this case text."""
+def is_done(out_dir: Path, text: str, spec=None) -> bool:
+    """Whether ``out_dir`` holds a converged result of this case text, whole.
+
+    ``result.h5`` must say ``converged = true``, hold the same case text and a
+    ``run_id`` (written only by a run that swapped its whole set in, see
+    :mod:`xfemslip.writers.folder`).  Given the case ``spec``, the VTU and PVD
+    files its ``output.formats`` call for must be there with the same
+    ``run_id``: a folder with a result.h5 but no (or another run's) VTU is run
+    again.
+    """
     path = Path(out_dir) / "result.h5"
     if not path.is_file():
         return False
     try:
         with h5py.File(path, "r") as f:
-            return bool(f.attrs.get("converged", False)) and (
-                f.attrs.get("case_toml") == text
-            )
+            attrs = dict(f.attrs)
     except OSError:  # unreadable: run it again
         return False
+    if not (
+        bool(attrs.get("converged", False))
+        and attrs.get("case_toml") == text
+        and "run_id" in attrs
+    ):
+        return False
+    return spec is None or _vtu_set_whole(Path(out_dir), spec, int(attrs["run_id"]))
+
+
+def _vtu_set_whole(out_dir: Path, spec, run_id: int) -> bool:
+    """Whether the VTU/PVD files of ``spec``'s output are there, of ``run_id``."""
+    from xfemslip.writers.vtu import pvd_files, read_run_id
+
+    if "vtu" not in spec.output.formats:
+        return True
+    names = ["result.vtu"]
+    if (out_dir / "fractures.vtu").exists():
+        names.append("fractures.vtu")
+    if spec.loading.steps > 1:
+        if read_run_id(out_dir / "result.pvd") != run_id:
+            return False
+        names += pvd_files(out_dir / "result.pvd")
+    return all(read_run_id(out_dir / name) == run_id for name in names)
 
 
 # --------------------------------------------------------------------------- #
@@ -214,23 +249,37 @@ def run_task(task: CaseTask) -> tuple[str, str, dict, str]:
 
 
 def _prepare(sweep, directory: Path, force: bool) -> tuple[list, list[CaseRow]]:
-    """Write each case.toml; (tasks to run, rows of the skipped cases)."""
+    """Write each case.toml; (tasks to run, rows of the refused and skipped
+    cases)."""
     tasks, skipped = [], []
     for case in sweep.cases:
         out_dir = directory / case.case_id
-        if not force and is_done(out_dir, case.text):
+        if case.refused:
+            logger.warning("%s refused: %s", case.label, case.refused)
+            skipped.append(
+                CaseRow(case.case_id, case.params, "refused", error=case.refused)
+            )
+            if case.text:  # for `xfemslip check` on it
+                _write_case(sweep, out_dir, case.text)
+            continue
+        if not force and is_done(out_dir, case.text, case.spec):
             row = CaseRow(case.case_id, case.params, "skipped")
             row.metrics = result_metrics(out_dir / "result.h5", case.spec)
             skipped.append(row)
             continue
-        try:
-            out_dir.mkdir(parents=True, exist_ok=True)
-            header = f"# generated by xfemslip sweep from {sweep.path}\n"
-            (out_dir / "case.toml").write_text(header + case.text, encoding="utf-8")
-        except OSError as exc:
-            raise OutputError(f"cannot write {out_dir}: {exc.strerror}") from None
+        _write_case(sweep, out_dir, case.text)
         tasks.append(CaseTask(case.case_id, case.text, str(case.path), str(out_dir)))
     return tasks, skipped
+
+
+def _write_case(sweep, out_dir: Path, text: str) -> None:
+    """``<out_dir>/case.toml``: the generated case, with where it came from."""
+    try:
+        out_dir.mkdir(parents=True, exist_ok=True)
+        header = f"# generated by xfemslip sweep from {sweep.path}\n"
+        (out_dir / "case.toml").write_text(header + text, encoding="utf-8")
+    except OSError as exc:
+        raise OutputError(f"cannot write {out_dir}: {exc.strerror}") from None
 
 
 def _outcome(task: CaseTask, future) -> tuple:
@@ -318,16 +367,34 @@ def run_sweep(
     # connect first: a wrong address must not leave case folders behind
     client = _client(scheduler) if scheduler else None
     try:
-        rows = _run_all(sweep, directory, jobs, client, force, progress)
+        with _sweep_lock(directory):
+            rows = _run_all(sweep, directory, jobs, client, force, progress)
     finally:
         if client is not None:
             client.close()
     order = {case.case_id: case.index for case in sweep.cases}
     rows.sort(key=lambda r: order[r.case_id])
-    write_summary(directory / SUMMARY, sweep.keys, rows)
-    if is_dfn_sweep(sweep.keys):  # realizations of a random network
-        write_dfn_summary(directory / DFN_SUMMARY, rows)
+    # one set: a dfn_summary.csv of an earlier sweep of this folder goes too
+    dfn = is_dfn_sweep(sweep.keys)  # realizations of a random network
+    replace_files(
+        {
+            directory / SUMMARY: lambda tmp: write_summary(tmp, sweep.keys, rows),
+            directory / DFN_SUMMARY: (lambda tmp: write_dfn_summary(tmp, rows))
+            if dfn
+            else None,
+        }
+    )
     return rows
+
+
+def _sweep_lock(directory: Path):
+    """The lock of the sweep folder (``.NAME.lock`` beside it): one sweep at a
+    time writes its members and summary."""
+    try:
+        directory.parent.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        raise OutputError(f"cannot write {directory}: {exc.strerror}") from None
+    return folder_lock(Path(os.path.realpath(directory)), directory)
 
 
 def _run_all(sweep, directory, jobs, client, force, progress) -> list[CaseRow]:
@@ -374,9 +441,9 @@ def summary_table(keys, rows: list[CaseRow]) -> tuple[list[str], list[list[str]]
 
 
 def write_summary(path: Path, keys, rows: list[CaseRow]) -> None:
-    """``summary.csv``, written atomically."""
+    """``summary.csv`` (run_sweep writes it through ``replace_files``)."""
     header, body = summary_table(keys, rows)
-    with atomic_path(path) as tmp, open(tmp, "w", newline="", encoding="utf-8") as fh:
+    with open(path, "w", newline="", encoding="utf-8") as fh:
         writer = csv.writer(fh)
         writer.writerow(header)
         writer.writerows(body)

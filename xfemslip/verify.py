@@ -550,11 +550,8 @@ def main(*, quick=False, tip=None, plot=None, csv_path=None, penalty="100") -> b
         click.echo(f"[{time.perf_counter() - start:6.1f} s] {msg}", err=True)
 
     report = run_verification(quick=quick, tip=tip, penalty=ratio, progress=progress)
-    from xfemslip.verify_output import format_table, write_csv, write_plot
+    from xfemslip.verify_output import format_table, write_outputs
 
     click.echo(format_table(report))
-    if csv_path is not None:
-        write_csv(report, Path(csv_path))
-    if plot is not None:
-        write_plot(report, Path(plot))
+    write_outputs(report, csv_path, plot)
     return not report.failures

@@ -84,6 +84,19 @@ CSV_FIELDS = (
 )
 
 
+def write_outputs(report: Report, csv_path: Path | None, plot: Path | None) -> None:
+    """``--csv`` and ``--plot``, written as one set (``replace_files``)."""
+    from xfemslip.writers.fileset import replace_files
+
+    writes = {}
+    if csv_path is not None:
+        writes[Path(csv_path)] = lambda tmp: write_csv(report, tmp)
+    if plot is not None:
+        fmt = Path(plot).suffix.lower().lstrip(".")
+        writes[Path(plot)] = lambda tmp: write_plot(report, tmp, fmt)
+    replace_files(writes)
+
+
 def write_csv(report: Report, path: Path) -> None:
     with open(path, "w", newline="") as fh:
         w = csv.writer(fh)
@@ -92,8 +105,9 @@ def write_csv(report: Report, path: Path) -> None:
             w.writerow([getattr(r, k) for k in CSV_FIELDS] + [report.tip or "default"])
 
 
-def write_plot(report: Report, path: Path) -> None:
-    """Error against h and against wall time (PNG or PDF by the suffix)."""
+def write_plot(report: Report, path: Path, fmt: str | None = None) -> None:
+    """Error against h and against wall time (``fmt`` png or pdf; default: by
+    the suffix of ``path``)."""
     import matplotlib
 
     matplotlib.use("Agg")
@@ -138,5 +152,5 @@ def write_plot(report: Report, path: Path) -> None:
     ax2.legend(fontsize=7)
     fig.suptitle(f"xfemslip verify (tip = {report.tip or 'default'})")
     fig.tight_layout()
-    fig.savefig(path, dpi=110)
+    fig.savefig(path, dpi=110, format=fmt)
     plt.close(fig)

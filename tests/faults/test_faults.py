@@ -57,11 +57,14 @@ def _error_line(result) -> str:
 
 
 def _no_partial_files(out: Path) -> list[str]:
-    """Names under out; none temporary, every final .h5 complete."""
+    """Names under out; none temporary (in it or beside it: the staging
+    folder and the lock), every final .h5 complete."""
     names = (
         sorted(str(p.relative_to(out)) for p in out.rglob("*")) if out.exists() else []
     )
     assert not any(Path(n).name.startswith(".") for n in names), names
+    beside = [p.name for p in out.parent.iterdir() if p.name.startswith(".")]
+    assert beside == [], beside
     for name in names:
         if name.endswith(".h5"):
             with h5py.File(out / name, "r") as f:
@@ -99,10 +102,10 @@ def test_signal_during_a_run_leaves_no_partial_file(tmp_path, sig, code, name):
     stderr = "".join(lines) + rest
     assert proc.returncode == code, stderr[-2000:]
     last = stderr.strip().splitlines()[-1]
-    assert last.startswith(f"Error: interrupted ({name})"), last
-    assert "no partial file" in last
+    assert last == f"Error: interrupted ({name}); nothing was written to {out}"
     assert "Traceback" not in stderr
-    assert _no_partial_files(out) == []  # interrupted while solving: nothing
+    assert not out.exists()  # interrupted while solving: nothing
+    _no_partial_files(out)
 
 
 def test_interrupt_while_writing_removes_the_file(tmp_path, runner, monkeypatch):
@@ -120,9 +123,11 @@ def test_interrupt_while_writing_removes_the_file(tmp_path, runner, monkeypatch)
     out = tmp_path / "out"
     result = runner.invoke(cli, ["run", "-q", str(case_file(tmp_path)), "-o", str(out)])
     assert result.exit_code == 130
-    assert _error_line(result).startswith("Error: interrupted (SIGINT)")
+    assert _error_line(result) == (
+        f"Error: interrupted (SIGINT); nothing was written to {out}"
+    )
     assert len(calls) == 4  # premise: it was writing
-    assert "result.h5" not in _no_partial_files(out)
+    assert _no_partial_files(out) == []
 
 
 # ------------------------------------------------------- full / unwritable
@@ -149,21 +154,34 @@ def test_full_disk_is_a_clear_error_and_leaves_no_file(tmp_path, runner, monkeyp
     assert _no_partial_files(out) == []
 
 
-def test_full_disk_while_writing_vtu(tmp_path, runner, monkeypatch):
-    """result.h5 is complete; the VTU that failed is not there at all."""
+@pytest.mark.parametrize("earlier", [False, True])
+def test_full_disk_while_writing_vtu(tmp_path, runner, monkeypatch, earlier):
+    """A disk that fills while the VTU is written leaves no result.h5 that
+    claims completeness: the folder keeps the earlier result byte for byte,
+    or there is none."""
     import meshio
+
+    out = tmp_path / "out"
+    before = {}
+    if earlier:
+        case = case_file(tmp_path / "earlier", steps=2)
+        assert (
+            runner.invoke(cli, ["run", "-q", str(case), "-o", str(out)]).exit_code == 0
+        )
+        before = {p: p.read_bytes() for p in out.rglob("*") if p.is_file()}
+        assert len(before) == 8  # premise: h5, pvd, 2 VTU and 2 x 2 in steps/
 
     def full(*args, **kwargs):
         raise OSError(errno.ENOSPC, os.strerror(errno.ENOSPC))
 
     monkeypatch.setattr(meshio, "write", full)
-    out = tmp_path / "out"
-    result = runner.invoke(cli, ["run", "-q", str(case_file(tmp_path)), "-o", str(out)])
+    args = ["run", "-q", str(case_file(tmp_path)), "-o", str(out), "--overwrite"]
+    result = runner.invoke(cli, args)
     assert result.exit_code == 1
     line = _error_line(result)
-    assert "cannot write" in line and ".vtu: No space left on device" in line
-    names = _no_partial_files(out)
-    assert "result.h5" in names and not any(n.endswith(".vtu") for n in names)
+    assert f"cannot write {out}/" in line and ".vtu: No space left on device" in line
+    _no_partial_files(out)
+    assert {p: p.read_bytes() for p in out.rglob("*") if p.is_file()} == before
 
 
 def test_output_under_a_file_is_a_clear_error(tmp_path, runner):

@@ -800,7 +800,12 @@ def sweep_inputs() -> list[Input]:
         "empty-list": ('"fractures[0].friction" = []', {2}, ()),
         "bad-key-path": ('"fractures[0]..friction" = [0.1]', {2}, ()),
         "missing-index": ('"fractures[7].friction" = [0.1]', {2}, ("fractures[7]",)),
-        "invalid-member": ('"fractures[0].friction" = [0.2, -1.0]', {2}, ("friction",)),
+        # the valid member runs, the other is refused alone (exit 1)
+        "invalid-member": (
+            '"fractures[0].friction" = [0.2, -1.0]',
+            {1},
+            ("fractures[0].friction: must be >= 0",),
+        ),
         "overlap": (
             '"fractures[0]" = [{ points = [[0.2, 0.3], [0.8, 0.7]], friction = 0.3 }]'
             '\n"fractures[0].friction" = [0.2]',
@@ -830,7 +835,7 @@ def sweep_inputs() -> list[Input]:
                 files={"sweep.toml": text, "base.toml": base},
                 argv=("sweep", "-j", "1", "-o", OUT, "sweep.toml"),
                 expect=frozenset(expect),
-                names=("sweep.toml", *names) if expect == {2} else (),
+                names=("sweep.toml", *names) if expect == {2} else names,
                 timeout=60.0,
             )
         )
@@ -1333,7 +1338,8 @@ def size_inputs() -> list[Input]:
             ("output.formats",),
         ),
         "formats-empty": (small(output={"formats": []}), ("output.formats",)),
-        "name-dot": (small(name=".."), ()),
+        "name-dot": (small(name=".."), ("name",)),
+        "name-single-dot": (small(name="."), ("name",)),
         "name-nul": (small(name="a\0b"), ("name",)),
         "name-300": (small(name="n" * 300), ("name",)),
         "name-unicode-200": (small(name="\u00e9" * 200), ("name",)),

@@ -253,8 +253,12 @@ def test_initial_stress_is_not_a_load():
     so the far-field increment that the predictor resolves on the patches is
     loading.stress less loading.initial_stress; the in-situ traction is in
     the committed tractions already.  With sigma0 = sigma there is no
-    increment: the step converges at once, without a guess."""
+    increment: the step converges at once, without a guess (the friction is
+    raised to 0.5 so that the in-situ traction, |tau| / -sigma_n = 1/3, is
+    admissible: with the case's 0.1 the first step would release the excess,
+    ContactSet.in_situ_force)."""
     base = RESERVOIR.read_text().replace("elements = [50, 50]", "elements = [16, 16]")
+    base = base.replace("friction = 0.1", "friction = 0.5")
     line = "stress = { xx = -20.0e6, yy = -40.0e6, xy = 0.0 }"
 
     def with_initial(xx, yy):

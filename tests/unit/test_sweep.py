@@ -294,7 +294,7 @@ def test_invalid_generated_cases_are_named_with_their_parameters(tmp_path, base)
     assert "fractures[0].friction: must be >= 0, got -0.2" in text
 
 
-def test_geometry_of_generated_cases_is_checked(tmp_path):
+def test_a_case_whose_geometry_cannot_be_built_is_refused_alone(tmp_path):
     # keys all valid, but the second case puts the two fractures on each other
     two = BASE.replace("center = [0.5, 0.5]", "center = [0.5, 0.3]")
     second = two[two.index("[[fractures]]") : two.index("[loading]")]
@@ -303,12 +303,19 @@ def test_geometry_of_generated_cases_is_checked(tmp_path):
     body = (
         'base = "base.toml"\n[vary]\n"fractures[1].center" = [[0.5, 0.7], [0.5, 0.3]]\n'
     )
+    sweep = loads_sweep(body, tmp_path / "s.toml")
+    ok, refused = sweep.cases
+    assert ok.refused == "" and len(ok.spec.fractures) == 2
+    assert refused.spec is None
+    assert refused.label == "case 001_center=0.5_0.3 (fractures[1].center = [0.5, 0.3])"
+    assert refused.refused.startswith("fractures[0] and fractures[1] overlap")
+    # the same problem in every case: nothing to run, the sweep is refused
+    body = 'base = "base.toml"\n[vary]\n"fractures[1].center" = [[0.5, 0.3]]\n'
     with pytest.raises(CaseError) as excinfo:
         loads_sweep(body, tmp_path / "bad.toml")
-    text = _problems(excinfo)
-    assert "case 001_center=0.5_0.3 (fractures[1].center = [0.5, 0.3])" in text
-    assert "fractures[0] and fractures[1] overlap" in text
-    assert "case 000" not in text
+    assert "case 000_center=0.5_0.3 (fractures[1].center = [0.5, 0.3]): " in (
+        _problems(excinfo)
+    )
 
 
 def test_cli_bad_sweep_is_exit_2_one_line_and_writes_nothing(tmp_path, base, runner):

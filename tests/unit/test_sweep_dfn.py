@@ -158,3 +158,59 @@ def test_aggregate_leaves_failed_cases_out():
         )
     assert is_dfn_sweep(["material.E", "network.generate.seed"])
     assert not is_dfn_sweep(["fractures[0].angle", "networkx"])
+
+
+def test_a_realization_that_cannot_be_built_is_refused_and_the_others_run(tmp_path):
+    """Seed 5 also moves the inline fracture out of the domain: that case is
+    reported (one line on stderr, a 'refused' row) and not run, seeds 4 and
+    6 run; exit code 1; dfn_summary.csv counts 2 realizations and 1 left out."""
+    inline = (
+        "[[base.fractures]]\npoints = [[0.05, 0.05], [0.15, 0.1]]\nfriction = 0.3\n"
+        'tip = "ramp"\n'
+    )
+    body = SWEEP.replace("[base.loading]", inline + "[base.loading]")
+    body = body.replace(
+        '"network.generate.seed" = { start = 4, stop = 6, step = 1 }',
+        '"network.generate.seed" = [4, 5, 6]\n'
+        '"fractures[0].points" = [[[0.05, 0.05], [0.15, 0.1]], '
+        "[[3.05, 0.05], [3.15, 0.1]], [[0.05, 0.05], [0.15, 0.1]]]",
+    )
+    body = body.replace('name = "dfn3"', 'name = "dfn3"\ncombine = "zip"')
+    path = tmp_path / "dfn3.toml"
+    path.write_text(body)
+    out = tmp_path / "out"
+    try:  # click < 8.2 mixes stderr into stdout unless told otherwise
+        runner = CliRunner(mix_stderr=False)
+    except TypeError:
+        runner = CliRunner()
+    result = runner.invoke(cli, ["sweep", str(path), "-o", str(out), "-j", "1"])
+    assert result.exit_code == 1, result.stderr
+    refused = [line for line in result.stderr.splitlines() if "refused:" in line]
+    assert len(refused) == 1
+    assert refused[0].startswith("WARNING: case 001_seed=5_points=3.05_0.05_3.15_0.1 (")
+    assert "fractures[0]: lies outside the domain [0, 1] x [0, 1]" in refused[0]
+    assert "2 done, 0 of them skipped as already done, 0 failed, 1 refused" in (
+        result.stderr
+    )
+    summary = _rows(out / "summary.csv")
+    assert [(r["network.generate.seed"], r["status"]) for r in summary] == [
+        ("4", "ok"),
+        ("5", "refused"),
+        ("6", "ok"),
+    ]
+    assert "lies outside the domain" in summary[1]["error"]
+    assert summary[1]["converged"] == "" and summary[0]["converged"] == "true"
+    for row in summary:
+        folder = out / row["case"]
+        assert (folder / "case.toml").is_file()  # for `xfemslip check`
+        assert (folder / "result.h5").is_file() == (row["status"] == "ok")
+    aggregate = {r["metric"]: r for r in _rows(out / "dfn_summary.csv")}
+    assert aggregate["fractures"]["realizations"] == "2"
+    assert aggregate["fractures"]["failed"] == "1"
+    assert float(aggregate["fractures"]["mean"]) == 7.0  # 6 generated + 1
+    # a rerun runs nothing again: the done cases are skipped, the refused one
+    # is refused again
+    again = runner.invoke(cli, ["sweep", str(path), "-o", str(out), "-j", "1"])
+    assert again.exit_code == 1
+    statuses = [r["status"] for r in _rows(out / "summary.csv")]
+    assert statuses == ["skipped", "refused", "skipped"]

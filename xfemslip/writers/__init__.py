@@ -6,7 +6,9 @@ plain arrays in the output sign convention (``output-format.md``).
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+import hashlib
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass, field, fields
 
 import numpy as np
 
@@ -59,3 +61,47 @@ class VisMesh:
     quad_cell: np.ndarray  # (Q,) int64
     triangles: np.ndarray  # (T, 3) int64
     triangle_cell: np.ndarray  # (T,) int64
+
+
+# Root attributes that hold a time, so differ between runs of the same case.
+TIMED_ATTRS = ("wall_time_s",)
+
+
+def run_id(
+    attrs: Mapping[str, object],
+    points: np.ndarray,
+    cells: np.ndarray,
+    steps: Sequence[StepFields],
+) -> int:
+    """The ``run_id`` every file of one output set carries (output-format.md).
+
+    A digest (SHA-256, first 63 bits as a non-negative int64) of the root
+    attributes except the timed ones (the case text among them), the mesh and
+    every array of every step.  Files of one run share it; two runs share it
+    only when they wrote the same numbers, so files stamped alike never show
+    different results, and the same input gives the same bytes.
+    """
+    digest = hashlib.sha256()
+
+    def add(name: str, value) -> None:
+        array = np.ascontiguousarray(value)
+        digest.update(f"{name}:{array.dtype.str}:{array.shape};".encode())
+        digest.update(array.tobytes())
+
+    for key in sorted(attrs):
+        if key not in TIMED_ATTRS and key != "run_id":
+            add(f"attr {key}", attrs[key])
+    add("points", points)
+    add("cells", cells)
+    for step in steps:
+        for item in fields(step):
+            value = getattr(step, item.name)
+            if item.name == "fractures":
+                for index, fracture in enumerate(value):
+                    for part in fields(fracture):
+                        data = getattr(fracture, part.name)
+                        if data is not None:
+                            add(f"{step.step} {index} {part.name}", data)
+            elif value is not None:
+                add(f"{step.step} {item.name}", value)
+    return int.from_bytes(digest.digest()[:8], "big") >> 1

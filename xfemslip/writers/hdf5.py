@@ -29,11 +29,14 @@ who think compression-positive; it is *named* so and never replaces
 When ``steps`` is empty (the first load step did not converge) the file holds
 the mesh and the root attributes only: no ``/fields``, ``/fractures`` or
 ``/steps``.  The file is written atomically (:mod:`xfemslip.writers.atomic`) and
-carries no timestamps, so the same input gives the same bytes.
+carries no timestamps, so the same input gives the same bytes.  The root
+attribute ``run_id`` (:func:`xfemslip.writers.run_id`, given by the caller)
+is the id that every file of its output set carries.
 """
 
 from __future__ import annotations
 
+import io
 import logging
 from collections.abc import Mapping, Sequence
 from pathlib import Path
@@ -41,7 +44,7 @@ from pathlib import Path
 import h5py
 import numpy as np
 
-from xfemslip import __version__
+from xfemslip import __version__, interrupt
 from xfemslip.writers import FractureFields, StepFields
 from xfemslip.writers.atomic import atomic_path, refuse_non_finite
 
@@ -105,28 +108,40 @@ def write_result(
         The file cannot be written.
     """
     points = _as_array(points, np.float64, (None, 2), "points")
-    n_nodes = points.shape[0]
     cells = _as_array(cells, np.int64, (None, 4), "cells")
-    n_cells = cells.shape[0]
     root_attrs = _root_attrs(attrs, load_steps)
-    with atomic_path(Path(path)) as tmp, h5py.File(tmp, "w", track_order=True) as h5:
-        for key, value in root_attrs.items():
-            h5.attrs[key] = value
-        mesh = h5.create_group("mesh", track_order=True)
-        _dataset(mesh, "points", points, "m")
-        _dataset(mesh, "cells", cells, "-")
-        if not steps:
-            logger.debug("%s: no converged step, writing the mesh only", path)
-            return
-        final = steps[-1]
-        _write_bulk_fields(
-            h5.create_group("fields", track_order=True), final, n_nodes, n_cells
-        )
-        _write_fractures(h5, final.fractures)
-        if load_steps > 1:
-            steps_group = h5.create_group("steps", track_order=True)
-            for step in steps:
-                _write_step(steps_group, step, n_nodes)
+    # HDF5 builds the file in memory and Python writes it out: a write that
+    # fails (a full disk) is then a plain OSError here, whereas a failure inside
+    # the HDF5 library leaves identifiers it cannot close, which print errors
+    # from their destructors and can crash the interpreter at exit.
+    with atomic_path(Path(path)) as tmp:
+        image = io.BytesIO()
+        with h5py.File(image, "w", track_order=True) as h5:
+            _fill(h5, root_attrs, points, cells, steps, load_steps)
+        with open(tmp, "wb") as fh:
+            fh.write(image.getbuffer())
+
+
+def _fill(h5, root_attrs, points, cells, steps, load_steps) -> None:
+    """The content of ``result.h5`` (see the module docstring)."""
+    n_nodes, n_cells = points.shape[0], cells.shape[0]
+    for key, value in root_attrs.items():
+        h5.attrs[key] = value
+    mesh = h5.create_group("mesh", track_order=True)
+    _dataset(mesh, "points", points, "m")
+    _dataset(mesh, "cells", cells, "-")
+    if not steps:
+        logger.debug("no converged step: writing the mesh only")
+        return
+    final = steps[-1]
+    _write_bulk_fields(
+        h5.create_group("fields", track_order=True), final, n_nodes, n_cells
+    )
+    _write_fractures(h5, final.fractures)
+    if load_steps > 1:
+        steps_group = h5.create_group("steps", track_order=True)
+        for step in steps:
+            _write_step(steps_group, step, n_nodes)
 
 
 def _root_attrs(attrs: Mapping[str, object], load_steps: int) -> dict[str, object]:
@@ -235,6 +250,7 @@ def _dataset(
     group: h5py.Group, name: str, value: np.ndarray, units: str
 ) -> h5py.Dataset:
     """Create one dataset without timestamps and tag it with its units."""
+    interrupt.checkpoint()  # between data sets: a deferred signal stops here
     refuse_non_finite(value, f"{group.name}/{name}")
     dataset = group.create_dataset(name, data=value, track_times=False)
     dataset.attrs["units"] = units

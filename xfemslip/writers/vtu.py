@@ -10,12 +10,15 @@
 
 Every file is written atomically (:mod:`xfemslip.writers.atomic`).  meshio is
 given ``file_format="vtu"`` explicitly because the temporary name has another
-suffix.
+suffix.  Given a ``run_id``, each file carries it: the VTU files as the field
+data array ``run_id`` (1,) int64, the PVD as a comment.
 """
 
 from __future__ import annotations
 
 import logging
+import re
+import shutil
 from collections.abc import Mapping, Sequence
 from pathlib import Path
 from xml.sax.saxutils import quoteattr
@@ -32,7 +35,11 @@ FRACTURE_POINT_DATA = ("slip", "opening", "normal_traction", "shear_traction")
 
 
 def write_bulk(
-    path: Path | str, vis: VisMesh, cell_data: Mapping[str, np.ndarray]
+    path: Path | str,
+    vis: VisMesh,
+    cell_data: Mapping[str, np.ndarray],
+    *,
+    run_id: int | None = None,
 ) -> None:
     """Write the visualisation mesh as an unstructured grid (``result.vtu``).
 
@@ -47,6 +54,9 @@ def write_bulk(
     cell_data : mapping of name -> (M,) or (M, k) array
         Values per BULK element (e.g. ``stress`` [Pa]); each vis cell gets the
         value of its bulk element.  ``cell_id`` (the bulk element id) is added.
+    run_id : int, optional
+        The output set's id, written as the field data array ``run_id`` (1,)
+        int64.
 
     Raises
     ------
@@ -91,12 +101,16 @@ def write_bulk(
         [(cell_type, conn) for cell_type, conn, _ in blocks],
         point_data={"displacement": displacement},
         cell_data=gathered,
+        field_data=_field_data(run_id),
     )
     _write_vtu(path, mesh)
 
 
 def write_fractures(
-    path: Path | str, fractures: Sequence[tuple[int, FractureFields]]
+    path: Path | str,
+    fractures: Sequence[tuple[int, FractureFields]],
+    *,
+    run_id: int | None = None,
 ) -> bool:
     """Write the fractures as polylines with their contact fields (``fractures.vtu``).
 
@@ -108,6 +122,8 @@ def write_fractures(
         ``index`` is the fracture's position in the case file.  Each fracture's
         K points, sorted by ``s``, are joined by "line" cells; a fracture with a
         single point becomes a "vertex" cell, one with none is left out.
+    run_id : int, optional
+        The output set's id (field data ``run_id``, as in :func:`write_bulk`).
 
     Point data: ``slip``, ``opening`` [m], ``normal_traction``,
     ``shear_traction``, ``contact_pressure`` = max(0, -normal_traction) [Pa],
@@ -151,11 +167,19 @@ def write_fractures(
         if name != "points"
     }
     points = _pad_3d(np.concatenate([part["points"] for part in parts]), "points")
-    _write_vtu(path, meshio.Mesh(points, cells, point_data=point_data))
+    mesh = meshio.Mesh(
+        points, cells, point_data=point_data, field_data=_field_data(run_id)
+    )
+    _write_vtu(path, mesh)
     return True
 
 
-def write_pvd(path: Path | str, entries: Sequence[tuple[float, str]]) -> None:
+def write_pvd(
+    path: Path | str,
+    entries: Sequence[tuple[float, str]],
+    *,
+    run_id: int | None = None,
+) -> None:
     """Write a ParaView collection file (``result.pvd``).
 
     Parameters
@@ -167,14 +191,20 @@ def write_pvd(path: Path | str, entries: Sequence[tuple[float, str]]) -> None:
         path relative to the .pvd file.  Data sets that share a timestep (e.g.
         the bulk mesh and the fractures of one load step) get consecutive
         ``part`` numbers from 0, so ParaView shows them together.
+    run_id : int, optional
+        The output set's id, written as the comment ``<!-- xfemslip run_id N
+        -->`` after the XML declaration (a comment: ParaView's collection
+        reader gives meaning to every attribute of a data set).
 
     Raises
     ------
     OutputError
         The file cannot be written.
     """
-    lines = [
-        '<?xml version="1.0"?>',
+    lines = ['<?xml version="1.0"?>']
+    if run_id is not None:
+        lines.append(f"<!-- xfemslip run_id {int(run_id)} -->")
+    lines += [
         '<VTKFile type="Collection" version="0.1" byte_order="LittleEndian">',
         "  <Collection>",
     ]
@@ -189,6 +219,13 @@ def write_pvd(path: Path | str, entries: Sequence[tuple[float, str]]) -> None:
     lines += ["  </Collection>", "</VTKFile>", ""]
     with atomic_path(Path(path)) as tmp:
         tmp.write_text("\n".join(lines), encoding="utf-8")
+
+
+def _field_data(run_id: int | None) -> dict[str, np.ndarray]:
+    """VTU field data: the set's ``run_id`` when given."""
+    if run_id is None:
+        return {}
+    return {"run_id": np.array([run_id], dtype=np.int64)}
 
 
 def _fracture_part(index: int, fields: FractureFields) -> dict[str, np.ndarray]:
@@ -225,5 +262,58 @@ def _write_vtu(path: Path | str, mesh: meshio.Mesh) -> None:
     for name, blocks in mesh.cell_data.items():
         for value in blocks:
             refuse_non_finite(value, f"{path}: {name}")
+    run_id = mesh.field_data.get("run_id")
     with atomic_path(Path(path)) as tmp:
-        meshio.write(tmp, mesh, file_format="vtu")
+        if run_id is None:
+            meshio.write(tmp, mesh, file_format="vtu")
+            return
+        raw = tmp.with_name(f"{tmp.name}.raw")
+        try:
+            meshio.write(raw, mesh, file_format="vtu")
+            _add_field_data(raw, tmp, int(run_id[0]))
+        finally:
+            raw.unlink(missing_ok=True)
+
+
+# meshio (5.3) does not write field data; VTK reads it as a child of the grid.
+_FIELD_DATA = (
+    '\n<FieldData>\n<DataArray type="Int64" Name="run_id" NumberOfTuples="1" '
+    'format="ascii">\n{}\n</DataArray>\n</FieldData>'
+)
+_GRID_TAG = b"<UnstructuredGrid>"
+
+
+def _add_field_data(src: Path, dst: Path, run_id: int) -> None:
+    """Copy the VTU ``src`` to ``dst`` with the ``run_id`` field data array
+    inserted after the grid's opening tag (which meshio writes in its first
+    lines)."""
+    with open(src, "rb") as fin, open(dst, "wb") as fout:
+        head = fin.read(4096)
+        at = head.index(_GRID_TAG) + len(_GRID_TAG)
+        fout.write(head[:at] + _FIELD_DATA.format(run_id).encode() + head[at:])
+        shutil.copyfileobj(fin, fout, 1 << 20)
+
+
+_VTU_RUN_ID = re.compile(rb'Name="run_id" NumberOfTuples="1" format="ascii">\s*(\d+)')
+_PVD_RUN_ID = re.compile(rb"<!-- xfemslip run_id (\d+) -->")
+
+
+def read_run_id(path: Path | str) -> int | None:
+    """The ``run_id`` of a VTU or PVD file written here (None when it has none
+    or cannot be read); only the file's first 4 kB are read."""
+    path = Path(path)
+    pattern = _PVD_RUN_ID if path.suffix == ".pvd" else _VTU_RUN_ID
+    try:
+        with open(path, "rb") as fh:
+            match = pattern.search(fh.read(4096))
+    except OSError:
+        return None
+    return int(match[1]) if match else None
+
+
+def pvd_files(path: Path | str) -> list[str]:
+    """The data set files a PVD names (relative to it)."""
+    from xml.etree import ElementTree
+
+    root = ElementTree.parse(path).getroot()
+    return [item.get("file", "") for item in root.iter("DataSet")]

@@ -1,0 +1,96 @@
+#!/usr/bin/env python3
+"""Predicted against measured peak memory of whole runs (xfemslip.memory).
+
+For each case: the three estimates (from the case alone, after the node
+enrichments, from the built model) and the peak resident memory of
+`xfemslip run` in its own process (ru_maxrss of that process alone), with
+the ratio estimate / measured.  Cases: the shipped ones, crowded generated
+networks (the shipped DFN realizations with 200 fractures), many load steps
+and large meshes.
+
+    python benchmarks/memory_estimate.py [--only NAME,...] [--timeout 900]
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import sys
+import tempfile
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT / "tests" / "unit"))
+from casegen import sweep_member  # noqa: E402
+from hardcases import estimates, measure  # noqa: E402
+
+from xfemslip import memory  # noqa: E402
+
+CASES = ROOT / "cases"
+
+
+def _shipped(name, **replace):
+    text = (CASES / f"{name}.toml").read_text()
+    for old, new in replace.items():
+        assert old in text, old
+        text = text.replace(old, new)
+    return text
+
+
+def _network(count, n, seed=1):
+    keys = {"network.generate.count": count, "mesh.elements": [n, n]}
+    return sweep_member(index=seed - 1, **keys)
+
+
+INPUTS = {
+    "reservoir": lambda: _shipped("reservoir_depletion"),
+    "liu-borja": lambda: _shipped("liu_borja_plate"),
+    "network": lambda: _shipped("fracture_network"),
+    "depleting": lambda: _shipped("depleting_reservoir"),
+    "reservoir-400-steps": lambda: _shipped(
+        "reservoir_depletion", **{"steps = 1": "steps = 400"}
+    ),
+    "network-100-steps": lambda: _shipped(
+        "fracture_network", **{"steps = 4": "steps = 100"}
+    ),
+    "reservoir-200x200": lambda: _shipped(
+        "reservoir_depletion", **{"elements = [50, 50]": "elements = [200, 200]"}
+    ),
+    "reservoir-300x300": lambda: _shipped(
+        "reservoir_depletion", **{"elements = [50, 50]": "elements = [300, 300]"}
+    ),
+    "dfn-60-30x30": lambda: _network(60, 30),
+    "dfn-200-50x50": lambda: _network(200, 50),
+    "dfn-200-100x100": lambda: _network(200, 100),
+}
+
+
+def main() -> int:
+    parser = argparse.ArgumentParser()
+    parser.add_argument("--only", default=",".join(INPUTS))
+    parser.add_argument("--timeout", type=float, default=900.0)
+    opt = parser.parse_args()
+    os.environ.pop(memory.ENV_LIMIT, None)
+    print(
+        f"{'case':20s} {'exit':>5s} {'case':>7s} {'enrich':>7s} {'model':>7s} "
+        f"{'peak':>7s} {'ratio':>6s}   [MB; ratio = model / peak]"
+    )
+    with tempfile.TemporaryDirectory() as tmp:
+        for name in opt.only.split(","):
+            path = Path(tmp) / f"{name}.toml"
+            path.write_text(INPUTS[name]())
+            est = estimates(path)
+            argv = [sys.executable, "-m", "xfemslip", "run", "-q", str(path)]
+            argv += ["-o", str(Path(tmp) / f"out-{name}")]
+            code, _, peak, _ = measure(argv, opt.timeout, Path(tmp) / f"{name}.log")
+            cols = " ".join(f"{e / 1e6:7.0f}" for e in est)
+            print(
+                f"{name:20s} {code!s:>5s} {cols} {peak:7.0f} "
+                f"{est[2] / 1e6 / peak:6.2f}",
+                flush=True,
+            )
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
