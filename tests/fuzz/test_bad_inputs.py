@@ -1,6 +1,7 @@
 """About a thousand generated bad and edge-case inputs, each through the real CLI.
 
-The inputs come from ``bad_inputs.py`` (fixed seed): mutated keys of the
+The inputs come from ``bad_inputs.py`` and the ``bad_input_*.py`` families
+(fixed seed): mutated keys of the
 shipped cases and of a small case (every key with the extremes of every type,
 and random mutations that are run), TOML nested thousands of levels deep,
 ``/dev/zero`` and FIFOs wherever a file is read, oversized files, broken CSV
@@ -43,7 +44,7 @@ from pathlib import Path
 import bad_inputs
 import h5py
 import pytest
-from bad_inputs import Input
+from bad_input_base import Input, small, toml
 
 WORKER = Path(__file__).with_name("bad_input_worker.py")
 MEMORY_BOUND = 2 * 2**30  # peak resident memory an input may reach [bytes]
@@ -323,10 +324,8 @@ def test_counts(outcomes: dict) -> None:
 def _big_boundary_case(folder: Path) -> None:
     """A valid case whose boundary CSV is just under the size cap (~30 MB,
     600,000 rows): reading and checking it takes seconds."""
-    doc = bad_inputs.small(
-        boundary={"bottom": {"uy": 0.0}, "left": {"file": "left.csv"}}
-    )
-    (folder / "case.toml").write_text(bad_inputs.toml(doc))
+    doc = small(boundary={"bottom": {"uy": 0.0}, "left": {"file": "left.csv"}})
+    (folder / "case.toml").write_text(toml(doc))
     n = 600_000
     rows = "".join(f"0.0,{i / (n - 1)!r},0.0,0.0\n" for i in range(n))
     (folder / "left.csv").write_text("x,y,ux,uy\n" + rows)
