@@ -23,7 +23,7 @@ import scipy.sparse.linalg as spla
 from xfemslip import solver as S
 from xfemslip.assembly import coo_block
 from xfemslip.case import load_case
-from xfemslip.contact import SLIP
+from xfemslip.conventions import SLIP
 from xfemslip.simulation import build_model, newton_solver
 
 spec = load_case(sys.argv[1])

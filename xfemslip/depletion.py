@@ -34,7 +34,7 @@ from pathlib import Path
 
 import numpy as np
 
-from xfemslip.contact import SLIP
+from xfemslip.conventions import SLIP
 from xfemslip.errors import ConvergenceError, UsageError
 from xfemslip.simulation import solve_and_write
 from xfemslip.writers.atomic import atomic_path

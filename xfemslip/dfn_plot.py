@@ -18,9 +18,9 @@ from matplotlib.collections import LineCollection
 from matplotlib.colors import Normalize
 from matplotlib.figure import Figure
 
+from xfemslip.conventions import SLIP
 from xfemslip.errors import OutputError, UsageError
 
-SLIP_CODE = 2  # output-format.md: 0 open, 1 stick, 2 slip
 PANEL = 4.2  # inches
 
 
@@ -62,7 +62,7 @@ def _draw_slip(fig, ax, fields) -> None:
             continue
         pieces = np.stack([points[:-1], points[1:]], axis=1)
         value = 0.5 * (np.abs(slip[:-1]) + np.abs(slip[1:]))
-        width = 2.6 if np.any(state == SLIP_CODE) else 1.0
+        width = 2.6 if np.any(state == SLIP) else 1.0
         collection = LineCollection(pieces, cmap="viridis", norm=norm, linewidths=width)
         collection.set_array(value)
         ax.add_collection(collection)

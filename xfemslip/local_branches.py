@@ -36,7 +36,7 @@ import numpy as np
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
-from xfemslip.contact import SLIP
+from xfemslip.conventions import SLIP
 
 # Largest cluster searched: 3**10 = 59049 combinations of 20 x 20 systems
 # (~1 s), solved CHUNK at a time (about 20 MB of work arrays per chunk).

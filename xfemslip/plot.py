@@ -32,6 +32,7 @@ from matplotlib.colors import Normalize
 from matplotlib.figure import Figure
 from matplotlib.tri import Triangulation
 
+from xfemslip.conventions import SLIP
 from xfemslip.errors import UsageError
 from xfemslip.plot_data import ResultData, read_result
 from xfemslip.plot_mohr import add_legend, draw_mohr, mohr_figsize
@@ -42,7 +43,6 @@ KINDS = ("displacement", "principal_stress", "deformed_mesh", "slip", "mohr")
 FORMATS = ("png", "pdf")
 PANEL = 3.6  # inches per panel
 DPI = 110
-SLIP_CODE = 2
 
 
 # --------------------------------------------------------------------------- #
@@ -223,7 +223,7 @@ def figure_slip(results: Sequence[ResultData]) -> Figure:
             # one result with several fractures (a network): one colour each
             colour = f"C{(k if len(results) > 1 else fr.index) % 10}"
             (line,) = ax.plot(s, np.abs(fr.slip), lw=1.4, color=colour, label=label)
-            in_slip = fr.state == SLIP_CODE
+            in_slip = fr.state == SLIP
             ax.plot(
                 s[in_slip], np.abs(fr.slip[in_slip]), ".", ms=3, color=line.get_color()
             )

@@ -9,7 +9,7 @@ from pathlib import Path
 
 import numpy as np
 
-from xfemslip.contact import SLIP
+from xfemslip.conventions import SLIP
 from xfemslip.regions import edges
 
 

@@ -6,17 +6,14 @@ for enriched elements).  Out-of-plane stress in plane strain:
 sigma_zz = nu (sigma_xx + sigma_yy) (the in-situ sigma_zz is taken as
 nu (sigma0_xx + sigma0_yy), consistent with plane strain); zero in plane stress.
 Fracture fields: slip = [[u]] . t, opening = [[u]] . n, p_N, p_T, state codes
-OPEN = 0, STICK = 1, SLIP = 2 (as in kernels/contact.py).
+codes of :mod:`xfemslip.conventions`.
 """
 
 from __future__ import annotations
 
 import numpy as np
 
-from xfemslip.kernels.codes import OPEN, SLIP, STICK  # noqa: F401  (codes mirrored)
 from xfemslip.writers import FractureFields, VisMesh
-
-STATE_CODES = "0 open, 1 stick, 2 slip"
 
 
 def cell_strain(mesh, bulk, u) -> np.ndarray:

@@ -31,7 +31,8 @@ import math
 
 import numpy as np
 
-from xfemslip.contact import OPEN, SLIP, STICK, ContactSet
+from xfemslip.contact import ContactSet
+from xfemslip.conventions import OPEN, SLIP, STICK
 
 
 def stress_increment(loading):

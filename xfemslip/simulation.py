@@ -19,7 +19,8 @@ import numpy as np
 from xfemslip import __version__, interrupt, kernels
 from xfemslip.assembly import BulkSystem, assemble_bulk
 from xfemslip.boundary import dirichlet, hold_enriched, traction_load
-from xfemslip.contact import OPEN, SLIP, STICK, ContactSet, build_contact
+from xfemslip.contact import ContactSet, build_contact
+from xfemslip.conventions import OPEN, SLIP, STATE_CODES, STICK
 from xfemslip.enrichment import EnrichedCells, build_enriched_cells, find_candidates
 from xfemslip.errors import ConvergenceError, GeometryError
 from xfemslip.geometry import build_fractures
@@ -36,7 +37,7 @@ from xfemslip.poro import (
     fracture_load,
     make_contact_effective,
 )
-from xfemslip.post import STATE_CODES, bulk_fields, fracture_fields, vis_mesh
+from xfemslip.post import bulk_fields, fracture_fields, vis_mesh
 from xfemslip.predictor import stress_increment
 from xfemslip.quadrature import InterfacePoints, interface_points
 from xfemslip.solver import NewtonSolver, Problem, StepResult

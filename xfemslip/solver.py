@@ -31,10 +31,19 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.sparse as sp
 
-from xfemslip import kernels, local_branches
+from xfemslip import local_branches
 from xfemslip.assembly import coo_block
 from xfemslip.case_specs import AUTO_PENALTY
-from xfemslip.contact import OPEN, SLIP, STICK, ContactResult, ContactSet
+from xfemslip.contact import ContactResult, ContactSet
+from xfemslip.conventions import (
+    OPEN,
+    SLIP,
+    SLIP_BACKWARD,
+    STICK,
+    TANGENT_CONSISTENT,
+    TANGENT_SECANT,
+    TANGENTS,
+)
 from xfemslip.errors import ConvergenceError
 from xfemslip.linsolve import LinearSolver
 from xfemslip.predictor import predict_state, predicted_law
@@ -81,8 +90,6 @@ LOCAL_SEARCHES = 2
 # friction history, exactly as a load step does; a failed attempt leaves the
 # committed state untouched (nothing is committed before convergence).
 DEFAULT_STEP_CUTS = 5
-
-TANGENTS = {"consistent": kernels.TANGENT_CONSISTENT, "secant": kernels.TANGENT_SECANT}
 
 
 @dataclass
@@ -134,7 +141,7 @@ def _regime(state, pt):
     """Branch of the contact law at each point: open, stick, slip forward (+t),
     slip backward.  A switch between any two changes the tangent, so it is what
     the log and the ConvergenceError count as a stick/slip switch."""
-    return np.where(state == SLIP, np.where(pt >= 0.0, SLIP, SLIP + 1), state)
+    return np.where(state == SLIP, np.where(pt >= 0.0, SLIP, SLIP_BACKWARD), state)
 
 
 class NewtonSolver:
@@ -457,7 +464,7 @@ class NewtonSolver:
             pt_prev, gt_prev, prev_regime = res.pt, res.gt, regime
             eta_before = eta
             u, res, r, eta = self._line_search(u, du, lam, eta, pt_prev, gt_prev, law)
-            if self.mode == kernels.TANGENT_SECANT and not eta < eta_before:
+            if self.mode == TANGENT_SECANT and not eta < eta_before:
                 # the secant direction is no descent direction (it drops the
                 # n-t coupling of the slip law): one consistent iteration
                 log.fallbacks += 1
@@ -468,7 +475,7 @@ class NewtonSolver:
                     steps,
                     it + 1,
                 )
-                res = law.evaluate(u, kernels.TANGENT_CONSISTENT, pt_prev, gt_prev)
+                res = law.evaluate(u, TANGENT_CONSISTENT, pt_prev, gt_prev)
         raise AssertionError("unreachable")
 
     def _guess(self, u, lam, regime):
@@ -517,14 +524,14 @@ class NewtonSolver:
         branch of its own, refined DFN meshes); when the search finds nothing,
         the step is taken.  Consistent tangent only.
         """
-        if self.mode != kernels.TANGENT_CONSISTENT:
+        if self.mode != TANGENT_CONSISTENT:
             return None, None
         trial = u.copy()
         trial[self.free] -= du
         res = law.evaluate(trial, self.mode, pt_prev, gt_prev)
         new = _regime(res.state, res.pt)
-        mask = ((regime == SLIP) & (new == SLIP + 1)) | (
-            (regime == SLIP + 1) & (new == SLIP)
+        mask = ((regime == SLIP) & (new == SLIP_BACKWARD)) | (
+            (regime == SLIP_BACKWARD) & (new == SLIP)
         )
         stubborn = mask & (held >= REVERSAL_HOLDS)
         mask &= held < REVERSAL_HOLDS
@@ -618,7 +625,7 @@ class NewtonSolver:
                 "may not find one; prescribe a displacement on that part, or raise "
                 "the friction or cohesion"
             )
-        if self.mode == kernels.TANGENT_SECANT:
+        if self.mode == TANGENT_SECANT:
             why += (
                 '; or set [solver] tangent = "consistent" (the secant tangent '
                 "converges linearly at best)"

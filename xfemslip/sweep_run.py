@@ -41,6 +41,7 @@ from pathlib import Path
 import h5py
 import numpy as np
 
+from xfemslip.conventions import SLIP
 from xfemslip.errors import OutputError, UsageError, XfemslipError
 from xfemslip.sweep_dfn import DFN_SUMMARY, is_dfn_sweep, write_dfn_summary
 from xfemslip.writers.fileset import replace_files
@@ -48,7 +49,6 @@ from xfemslip.writers.lock import folder_lock
 
 logger = logging.getLogger(__name__)
 
-SLIP_CODE = 2  # output-format.md: 0 open, 1 stick, 2 slip
 METRICS = (
     "converged",
     "max_abs_slip_m",
@@ -121,7 +121,7 @@ def slipping_length(s, state, s_lo: float, s_hi: float) -> float:
     """Length [m] of fracture in slip: each point stands for the stretch between
     the midpoints to its neighbours (the ends reach s_lo and s_hi)."""
     stretch = point_stretches(s, s_lo, s_hi)
-    return float(np.sum(stretch[np.asarray(state) == SLIP_CODE]))
+    return float(np.sum(stretch[np.asarray(state) == SLIP]))
 
 
 def result_metrics(h5_path: Path, spec) -> dict:
@@ -145,12 +145,12 @@ def result_metrics(h5_path: Path, spec) -> dict:
             if slip.size:
                 slip_max = max(slip_max, float(np.max(np.abs(slip))))
             stretch = point_stretches(s, *arc_extent(fracture.points, box))
-            length += float(np.sum(stretch[state == SLIP_CODE]))
-            if np.any(state == SLIP_CODE):
+            length += float(np.sum(stretch[state == SLIP]))
+            if np.any(state == SLIP):
                 slipping_means.append(
                     float(np.sum(stretch * np.abs(slip)) / np.sum(stretch))
                 )
-            n_slip += int(np.sum(state == SLIP_CODE))
+            n_slip += int(np.sum(state == SLIP))
             n_points += int(state.size)
     n_fractures = len(spec.fractures)
     return {

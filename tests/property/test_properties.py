@@ -18,7 +18,8 @@ from hypothesis import assume, given, settings
 from hypothesis import strategies as st
 
 from xfemslip.case import loads_case
-from xfemslip.kernels.contact import OPEN, SLIP, STICK, coulomb_return_map
+from xfemslip.conventions import OPEN, SLIP, STICK
+from xfemslip.kernels.contact import coulomb_return_map
 from xfemslip.kernels.shape import q4_shape
 from xfemslip.quadrature import cell_subtriangles, polygon_area, split_polygon
 from xfemslip.simulation import build_model

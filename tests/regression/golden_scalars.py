@@ -13,13 +13,12 @@ import h5py
 import numpy as np
 
 from xfemslip.case import load_case
+from xfemslip.conventions import SLIP
 from xfemslip.simulation import run_case
 
 ROOT = Path(__file__).resolve().parents[2]
 CASES_DIR = ROOT / "cases"
 GOLDEN_DIR = Path(__file__).resolve().parent / "golden"
-
-SLIP_CODE = 2  # output-format.md: 0 open, 1 stick, 2 slip
 
 
 def case_files() -> list[Path]:
@@ -56,7 +55,7 @@ def key_scalars(out_dir: Path, summary) -> dict:
         "max_abs_slip": float(np.max(np.abs(slip))) if slip.size else 0.0,
         "min_slip": float(np.min(slip)) if slip.size else 0.0,
         "n_contact_points": int(slip.size),
-        "n_slip_points": int(np.sum(state == SLIP_CODE)),
+        "n_slip_points": int(np.sum(state == SLIP)),
         "iterations_per_step": [int(k) for k in summary.iterations_per_step],
         # the reaction is not in the output; the mean vertical stress stands in
         "mean_stress_yy": float(np.mean(stress[:, 1])),

@@ -31,13 +31,13 @@ import numpy as np
 
 from xfemslip import closed_form as cf
 from xfemslip.case import loads_case
+from xfemslip.conventions import OPEN, SLIP, STICK  # noqa: F401 (re-exported)
 from xfemslip.errors import ConvergenceError
 from xfemslip.simulation import build_model
 from xfemslip.solver import NewtonSolver
 
 ROOT = Path(__file__).resolve().parents[2]
 RESERVOIR = ROOT / "cases" / "reservoir_depletion.toml"
-OPEN, STICK, SLIP = 0, 1, 2
 
 STRESS = (-20.0e6, -40.0e6, 0.0)  # far field of the crack cases [Pa]
 # with shear, so that a horizontal crack (along element edges) slips:

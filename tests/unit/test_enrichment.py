@@ -19,7 +19,7 @@ import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 from casegen import fracture_case
 
-from xfemslip import kernels
+from xfemslip import conventions
 from xfemslip.assembly import _enriched_matrices
 from xfemslip.case import loads_case
 from xfemslip.enrichment import ENRICHMENT_DIAG_RATIO, HEAVISIDE, find_candidates
@@ -225,11 +225,11 @@ def _reduced_tangent(m):
     c = m.contact
     res = c.evaluate(
         np.zeros(m.problem.n_dofs),
-        kernels.TANGENT_CONSISTENT,
+        conventions.TANGENT_CONSISTENT,
         c.pt_committed,
         c.gt_committed,
     )
-    assert np.all(res.state == kernels.STICK)
+    assert np.all(res.state == conventions.STICK)
     K = (m.bulk.K + c.tangent_matrix(res)).tocsr()
     free = np.setdiff1d(np.arange(K.shape[0]), m.problem.fixed)
     A = K[free][:, free]
@@ -355,13 +355,16 @@ def _stick_solution(m):
     """Linear solve with every point stuck: u and the contact response at u."""
     p, c = m.problem, m.contact
     res = c.evaluate(
-        np.zeros(p.n_dofs), kernels.TANGENT_CONSISTENT, c.pt_committed, c.gt_committed
+        np.zeros(p.n_dofs),
+        conventions.TANGENT_CONSISTENT,
+        c.pt_committed,
+        c.gt_committed,
     )
     K = (p.K + c.tangent_matrix(res)).tocsr()
     free = np.setdiff1d(np.arange(p.n_dofs), p.fixed)
     u = np.zeros(p.n_dofs)
     u[free] = spla.spsolve(K[free][:, free].tocsc(), p.F_unit[free])
-    return c.evaluate(u, kernels.TANGENT_CONSISTENT, c.pt_committed, c.gt_committed)
+    return c.evaluate(u, conventions.TANGENT_CONSISTENT, c.pt_committed, c.gt_committed)
 
 
 def _assert_closed_under_hydrostatic_compression(tip_table):
@@ -369,7 +372,7 @@ def _assert_closed_under_hydrostatic_compression(tip_table):
     shear in the continuum.  On 8 x 8 cells the penalty solution is rough, but every
     point must stay closed with |p_N| of the order of 5 MPa."""
     res = _stick_solution(_hydrostatic_model(tip_table))
-    assert np.all(res.state != kernels.OPEN)
+    assert np.all(res.state != conventions.OPEN)
     assert np.all(res.pn < 0.0)
     assert np.all(res.pn > -2.0 * 5.0e6)
 

@@ -433,7 +433,7 @@ def test_stuck_fractures_carry_the_uniform_traction(name):
     sigma . n of the far field (within 2.5 % of |sigma_yy|: the ramp tips
     perturb it by up to 0.8 MPa), with the penalty jump p_T / k_T; no NaN."""
     from tests.verification.harness import case_text
-    from xfemslip.kernels import STICK
+    from xfemslip.conventions import STICK
     from xfemslip.simulation import build_model, newton_solver
 
     fractures = [

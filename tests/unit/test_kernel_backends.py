@@ -21,9 +21,9 @@ from casegen import sweep_member
 from xfemslip import kernels
 from xfemslip.assembly import _enriched_matrices
 from xfemslip.case import load_case, loads_case
+from xfemslip.conventions import OPEN, SLIP, STICK, TANGENT_CONSISTENT, TANGENT_SECANT
 from xfemslip.enrichment import build_enriched_cells, find_candidates
 from xfemslip.kernels import vectorized
-from xfemslip.kernels.codes import OPEN, SLIP, STICK, TANGENT_CONSISTENT, TANGENT_SECANT
 from xfemslip.material import elasticity_matrix
 from xfemslip.simulation import _geometry, build_model, kernel_work
 from xfemslip.solver import NewtonSolver

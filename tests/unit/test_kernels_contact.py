@@ -10,15 +10,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from xfemslip.kernels.contact import (
-    OPEN,
-    SLIP,
-    STICK,
-    TANGENT_CONSISTENT,
-    TANGENT_SECANT,
-    contact_response,
-    coulomb_return_map,
-)
+from xfemslip.conventions import OPEN, SLIP, STICK, TANGENT_CONSISTENT, TANGENT_SECANT
+from xfemslip.kernels.contact import contact_response, coulomb_return_map
 
 KN, KT = 1.0e12, 5.0e11  # [Pa/m]
 F, C = 0.5, 0.2e6  # friction [-], cohesion [Pa]

@@ -12,7 +12,7 @@ import pytest
 from xfemslip import local_branches
 from xfemslip.assembly import coo_block
 from xfemslip.case import loads_case
-from xfemslip.contact import SLIP
+from xfemslip.conventions import SLIP
 from xfemslip.simulation import build_model
 from xfemslip.solver import NewtonSolver, _forced_law, _frozen_law
 

@@ -19,10 +19,10 @@ import numpy as np
 import pytest
 from casegen import fracture_case
 
-from xfemslip import kernels
+from xfemslip import conventions
 from xfemslip.case import loads_case
 from xfemslip.closed_form import slip_window
-from xfemslip.contact import SLIP, STICK
+from xfemslip.conventions import SLIP, STICK
 from xfemslip.predictor import predict_state, predicted_law, stress_increment
 from xfemslip.simulation import build_model
 from xfemslip.solver import NewtonSolver
@@ -188,7 +188,7 @@ def test_predicted_law_is_the_true_law_on_its_branch():
     solver, _ = _run(_reservoir(), False)
     step = solver.completed[-1]
     c = build_model(_reservoir()).contact  # the history before the step
-    mode = kernels.TANGENT_CONSISTENT
+    mode = conventions.TANGENT_CONSISTENT
     true = c.evaluate(step.u, mode, c.pt_committed, c.gt_committed)
     sign = np.where(true.pt >= 0.0, 1.0, -1.0)
     forced = predicted_law(c, true.state, sign).evaluate(

@@ -16,7 +16,7 @@ import numpy as np
 from casegen import sweep_member
 
 from xfemslip.case import loads_case
-from xfemslip.contact import OPEN, SLIP
+from xfemslip.conventions import OPEN, SLIP
 from xfemslip.simulation import build_model, newton_solver
 
 HERE = Path(__file__).resolve().parent

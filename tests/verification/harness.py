@@ -14,10 +14,9 @@ import h5py
 import numpy as np
 
 from xfemslip.case import load_case
+from xfemslip.conventions import OPEN, SLIP, STICK  # noqa: F401 (re-exported)
 from xfemslip.simulation import run_case
 from xfemslip.verify import box_edges, write_edge_csv  # noqa: F401 (re-exported)
-
-OPEN, STICK, SLIP = 0, 1, 2  # state codes of output-format.md
 
 FRACTURE_KEYS = (
     "s",

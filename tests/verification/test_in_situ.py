@@ -40,7 +40,7 @@ from xfemslip import peer
 from xfemslip.assembly import enriched_part_bbar
 from xfemslip.case import load_case
 from xfemslip.cli import cli
-from xfemslip.contact import OPEN, SLIP, STICK
+from xfemslip.conventions import OPEN, SLIP, STICK
 from xfemslip.depletion import deplete
 from xfemslip.simulation import build_model, newton_solver, run_case
 

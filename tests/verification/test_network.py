@@ -29,7 +29,7 @@ import pytest
 
 from tests.verification.harness import case_text
 from xfemslip.case import loads_case
-from xfemslip.kernels import SLIP, STICK
+from xfemslip.conventions import SLIP, STICK
 from xfemslip.simulation import build_model, newton_solver
 from xfemslip.solver import NewtonSolver
 

@@ -20,14 +20,6 @@ import importlib
 import logging
 import os
 
-from xfemslip.kernels.codes import (
-    OPEN,
-    SLIP,
-    STICK,
-    TANGENT_CONSISTENT,
-    TANGENT_SECANT,
-)
-
 logger = logging.getLogger(__name__)
 
 BACKENDS = ("auto", "numba", "numpy")
@@ -98,11 +90,6 @@ def __getattr__(name):
 
 __all__ = [
     "BACKENDS",
-    "OPEN",
-    "SLIP",
-    "STICK",
-    "TANGENT_CONSISTENT",
-    "TANGENT_SECANT",
     "active",
     "backend",
     "choose",

@@ -45,13 +45,13 @@ import h5py
 import numpy as np
 
 from xfemslip import __version__, interrupt
+from xfemslip.conventions import STATE_CODES
 from xfemslip.writers import FractureFields, StepFields
 from xfemslip.writers.atomic import atomic_path, refuse_non_finite
 
 logger = logging.getLogger(__name__)
 
 FORMAT_VERSION = 1
-STATE_CODES = "0 open, 1 stick, 2 slip"  # mirrors kernels/contact.py OPEN/STICK/SLIP
 
 # Root attributes of output-format.md that the caller must provide.
 REQUIRED_ATTRS = ("case_toml", "converged", "newton_iterations", "wall_time_s")
