@@ -49,7 +49,7 @@ from xfem_process import timed_run
 
 from xfemslip import closed_form as cf
 from xfemslip import verify as V
-from xfemslip.case_fractures import TIP_KINDS
+from xfemslip.case.fractures import TIP_KINDS
 from xfemslip.errors import XfemslipError
 
 AOH = (4, 8, 16, 32, 64)

@@ -34,7 +34,7 @@ from pathlib import Path
 import click
 
 from xfemslip import __version__
-from xfemslip.case_files import path_problem
+from xfemslip.case.files import path_problem
 from xfemslip.errors import (
     CaseError,
     GeometryError,

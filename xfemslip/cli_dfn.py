@@ -2,7 +2,7 @@
 (registered in :mod:`xfemslip.cli`).
 
 Parses the arguments, prints, maps errors (through ``cli._reported_errors``);
-the network is built by the case loader (:mod:`xfemslip.case_network`,
+the network is built by the case loader (:mod:`xfemslip.case.network`,
 :mod:`xfemslip.dfn`), the figure by :mod:`xfemslip.dfn_plot`.
 """
 

@@ -16,7 +16,7 @@ from pathlib import Path
 
 import click
 
-from xfemslip.case_files import path_problem
+from xfemslip.case.files import path_problem
 from xfemslip.cli import (
     EXIT_FAILURE,
     _configure_logging,

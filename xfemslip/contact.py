@@ -18,7 +18,7 @@ import numpy as np
 
 from xfemslip import kernels
 from xfemslip.assembly import coo_block, scatter_vector
-from xfemslip.case_specs import AUTO_PENALTY, CONTACT_PATCH_CELLS
+from xfemslip.case.specs import AUTO_PENALTY, CONTACT_PATCH_CELLS
 from xfemslip.conventions import STICK
 from xfemslip.enrichment import HEAVISIDE, group_values
 from xfemslip.geometry import GEOMETRY_TOL

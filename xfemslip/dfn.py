@@ -2,7 +2,7 @@
 centres, orientations and lengths, drawn from a seeded NumPy ``Generator``.
 
 Pure NumPy.  The parameters arrive validated (``[network.generate]`` is read
-by :mod:`xfemslip.case_network`); ``generate`` returns the segments, and the
+by :mod:`xfemslip.case.network`); ``generate`` returns the segments, and the
 case reader turns them into ``FractureSpec`` entries.
 
 The model (README, *Random fracture networks*):

@@ -82,7 +82,7 @@ def _draw_plain(ax, spec) -> None:
 def read_slipping_counts(summary: Path) -> tuple[np.ndarray, np.ndarray]:
     """(slipping_fractures, fractures) of the ok/skipped rows of a summary.csv
     (read with the size cap of every CSV input; a bad row names its line)."""
-    from xfemslip.case_files import MAX_CSV_BYTES, UnreadableInput, read_input
+    from xfemslip.case.files import MAX_CSV_BYTES, UnreadableInput, read_input
 
     try:
         lines = read_input(summary, MAX_CSV_BYTES).splitlines()

@@ -1,6 +1,6 @@
 """Reservoir regions: axis-aligned boxes or one simple polygon (pure NumPy).
 
-Used by case_pore.py (validation: does the region hold a cell centre, is the
+Used by xfemslip.case.pore (validation: does the region hold a cell centre, is the
 polygon simple) and poro.py (which cells, quadrature points and fracture
 faces lie in the reservoir).  Membership is strict for boxes; a point exactly
 on a polygon edge may fall on either side (even-odd rule).

@@ -33,7 +33,7 @@ import scipy.sparse as sp
 
 from xfemslip import local_branches
 from xfemslip.assembly import coo_block
-from xfemslip.case_specs import AUTO_PENALTY
+from xfemslip.case.specs import AUTO_PENALTY
 from xfemslip.contact import ContactResult, ContactSet
 from xfemslip.conventions import (
     OPEN,

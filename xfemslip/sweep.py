@@ -49,8 +49,8 @@ from pathlib import Path
 import tomli_w
 
 from xfemslip.case import loads_case, parse_toml, path_problem, read_text
-from xfemslip.case_files import MAX_TOML_BYTES, UnreadableInput, read_input
-from xfemslip.case_tables import _show, _Table
+from xfemslip.case.files import MAX_TOML_BYTES, UnreadableInput, read_input
+from xfemslip.case.tables import Table, show
 from xfemslip.errors import CaseError, GeometryError, MeshError
 from xfemslip.sweep_vary import (
     MAX_CASES,
@@ -202,7 +202,7 @@ def _validate_case(text: str, path: Path):
 # --------------------------------------------------------------------------- #
 
 
-def _read_base(root: _Table, path: Path) -> tuple[dict | None, Path, str | None]:
+def _read_base(root: Table, path: Path) -> tuple[dict | None, Path, str | None]:
     """``base``: a case file path (relative to the sweep file) or an inline table.
 
     Returns (document, path to load the cases as, base name)."""
@@ -213,7 +213,7 @@ def _read_base(root: _Table, path: Path) -> tuple[dict | None, Path, str | None]
     if isinstance(value, dict):
         return value, path, value.get("name", path.stem)
     if not isinstance(value, str) or not value.strip():
-        root.error("base", f"expected a case file path or a table, got {_show(value)}")
+        root.error("base", f"expected a case file path or a table, got {show(value)}")
         return None, path, None
     base_path = (path.parent / value) if not Path(value).is_absolute() else Path(value)
     try:
@@ -234,7 +234,7 @@ def loads_sweep(text: str, path: str | Path = "<string>") -> SweepSpec:
     path = Path(path)
     document = parse_toml(text, path)
     problems: list[tuple[str, str]] = []
-    root = _Table(document, "", problems, SWEEP_KEYS)
+    root = Table(document, "", problems, SWEEP_KEYS)
     name = root.string("name", path.stem)
     if isinstance(name, str) and any(c in "/\\" or ord(c) < 32 for c in name):
         root.error("name", f"must not contain a path separator, got {name!r}")

@@ -12,7 +12,7 @@ from __future__ import annotations
 import math
 import re
 
-from xfemslip.case_tables import _show, _Table
+from xfemslip.case.tables import Table, show
 
 RANGE_KEYS = ("start", "stop", "step", "num")
 MAX_CASES = 10_000  # a typo in a range must not start a million runs
@@ -95,10 +95,10 @@ def _flatten_vary(table: dict, prefix: str = "") -> list[tuple[str, object]]:
 def _number(value, key: str, problems: list) -> float | int | None:
     """A finite TOML number (not a boolean) that a float can hold."""
     if isinstance(value, bool) or not isinstance(value, int | float):
-        problems.append((key, f"expected a number, got {_show(value)}"))
+        problems.append((key, f"expected a number, got {show(value)}"))
         return None
     if not _fits_float(value):
-        problems.append((key, f"must be finite, got {_show(value)}"))
+        problems.append((key, f"must be finite, got {show(value)}"))
         return None
     return value
 
@@ -163,7 +163,7 @@ def expand_range(spec: dict, key: str, problems: list) -> list | None:
         num = spec["num"]
         if isinstance(num, bool) or not isinstance(num, int) or num < 1:
             problems.append(
-                (f"{key}.num", f"expected an integer >= 1, got {_show(num)}")
+                (f"{key}.num", f"expected an integer >= 1, got {show(num)}")
             )
             return None
         if num > MAX_CASES:
@@ -196,7 +196,7 @@ def expand_range(spec: dict, key: str, problems: list) -> list | None:
     ]
 
 
-def read_vary(root: _Table, combine: str | None) -> list[tuple[str, list]]:
+def read_vary(root: Table, combine: str | None) -> list[tuple[str, list]]:
     """[vary] -> [(key path, values)], checked: paths, lists, ranges, overlaps."""
     table = root.table("vary", None, required=True)
     if table is None:
@@ -225,7 +225,7 @@ def read_vary(root: _Table, combine: str | None) -> list[tuple[str, list]]:
                 (
                     where,
                     "expected a non-empty array of values or a range table "
-                    f"{{start, stop, step|num}}, got {_show(spec)}",
+                    f"{{start, stop, step|num}}, got {show(spec)}",
                 )
             )
             values = None

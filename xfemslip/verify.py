@@ -526,7 +526,7 @@ def main(*, quick=False, tip=None, plot=None, csv_path=None, penalty="100") -> b
     """``xfemslip verify``: run, print the table; True when every target is met."""
     import click
 
-    from xfemslip.case_fractures import TIP_KINDS
+    from xfemslip.case.fractures import TIP_KINDS
     from xfemslip.errors import UsageError
 
     if plot is not None and Path(plot).suffix.lower() not in (".png", ".pdf"):

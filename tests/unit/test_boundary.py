@@ -105,7 +105,7 @@ def test_top_traction_on_an_uncracked_mesh():
 
 def test_traction_on_every_edge_is_self_equilibrated():
     sxx, syy, sxy = -20e6, -40e6, 5e6
-    # case.py refuses a case without any prescribed displacement, so the
+    # xfemslip.case refuses a case without any prescribed displacement, so the
     # all-traction boundary is handed to traction_load directly
     m = _model(
         'bottom = { uy = 0.0 }\nleft = "traction"\nright = "traction"\n'

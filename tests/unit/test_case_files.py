@@ -1,4 +1,4 @@
-"""Reading input files (xfemslip.case_files): size caps, special files,
+"""Reading input files (xfemslip.case.files): size caps, special files,
 encodings, TOML nesting, paths that no file system holds."""
 
 from __future__ import annotations
@@ -17,7 +17,7 @@ from xfemslip.case import (
     parse_toml,
     path_problem,
 )
-from xfemslip.case_files import READ_CHUNK, UnreadableInput, read_input
+from xfemslip.case.files import READ_CHUNK, UnreadableInput, read_input
 from xfemslip.errors import CaseError
 
 CASE = """\

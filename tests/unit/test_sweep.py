@@ -14,7 +14,7 @@ import numpy as np
 import pytest
 from click.testing import CliRunner
 
-from xfemslip.case_tables import _Table
+from xfemslip.case.tables import Table
 from xfemslip.cli import cli
 from xfemslip.errors import CaseError
 from xfemslip.sweep import (
@@ -540,7 +540,7 @@ def test_case_count_is_the_product_of_the_lengths(values, count):
 def test_ranges_whose_size_overflows_are_refused_at_their_key(range_, key, message):
     problems = []
     document = tomllib.loads(f'[vary]\n"material.nu" = {range_}\n')
-    read_vary(_Table(document, "", problems), "product")
+    read_vary(Table(document, "", problems), "product")
     assert len(problems) == 1
     assert problems[0][0] == key
     assert problems[0][1].startswith(message[:60]), problems[0][1]

@@ -1,9 +1,5 @@
 """``[network.generate]``: the random-network table -> ``dfn.DfnParams``,
-and its realization in the domain (read by :mod:`xfemslip.case_network`).
-
-Private helper of :mod:`xfemslip.case`, which stays the ONLY entry point for
-validating user input (house style: case.py is the only place user input is
-validated); import the public names from ``xfemslip.case``, not from here.
+and its realization in the domain (read by :mod:`xfemslip.case.network`).
 """
 
 from __future__ import annotations
@@ -13,16 +9,16 @@ import math
 import numpy as np
 
 from xfemslip import dfn
-from xfemslip.case_grid import _Grid
-from xfemslip.case_segments import MAX_NETWORK_FRACTURES
-from xfemslip.case_tables import (
-    _NON_NEGATIVE,
-    _POSITIVE,
+from xfemslip.case.grid import Grid
+from xfemslip.case.segments import MAX_NETWORK_FRACTURES
+from xfemslip.case.tables import (
     MAX_COORDINATE,
+    NON_NEGATIVE,
+    POSITIVE,
     Range,
-    _fmt,
-    _show,
-    _Table,
+    Table,
+    fmt,
+    show,
 )
 
 GENERATE_KEYS = (
@@ -47,14 +43,14 @@ LENGTH_KEYS = ("distribution", "value", "exponent", "min", "max", "median", "sig
 MIN_LOGNORMAL_MASS = 1e-4
 
 
-def _only_with(table: _Table, kind: str, used: tuple[str, ...]) -> None:
+def _only_with(table: Table, kind: str, used: tuple[str, ...]) -> None:
     """Keys of the law's table that this distribution does not use."""
     for name in table.data:
         if name != "distribution" and name not in used:
             table.error(name, f'not used with distribution = "{kind}"')
 
 
-def _read_orientation(parent: _Table) -> dfn.Orientation | None:
+def _read_orientation(parent: Table) -> dfn.Orientation | None:
     """``orientation = { distribution = .., mean = .., kappa | std = .. }`` [deg]."""
     table = parent.table("orientation", ORIENTATION_KEYS, required=True)
     if table is None:
@@ -77,7 +73,7 @@ def _read_orientation(parent: _Table) -> dfn.Orientation | None:
     return dfn.Orientation(kind=kind, **values)
 
 
-def _read_length(parent: _Table) -> dfn.LengthLaw | None:
+def _read_length(parent: Table) -> dfn.LengthLaw | None:
     """``length = { distribution = .., ... }`` [m]."""
     table = parent.table("length", LENGTH_KEYS, required=True)
     if table is None:
@@ -93,27 +89,27 @@ def _read_length(parent: _Table) -> dfn.LengthLaw | None:
     }
     _only_with(table, kind, used[kind])
     if kind == "constant":
-        value = table.number("value", rule=_POSITIVE)
+        value = table.number("value", rule=POSITIVE)
         return None if value is None else dfn.LengthLaw(kind=kind, value=value)
     if kind == "power_law":  # min and max required; optional truncation otherwise
         lmin, lmax = (
-            table.number("min", rule=_POSITIVE),
-            table.number("max", rule=_POSITIVE),
+            table.number("min", rule=POSITIVE),
+            table.number("max", rule=POSITIVE),
         )
     else:
         lmin, lmax = (
-            table.number("min", None, _POSITIVE),
-            table.number("max", None, _POSITIVE),
+            table.number("min", None, POSITIVE),
+            table.number("max", None, POSITIVE),
         )
     if lmin is not None and lmax is not None and lmax <= lmin:
-        table.error("max", f"must be > min = {_fmt(lmin)}, got {lmax!r}")
+        table.error("max", f"must be > min = {fmt(lmin)}, got {lmax!r}")
     if kind == "power_law":
         exponent = table.number("exponent", rule=Range(-10.0, 10.0))
         if len(table.problems) > start:
             return None
         law = dfn.LengthLaw(kind=kind, exponent=exponent, lmin=lmin, lmax=lmax)
         return _drawable(table, law)
-    median = table.number("median", rule=_POSITIVE)
+    median = table.number("median", rule=POSITIVE)
     sigma = table.number("sigma", rule=Range(0.0, 10.0, lo_open=True))
     if len(table.problems) > start:
         return None
@@ -129,7 +125,7 @@ def _read_length(parent: _Table) -> dfn.LengthLaw | None:
     return _drawable(table, law)
 
 
-def _drawable(table: _Table, law: dfn.LengthLaw) -> dfn.LengthLaw | None:
+def _drawable(table: Table, law: dfn.LengthLaw) -> dfn.LengthLaw | None:
     """The law, if its mean and (power law) its inverse CDF at 0 and 1 come
     out finite and in [min, max]; values such as min = 1e-300 with exponent
     2.5 overflow (min**(1 - exponent) = 1e450)."""
@@ -184,7 +180,7 @@ def _lognormal_mass(law: dfn.LengthLaw) -> float:
     return hi - lo
 
 
-def _read_sets(table: _Table) -> tuple[dfn.FractureSet, ...] | None:
+def _read_sets(table: Table) -> tuple[dfn.FractureSet, ...] | None:
     """``orientation`` + ``length`` (one set), or ``sets = [{weight, orientation,
     length}, ...]``."""
     single = [k for k in ("orientation", "length") if table.has(k)]
@@ -195,17 +191,17 @@ def _read_sets(table: _Table) -> tuple[dfn.FractureSet, ...] | None:
         value = table.data["sets"]
         if not isinstance(value, list) or not value:
             table.error(
-                "sets", f"expected a non-empty array of tables, got {_show(value)}"
+                "sets", f"expected a non-empty array of tables, got {show(value)}"
             )
             return None
         out = []
         for i, item in enumerate(value):
             if not isinstance(item, dict):
-                table.error(f"sets[{i}]", f"expected a table, got {_show(item)}")
+                table.error(f"sets[{i}]", f"expected a table, got {show(item)}")
                 out.append(None)
                 continue
-            sub = _Table(item, table.key(f"sets[{i}]"), table.problems, SET_KEYS)
-            weight = sub.number("weight", rule=_POSITIVE)
+            sub = Table(item, table.key(f"sets[{i}]"), table.problems, SET_KEYS)
+            weight = sub.number("weight", rule=POSITIVE)
             orientation, length = _read_orientation(sub), _read_length(sub)
             ok = None not in (weight, orientation, length)
             out.append(
@@ -220,7 +216,7 @@ def _read_sets(table: _Table) -> tuple[dfn.FractureSet, ...] | None:
     return (dfn.FractureSet(weight=1.0, orientation=orientation, length=length),)
 
 
-def _read_region(table: _Table) -> tuple[float, float, float, float] | None | bool:
+def _read_region(table: Table) -> tuple[float, float, float, float] | None | bool:
     """``region = [[x0, y0], [x1, y1]]`` (lower-left, upper-right) -> (x0, x1, y0, y1);
     None when not given, False when invalid."""
     if not table.has("region"):
@@ -241,7 +237,7 @@ def _read_region(table: _Table) -> tuple[float, float, float, float] | None | bo
         table.error(
             "region",
             "expected [[x0, y0], [x1, y1]] (lower-left and upper-right corners, "
-            f"m, within +-{MAX_COORDINATE:g}), got {_show(value)}",
+            f"m, within +-{MAX_COORDINATE:g}), got {show(value)}",
         )
         return False
     (x0, y0), (x1, y1) = corners
@@ -254,7 +250,7 @@ def _read_region(table: _Table) -> tuple[float, float, float, float] | None | bo
     return (float(x0), float(x1), float(y0), float(y1))
 
 
-def _read_count(table: _Table) -> dict | None:
+def _read_count(table: Table) -> dict | None:
     """Exactly one of count, p20 [1/m^2], p21 [m/m^2]."""
     given = [k for k in ("count", "p20", "p21") if table.has(k)]
     if len(given) != 1:
@@ -268,23 +264,23 @@ def _read_count(table: _Table) -> dict | None:
     if name == "count":
         value = table.integer("count", rule=Range(0, MAX_NETWORK_FRACTURES))
     else:
-        value = table.number(name, rule=_POSITIVE)
+        value = table.number(name, rule=POSITIVE)
     return None if value is None else {name: value}
 
 
-def _read_generate(table: _Table) -> dfn.DfnParams | None:
+def read_generate(table: Table) -> dfn.DfnParams | None:
     """``[network.generate]`` -> DfnParams (validated, not yet realized)."""
     start = len(table.problems)
-    seed = table.integer("seed", rule=_NON_NEGATIVE)
+    seed = table.integer("seed", rule=NON_NEGATIVE)
     count = _read_count(table)
     region = _read_region(table)
     sets = _read_sets(table)
     intersections = table.choice("intersections", dfn.INTERSECTIONS, "allow")
-    spacing = table.number("min_spacing", 0.0, _NON_NEGATIVE)
+    spacing = table.number("min_spacing", 0.0, NON_NEGATIVE)
     if spacing and intersections != "avoid":
         table.error("min_spacing", 'only used with intersections = "avoid"')
     outside = table.choice("outside", dfn.OUTSIDE, "clip")
-    min_length = table.number("min_length", 0.0, _NON_NEGATIVE)
+    min_length = table.number("min_length", 0.0, NON_NEGATIVE)
     if len(table.problems) > start or region is False:
         return None
     return dfn.DfnParams(
@@ -313,8 +309,8 @@ def _expected_count(params: dfn.DfnParams, box) -> float:
     return params.p21 * area / mean
 
 
-def _realize(
-    table: _Table, params: dfn.DfnParams, grid: _Grid, existing: np.ndarray
+def realize(
+    table: Table, params: dfn.DfnParams, grid: Grid, existing: np.ndarray
 ) -> dfn.Network | None:
     """The network of ``params`` in the domain; a problem if it does not fit."""
     (x0, y0), (w, h) = grid.origin, grid.size
@@ -334,8 +330,8 @@ def _realize(
             None,
             f"placed only {network.placed} of {network.requested} fractures in "
             f"{network.candidates} random draws (intersections = "
-            f'"{params.intersections}", min_spacing = {_fmt(params.min_spacing)} m, '
-            f'outside = "{params.outside}", min_length = {_fmt(params.min_length)} m); '
+            f'"{params.intersections}", min_spacing = {fmt(params.min_spacing)} m, '
+            f'outside = "{params.outside}", min_length = {fmt(params.min_length)} m); '
             "ask for fewer or shorter fractures, or relax these rules",
         )
         return None

@@ -1,9 +1,5 @@
 """``network.file``: a CSV file of fracture segments -> polylines with their
-contact parameters (read by :mod:`xfemslip.case_network`).
-
-Private helper of :mod:`xfemslip.case`, which stays the ONLY entry point for
-validating user input (house style: case.py is the only place user input is
-validated); import the public names from ``xfemslip.case``, not from here.
+contact parameters (read by :mod:`xfemslip.case.network`).
 """
 
 from __future__ import annotations
@@ -14,31 +10,31 @@ from pathlib import Path
 
 import numpy as np
 
-from xfemslip.case_csv import (
+from xfemslip.case.files import (
     CSV_TOLERANCE,
     MAX_CSV_PROBLEMS,
-    _add_capped,
-    _csv_lines,
-    _quote,
+    add_capped,
+    csv_lines,
+    quote,
 )
-from xfemslip.case_grid import _Grid
-from xfemslip.case_polyline import _segment_meets_box, _self_intersection
-from xfemslip.case_tables import (
-    _COORDINATE,
-    _NON_NEGATIVE,
-    _POSITIVE,
-    _exact,
-    _fmt,
-    _range_problem,
-    _suggest,
-    _Table,
+from xfemslip.case.fractures import segment_meets_box, self_intersection
+from xfemslip.case.grid import Grid
+from xfemslip.case.tables import (
+    COORDINATE,
+    NON_NEGATIVE,
+    POSITIVE,
+    Table,
+    exact,
+    fmt,
+    range_problem,
+    suggest,
 )
 
 PROPERTY_RULES = {
-    "friction": _NON_NEGATIVE,
-    "cohesion": _NON_NEGATIVE,
-    "kn": _POSITIVE,
-    "kt": _POSITIVE,
+    "friction": NON_NEGATIVE,
+    "cohesion": NON_NEGATIVE,
+    "kn": POSITIVE,
+    "kt": POSITIVE,
 }
 SEGMENT_COLUMNS = ("x0", "y0", "x1", "y1")
 OPTIONAL_COLUMNS = ("fracture", *PROPERTY_RULES)
@@ -54,14 +50,14 @@ def _csv_header(line: str | None, file: Path) -> tuple[list[str], list[str]]:
     allowed = SEGMENT_COLUMNS + OPTIONAL_COLUMNS
     unknown = [c for c in columns if c not in allowed]
     if len(unknown) > MAX_CSV_PROBLEMS:
-        first = ", ".join(_quote(c) for c in unknown[:3])
+        first = ", ".join(quote(c) for c in unknown[:3])
         bad = [
             f"{file} line 1: {len(unknown)} unknown columns ({first}, ...); "
             "allowed: " + ", ".join(allowed)
         ]
     else:
         bad = [
-            f"{file} line 1: unknown column {_quote(c)}{_suggest(c, allowed)}"
+            f"{file} line 1: unknown column {quote(c)}{suggest(c, allowed)}"
             for c in unknown
         ]
     counts = Counter(c for c in columns if c in allowed)
@@ -90,11 +86,11 @@ def _csv_cell(name: str, text: str) -> tuple[object, str | None]:
     try:
         value = float(text)
     except ValueError:
-        return None, f"{name} is not a number: {_quote(text)}"
+        return None, f"{name} is not a number: {quote(text)}"
     if not math.isfinite(value):
-        return None, f"{name} must be finite, got {_quote(text)}"
-    rule = _COORDINATE if name in SEGMENT_COLUMNS else PROPERTY_RULES.get(name)
-    message = _range_problem(value, rule, name)
+        return None, f"{name} must be finite, got {quote(text)}"
+    rule = COORDINATE if name in SEGMENT_COLUMNS else PROPERTY_RULES.get(name)
+    message = range_problem(value, rule, name)
     return value, (f"{name} {message}" if message else None)
 
 
@@ -108,7 +104,7 @@ def _csv_rows(lines: list[str], columns: list[str], file: Path):
         if len(fields) != len(columns):
             bad.append(
                 f"{file} line {number}: expected {len(columns)} values "
-                f"({','.join(columns)}), got {len(fields)}: {_quote(line)}"
+                f"({','.join(columns)}), got {len(fields)}: {quote(line)}"
             )
             continue
         row, problems = {}, []
@@ -120,7 +116,7 @@ def _csv_rows(lines: list[str], columns: list[str], file: Path):
         if not problems and p0 == p1:
             problems.append(
                 f"zero-length segment: (x0, y0) = (x1, y1) = "
-                f"({_exact(p0[0])}, {_exact(p0[1])})"
+                f"({exact(p0[0])}, {exact(p0[1])})"
             )
         bad += [f"{file} line {number}: {p}" for p in problems]
         if not problems:
@@ -179,9 +175,9 @@ def _chain(group: list, fid, file: Path, tol: float) -> tuple[np.ndarray | None,
         start = (row["x0"], row["y0"])
         if math.dist(start, points[-1]) > tol:
             bad.append(
-                f"{file} line {number}: fracture {_quote(fid)} continues at "
-                f"({_exact(start[0])}, {_exact(start[1])}) but its segment on line "
-                f"{prev} ends at ({_exact(points[-1][0])}, {_exact(points[-1][1])}); "
+                f"{file} line {number}: fracture {quote(fid)} continues at "
+                f"({exact(start[0])}, {exact(start[1])}) but its segment on line "
+                f"{prev} ends at ({exact(points[-1][0])}, {exact(points[-1][1])}); "
                 "the rows of a fracture must chain end to start"
             )
         points.append((row["x1"], row["y1"]))
@@ -198,8 +194,8 @@ def _group_properties(group: list, fid, file: Path, defaults: dict):
         if len(values) > 1:
             (n1, v1), (n2, v2) = given[0], next(g for g in given if g[1] != given[0][1])
             bad.append(
-                f"{file} lines {n1} and {n2}: fracture {_quote(fid)} has {name} "
-                f"{_fmt(v1)} and {_fmt(v2)}; its rows must agree"
+                f"{file} lines {n1} and {n2}: fracture {quote(fid)} has {name} "
+                f"{fmt(v1)} and {fmt(v2)}; its rows must agree"
             )
         props[name] = given[0][1] if given else defaults.get(name)
     if props["friction"] is None and not bad:
@@ -210,20 +206,20 @@ def _group_properties(group: list, fid, file: Path, defaults: dict):
     return props, bad
 
 
-def _read_segments_file(
-    table: _Table, grid: _Grid | None, folder: Path, defaults: dict
+def read_segments_file(
+    table: Table, grid: Grid | None, folder: Path, defaults: dict
 ) -> list[tuple[np.ndarray, dict, str]] | None:
     """``network.file``: [(points, properties, source)] per fracture, or None."""
     name = table.string("file")
     if name is None:
         return None
     file, key = folder / name, table.key("file")
-    lines = _csv_lines(file, key, table.problems)
+    lines = csv_lines(file, key, table.problems)
     if lines is None:
         return None
     columns, bad = _csv_header(lines[0] if lines else None, file)
     if bad:
-        _add_capped(table.problems, key, bad)
+        add_capped(table.problems, key, bad)
         return None
     count = _fracture_count(lines, columns)
     if count > MAX_NETWORK_FRACTURES:  # before a number is read
@@ -245,17 +241,17 @@ def _read_segments_file(
         if shape:
             bad.append(f"{where}: {shape}")
             continue
-        label = f"fracture {_quote(fid)}, " if fid is not None else ""
+        label = f"fracture {quote(fid)}, " if fid is not None else ""
         out.append((points, props, f"network.file {name}: {label}{_lines_text(group)}"))
     if not rows and not bad:
         bad.append(f"{file}: no segment rows after the header")
-    _add_capped(table.problems, key, bad)
+    add_capped(table.problems, key, bad)
     return None if bad else out
 
 
-def _shape_problem(points: np.ndarray, grid: _Grid | None) -> str | None:
+def _shape_problem(points: np.ndarray, grid: Grid | None) -> str | None:
     """Self-intersection, or a fracture wholly outside the domain."""
-    pair = _self_intersection(points)
+    pair = self_intersection(points)
     if pair is not None:
         i, j = pair
         return f"self-intersecting polyline: segments {i} and {j} touch or cross"
@@ -264,11 +260,11 @@ def _shape_problem(points: np.ndarray, grid: _Grid | None) -> str | None:
     lo = grid.origin
     hi = (lo[0] + grid.size[0], lo[1] + grid.size[1])
     if not any(
-        _segment_meets_box(a, b, lo, hi)
+        segment_meets_box(a, b, lo, hi)
         for a, b in zip(points[:-1], points[1:], strict=True)
     ):
         return (
-            f"lies outside the domain [{_fmt(lo[0])}, {_fmt(hi[0])}] x "
-            f"[{_fmt(lo[1])}, {_fmt(hi[1])}]"
+            f"lies outside the domain [{fmt(lo[0])}, {fmt(hi[0])}] x "
+            f"[{fmt(lo[1])}, {fmt(hi[1])}]"
         )
     return None

@@ -1,9 +1,4 @@
-"""``[domain]`` and ``[mesh]`` -> origin, size and node coordinates (``_Grid``).
-
-Private helper of :mod:`xfemslip.case`, which stays the ONLY entry point for
-validating user input (house style: case.py is the only place user input is
-validated); import the public names from ``xfemslip.case``, not from here.
-"""
+"""``[domain]`` and ``[mesh]`` -> origin, size and node coordinates (``Grid``)."""
 
 from __future__ import annotations
 
@@ -11,19 +6,19 @@ from typing import NamedTuple
 
 import numpy as np
 
-from xfemslip.case_specs import MeshSpec
-from xfemslip.case_tables import (
-    _POSITIVE,
-    _REQUIRED,
+from xfemslip.case.specs import MeshSpec
+from xfemslip.case.tables import (
     MAX_COORDINATE,
+    POSITIVE,
+    REQUIRED,
     Range,
-    _check_integer,
-    _check_number,
-    _check_vector,
-    _exact,
-    _frozen,
-    _show,
-    _Table,
+    Table,
+    check_integer,
+    check_number,
+    check_vector,
+    exact,
+    frozen,
+    show,
 )
 
 # Memory guard: a Q4 element adds 64 stiffness triplets (8 B value + 2 x 8 B
@@ -35,7 +30,7 @@ BYTES_PER_ELEMENT = 2048
 DOMAIN_RTOL = 1e-12
 
 
-class _Grid(NamedTuple):
+class Grid(NamedTuple):
     """Resolved domain and mesh, shared by the checks that need geometry."""
 
     origin: tuple[float, float]
@@ -67,22 +62,20 @@ def _check_element_count(nx: int, ny: int, key: str, problems: list) -> bool:
     return False
 
 
-def _read_axis(mesh: _Table, name: str) -> np.ndarray | None:
+def _read_axis(mesh: Table, name: str) -> np.ndarray | None:
     """``mesh.x`` or ``mesh.y``: >= 2 strictly increasing finite numbers."""
     found, value = mesh._get(
-        name, _REQUIRED, f" (mesh.{'y' if name == 'x' else 'x'} is given; give both)"
+        name, REQUIRED, f" (mesh.{'y' if name == 'x' else 'x'} is given; give both)"
     )
     if not found:
         return None
     key = mesh.key(name)
     if not isinstance(value, list) or len(value) < 2:
         mesh.error(
-            name, f"expected an array of >= 2 increasing numbers, got {_show(value)}"
+            name, f"expected an array of >= 2 increasing numbers, got {show(value)}"
         )
         return None
-    items = [
-        _check_number(v, f"{key}[{i}]", mesh.problems) for i, v in enumerate(value)
-    ]
+    items = [check_number(v, f"{key}[{i}]", mesh.problems) for i, v in enumerate(value)]
     if any(v is None for v in items):
         return None
     coords = np.array(items, dtype=np.float64)
@@ -92,8 +85,8 @@ def _read_axis(mesh: _Table, name: str) -> np.ndarray | None:
         i = int(bad[0]) + 1
         mesh.error(
             f"{name}[{i}]",
-            f"must be > {name}[{i - 1}] = {_exact(coords[i - 1])} "
-            f"(strictly increasing), got {_exact(coords[i])}",
+            f"must be > {name}[{i - 1}] = {exact(coords[i - 1])} "
+            f"(strictly increasing), got {exact(coords[i])}",
         )
         return None
     return coords
@@ -113,14 +106,14 @@ def _axis_resolves(coords: np.ndarray, key: str, problems: list) -> bool:
         problems.append(
             (
                 key,
-                f"node coordinates from {_exact(coords[0])} to {_exact(coords[-1])} "
+                f"node coordinates from {exact(coords[0])} to {exact(coords[-1])} "
                 f"reach beyond +-{MAX_COORDINATE:g} m (squared distances in the "
                 "geometry would overflow)",
             )
         )
         return False
     message = (
-        f"node coordinates from {_exact(coords[0])} to {_exact(coords[-1])} are not "
+        f"node coordinates from {exact(coords[0])} to {exact(coords[-1])} are not "
         "finite and strictly increasing in float64 (sizes too small relative to the "
         "origin, or too large)"
     )
@@ -128,7 +121,7 @@ def _axis_resolves(coords: np.ndarray, key: str, problems: list) -> bool:
     return False
 
 
-def _domain_agrees(domain: _Table, name: str, given, expected, scale: float) -> None:
+def _domain_agrees(domain: Table, name: str, given, expected, scale: float) -> None:
     """Record a problem if ``domain.<name>`` differs from the mesh's value."""
     if given is None or all(
         abs(g - e) <= DOMAIN_RTOL * scale for g, e in zip(given, expected, strict=True)
@@ -137,12 +130,12 @@ def _domain_agrees(domain: _Table, name: str, given, expected, scale: float) -> 
     domain.error(
         name,
         f"disagrees with mesh.x / mesh.y: expected "
-        f"[{_exact(expected[0])}, {_exact(expected[1])}], got "
-        f"[{_exact(given[0])}, {_exact(given[1])}] (or leave [domain] out)",
+        f"[{exact(expected[0])}, {exact(expected[1])}], got "
+        f"[{exact(given[0])}, {exact(given[1])}] (or leave [domain] out)",
     )
 
 
-def _mesh_from_axes(mesh: _Table, domain: _Table | None, size, origin) -> _Grid | None:
+def _mesh_from_axes(mesh: Table, domain: Table | None, size, origin) -> Grid | None:
     """Explicit rectilinear mesh; a given [domain] must agree with it."""
     x, y = _read_axis(mesh, "x"), _read_axis(mesh, "y")
     if x is None or y is None:
@@ -160,17 +153,17 @@ def _mesh_from_axes(mesh: _Table, domain: _Table | None, size, origin) -> _Grid 
         _domain_agrees(domain, "size", size, mesh_size, scale)
         if domain.has("origin"):
             _domain_agrees(domain, "origin", origin, mesh_origin, scale)
-    return _Grid(mesh_origin, mesh_size, MeshSpec(x=_frozen(x), y=_frozen(y)))
+    return Grid(mesh_origin, mesh_size, MeshSpec(x=frozen(x), y=frozen(y)))
 
 
-def _mesh_uniform(mesh: _Table, domain: _Table | None, size, origin) -> _Grid | None:
+def _mesh_uniform(mesh: Table, domain: Table | None, size, origin) -> Grid | None:
     """``elements = [nx, ny]`` over ``domain.size``: uniform node coordinates."""
-    counts = _check_vector(
+    counts = check_vector(
         mesh.data["elements"],
         mesh.key("elements"),
         mesh.problems,
         2,
-        lambda v, k: _check_integer(v, k, mesh.problems, Range(1)),
+        lambda v, k: check_integer(v, k, mesh.problems, Range(1)),
     )
     if domain is not None and not domain.has("size"):
         domain.error("size", "required key missing (mesh.elements needs domain.size)")
@@ -186,15 +179,15 @@ def _mesh_uniform(mesh: _Table, domain: _Table | None, size, origin) -> _Grid | 
     y_ok = _axis_resolves(y, key, mesh.problems)
     if not (x_ok and y_ok):
         return None
-    return _Grid(origin, size, MeshSpec(x=_frozen(x), y=_frozen(y)))
+    return Grid(origin, size, MeshSpec(x=frozen(x), y=frozen(y)))
 
 
-def _read_grid(root: _Table) -> _Grid | None:
+def read_grid(root: Table) -> Grid | None:
     """[domain] and [mesh] -> origin, size and node coordinates."""
     domain = root.table("domain", ("size", "origin"))
     size = origin = None
     if domain is not None:
-        size = domain.numbers("size", 2, None, _POSITIVE)
+        size = domain.numbers("size", 2, None, POSITIVE)
         origin = domain.numbers("origin", 2, (0.0, 0.0))
     mesh = root.table("mesh", ("elements", "x", "y"), required=True)
     if mesh is None:

@@ -1,9 +1,5 @@
 """``[pore_pressure]`` and ``[reservoir]`` -> ``PorePressureSpec``, ``ReservoirSpec``.
 
-Private helper of :mod:`xfemslip.case`, which stays the ONLY entry point for
-validating user input (house style: case.py is the only place user input is
-validated); import the public names from ``xfemslip.case``, not from here.
-
 Both tables are optional; a case without them runs exactly as before.
 """
 
@@ -11,15 +7,15 @@ from __future__ import annotations
 
 import numpy as np
 
-from xfemslip.case_specs import PorePressureSpec, ReservoirSpec
-from xfemslip.case_tables import (
-    _COORDINATE,
-    _POSITIVE,
+from xfemslip.case.specs import PorePressureSpec, ReservoirSpec
+from xfemslip.case.tables import (
+    COORDINATE,
+    POSITIVE,
     Range,
-    _check_number,
-    _frozen,
-    _show,
-    _Table,
+    Table,
+    check_number,
+    frozen,
+    show,
 )
 from xfemslip.regions import in_boxes, in_polygon, polygon_problem
 
@@ -28,7 +24,7 @@ PORE_PRESSURE_REGIONS = ("all", "reservoir")
 RESERVOIR_KEYS = ("box", "boxes", "polygon", "E", "nu")
 
 
-def _read_pore_pressure(root: _Table) -> PorePressureSpec | None:
+def read_pore_pressure(root: Table) -> PorePressureSpec | None:
     """[pore_pressure]: initial, change [Pa], biot in (0, 1], region."""
     table = root.table("pore_pressure", PORE_PRESSURE_KEYS)
     if table is None or not table.present:
@@ -63,12 +59,12 @@ def _check_box(value, key: str, problems: list) -> tuple | None:
         problems.append(
             (
                 key,
-                f"expected an array [x0, y0, x1, y1] of 4 numbers, got {_show(value)}",
+                f"expected an array [x0, y0, x1, y1] of 4 numbers, got {show(value)}",
             )
         )
         return None
     items = [
-        _check_number(v, f"{key}[{i}]", problems, _COORDINATE)
+        check_number(v, f"{key}[{i}]", problems, COORDINATE)
         for i, v in enumerate(value)
     ]
     if any(v is None for v in items):
@@ -82,7 +78,7 @@ def _check_box(value, key: str, problems: list) -> tuple | None:
     return tuple(items)
 
 
-def _read_polygon(table: _Table) -> list | None:
+def _read_polygon(table: Table) -> list | None:
     """``polygon = [[x, y], ...]``: at least 3 vertices of a simple polygon [m]."""
     key = table.key("polygon")
     value = table.data["polygon"]
@@ -90,7 +86,7 @@ def _read_polygon(table: _Table) -> list | None:
         table.error(
             "polygon",
             f"expected an array of at least 3 vertices [[x, y], ...], got "
-            f"{_show(value)}",
+            f"{show(value)}",
         )
         return None
     vertices = []
@@ -99,12 +95,12 @@ def _read_polygon(table: _Table) -> list | None:
             table.problems.append(
                 (
                     f"{key}[{i}]",
-                    f"expected a vertex [x, y] of 2 numbers, got {_show(v)}",
+                    f"expected a vertex [x, y] of 2 numbers, got {show(v)}",
                 )
             )
             return None
         xy = [
-            _check_number(c, f"{key}[{i}][{j}]", table.problems, _COORDINATE)
+            check_number(c, f"{key}[{i}][{j}]", table.problems, COORDINATE)
             for j, c in enumerate(v)
         ]
         if any(c is None for c in xy):
@@ -117,7 +113,7 @@ def _read_polygon(table: _Table) -> list | None:
     return vertices
 
 
-def _read_boxes(table: _Table) -> list | None:
+def _read_boxes(table: Table) -> list | None:
     """``box = [..]`` or ``boxes = [[..], ..]`` (one of them, or a polygon)."""
     if table.has("box") == table.has("boxes"):
         table.error(
@@ -131,7 +127,7 @@ def _read_boxes(table: _Table) -> list | None:
         return None if box is None else [box]
     value = table.data["boxes"]
     if not isinstance(value, list) or not value:
-        table.error("boxes", f"expected a non-empty array of boxes, got {_show(value)}")
+        table.error("boxes", f"expected a non-empty array of boxes, got {show(value)}")
         return None
     boxes = [
         _check_box(v, f"{table.key('boxes')}[{i}]", table.problems)
@@ -140,7 +136,7 @@ def _read_boxes(table: _Table) -> list | None:
     return None if any(b is None for b in boxes) else boxes
 
 
-def _read_reservoir(root: _Table, grid) -> ReservoirSpec | None:
+def read_reservoir(root: Table, grid) -> ReservoirSpec | None:
     """[reservoir]: boxes or a polygon, and the reservoir's E [Pa] and nu [-]."""
     table = root.table("reservoir", RESERVOIR_KEYS)
     if table is None or not table.present:
@@ -159,7 +155,7 @@ def _read_reservoir(root: _Table, grid) -> ReservoirSpec | None:
         boxes = None if polygon is None else []
     else:
         boxes = _read_boxes(table)
-    E = table.number("E", rule=_POSITIVE)
+    E = table.number("E", rule=POSITIVE)
     nu = table.number("nu", rule=Range(0.0, 0.5, hi_open=True))
     if boxes is not None and grid is not None:
         x, y = grid.mesh.x, grid.mesh.y
@@ -185,8 +181,8 @@ def _read_reservoir(root: _Table, grid) -> ReservoirSpec | None:
     if len(table.problems) > start:
         return None
     return ReservoirSpec(
-        boxes=_frozen(np.array(boxes, float).reshape(-1, 4)),
+        boxes=frozen(np.array(boxes, float).reshape(-1, 4)),
         E=E,
         nu=nu,
-        polygon=None if polygon is None else _frozen(polygon),
+        polygon=None if polygon is None else frozen(polygon),
     )

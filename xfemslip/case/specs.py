@@ -1,9 +1,4 @@
-"""Spec dataclasses of a resolved case: ``CaseSpec`` and its parts.
-
-Private helper of :mod:`xfemslip.case`, which stays the ONLY entry point for
-validating user input (house style: case.py is the only place user input is
-validated); import the public names from ``xfemslip.case``, not from here.
-"""
+"""Spec dataclasses of a resolved case: ``CaseSpec`` and its parts."""
 
 from __future__ import annotations
 
@@ -52,7 +47,7 @@ CONTACT_PATCH_CELLS = 1.5
 
 @dataclass(frozen=True, kw_only=True)
 class FractureSpec:
-    index: int  # [[fractures]] position; [network] ones follow (case_network)
+    index: int  # [[fractures]] position; [network] ones follow (network.py)
     points: np.ndarray  # (k, 2) float64 polyline vertices, k >= 2 [m]
     friction: float  # Coulomb coefficient f [-]
     cohesion: float  # c_f [Pa]

@@ -1,9 +1,8 @@
-"""Input files: read with a size cap, parse TOML with a nesting cap, check
-output paths -- before anything is built from them.
+"""Input files: read with a size cap, parse TOML with a nesting cap, read CSV
+lines, check output paths -- before anything is built from them.
 
-Private helper of :mod:`xfemslip.case` (and of :mod:`xfemslip.sweep` and the
-CLI), which stays the ONLY entry point for validating user input; import the
-public names from ``xfemslip.case``.
+Used by the case readers of this package, by the sweep reader and by the CLI
+(the checks of output paths).
 
 Every input file (case and sweep files, boundary and network CSV files) is
 read by ``read_input``:
@@ -61,6 +60,13 @@ _KINDS = (
     (stat.S_ISBLK, "a block device"),
     (stat.S_ISSOCK, "a socket"),
 )
+
+# CSV points count as on an edge / at its ends within this fraction of the
+# largest domain size (rounding of coordinates printed by another program).
+CSV_TOLERANCE = 1e-9
+
+# At most this many row problems are listed per CSV file (then a count).
+MAX_CSV_PROBLEMS = 10
 
 
 class UnreadableInput(Exception):
@@ -216,3 +222,28 @@ def path_problem(path: str | os.PathLike) -> str | None:
             f"the {MAX_NAME_BYTES} a file or folder name may have"
         )
     return None
+
+
+def csv_lines(file: Path, key: str, problems: list) -> list[str] | None:
+    """The lines of a CSV input file (read with the MAX_CSV_BYTES cap), or
+    None after recording why it cannot be read."""
+    try:
+        return read_input(file, MAX_CSV_BYTES).splitlines()
+    except UnreadableInput as exc:
+        problems.append((key, f"cannot read {file}: {exc}"))
+        return None
+
+
+def quote(text: str, limit: int = 60) -> str:
+    """``repr`` of a CSV line or field for a message, cut to ``limit`` chars."""
+    text = text.strip()
+    if len(text) <= limit:
+        return repr(text)
+    return f"{text[:limit]!r}... ({len(text)} characters)"
+
+
+def add_capped(problems: list, key: str, messages: list[str]) -> None:
+    """Record at most MAX_CSV_PROBLEMS messages, then how many were left out."""
+    problems.extend((key, m) for m in messages[:MAX_CSV_PROBLEMS])
+    if len(messages) > MAX_CSV_PROBLEMS:
+        problems.append((key, f"... and {len(messages) - MAX_CSV_PROBLEMS} more rows"))

@@ -1,13 +1,11 @@
-"""Case files (TOML, ``case-format.md`` version 1) -> validated frozen specs.
+"""``load_case`` / ``loads_case``: a case file -> a validated ``CaseSpec``.
 
-This is the ONLY module that validates user input.  ``load_case(path)``
-reads a file, collects every problem it finds (each with its key path) and
-raises one ``CaseError``; otherwise it returns a ``CaseSpec`` whose fields are
-resolved to SI values and plain NumPy arrays, so that the numerical modules
-never look at the TOML again.
-
-Units: m, Pa, N/m^3 (= Pa/m) for penalty stiffnesses; angles in degrees in the
-file, converted here and nowhere else.  Stresses: tension positive.
+The readers of ``name``, ``[material]``, ``[loading]``, ``[solver]`` and
+``[output]`` are here; the other tables have their own modules in this
+package, which this one calls in document order.  Every problem is collected
+(each with its key path) and raised as one ``CaseError``; otherwise the
+returned ``CaseSpec`` holds SI values and read-only NumPy arrays, so that the
+numerical modules never look at the TOML again.
 
 Resolution rules beyond ``case-format.md`` (see ``describe`` for the printout):
 
@@ -22,214 +20,37 @@ Resolution rules beyond ``case-format.md`` (see ``describe`` for the printout):
   1); a point beyond either end of its edge is an error like a point off the
   edge, and points closer than the tolerance along the edge must carry the
   same values (one of them is then kept).
-
-Public functions: ``load_case``, ``loads_case``, ``describe``; ``SOLVER_OPTIONS``
-is the one table of ``[solver]`` options.
-
-The work is split over private helper modules, imported only from here (every
-public name is re-exported here): ``case_specs`` (the spec dataclasses),
-``case_tables`` (typed TOML-table reader, value checks, message helpers),
-``case_grid`` (``[domain]`` and ``[mesh]``), ``case_fractures`` and
-``case_polyline`` (``[[fractures]]`` and its polyline checks),
-``case_network``, ``case_segments`` and ``case_generate`` (``[network]``: a
-CSV file of segments, random networks),
-``case_boundary`` and ``case_csv`` (``[boundary]`` and its CSV files) and
-``case_describe`` (``describe``).  This module keeps the other constants,
-``SOLVER_OPTIONS``, the readers of ``name``, ``[material]``, ``[loading]``,
-``[solver]`` and ``[output]``, and the entry points.
 """
 
 from __future__ import annotations
 
 from pathlib import Path
 
-from xfemslip.case_boundary import EDGE_KEYS, EDGE_WORDS, _read_boundary
-from xfemslip.case_csv import CSV_HEADER, CSV_TOLERANCE, MAX_CSV_PROBLEMS
-from xfemslip.case_describe import describe
-from xfemslip.case_files import (
-    MAX_CSV_BYTES,
-    MAX_NAME_BYTES,
-    MAX_TOML_BYTES,
-    MAX_TOML_DEPTH,
-    parse_toml,
-    path_problem,
-    read_text,
+from xfemslip.case.boundary import read_boundary
+from xfemslip.case.files import MAX_NAME_BYTES, parse_toml, path_problem, read_text
+from xfemslip.case.fractures import read_fractures
+from xfemslip.case.grid import read_grid
+from xfemslip.case.network import read_network
+from xfemslip.case.options import (
+    MATERIAL_MODELS,
+    MAX_STEPS,
+    OUTPUT_FORMATS,
+    SOLVER_OPTIONS,
+    STRESS_KEYS,
+    TOP_KEYS,
 )
-from xfemslip.case_fractures import (
-    FRACTURE_KEYS,
-    TIP_KEYS,
-    TIP_KINDS,
-    _read_fractures,
-)
-from xfemslip.case_grid import (
-    BYTES_PER_ELEMENT,
-    DOMAIN_RTOL,
-    MAX_ELEMENTS,
-    _read_grid,
-)
-from xfemslip.case_network import _read_network
-from xfemslip.case_pore import (
-    PORE_PRESSURE_KEYS,
-    PORE_PRESSURE_REGIONS,
-    RESERVOIR_KEYS,
-    _read_pore_pressure,
-    _read_reservoir,
-)
-from xfemslip.case_specs import (
-    CONTACT_PATCH_CELLS,
-    EDGES,
-    BoundarySpec,
+from xfemslip.case.pore import read_pore_pressure, read_reservoir
+from xfemslip.case.specs import (
     CaseSpec,
-    EdgeSpec,
-    FractureSpec,
     LoadingSpec,
     MaterialSpec,
-    MeshSpec,
     OutputSpec,
-    PorePressureSpec,
-    ReservoirSpec,
     SolverSpec,
 )
-from xfemslip.case_tables import (
-    _POSITIVE,
-    Option,
-    Range,
-    _check_choice,
-    _show,
-    _Table,
-)
+from xfemslip.case.tables import POSITIVE, Range, Table, check_choice, show
 from xfemslip.errors import CaseError
 
-__all__ = [
-    "BYTES_PER_ELEMENT",
-    "CSV_HEADER",
-    "CSV_TOLERANCE",
-    "DOMAIN_RTOL",
-    "EDGES",
-    "EDGE_KEYS",
-    "EDGE_WORDS",
-    "FRACTURE_KEYS",
-    "MATERIAL_MODELS",
-    "MAX_CSV_BYTES",
-    "MAX_NAME_BYTES",
-    "MAX_TOML_BYTES",
-    "MAX_TOML_DEPTH",
-    "MAX_CSV_PROBLEMS",
-    "MAX_ELEMENTS",
-    "MAX_STEPS",
-    "OUTPUT_FORMATS",
-    "PORE_PRESSURE_KEYS",
-    "PORE_PRESSURE_REGIONS",
-    "RESERVOIR_KEYS",
-    "SOLVER_OPTIONS",
-    "STRESS_KEYS",
-    "TIP_KEYS",
-    "TIP_KINDS",
-    "TOP_KEYS",
-    "BoundarySpec",
-    "CaseSpec",
-    "EdgeSpec",
-    "FractureSpec",
-    "LoadingSpec",
-    "MaterialSpec",
-    "MeshSpec",
-    "Option",
-    "OutputSpec",
-    "PorePressureSpec",
-    "Range",
-    "ReservoirSpec",
-    "SolverSpec",
-    "describe",
-    "load_case",
-    "loads_case",
-    "parse_toml",
-    "path_problem",
-    "read_text",
-]
-
-
-# --------------------------------------------------------------------------- #
-# Constants and option tables
-# --------------------------------------------------------------------------- #
-
-# The constants of [domain]/[mesh], [[fractures]], [boundary] and the CSV files
-# live beside their readers (case_grid, case_fractures, case_boundary, case_csv)
-# and are re-exported above.
-TOP_KEYS = (
-    "name",
-    "domain",
-    "mesh",
-    "material",
-    "fractures",
-    "network",
-    "loading",
-    "boundary",
-    "solver",
-    "output",
-    "pore_pressure",
-    "reservoir",
-)
-STRESS_KEYS = ("xx", "yy", "xy")
-MATERIAL_MODELS = ("plane_strain", "plane_stress")
-OUTPUT_FORMATS = ("h5", "vtu")
-MAX_STEPS = 100_000
-
-
-SOLVER_OPTIONS: tuple[Option, ...] = (
-    Option(
-        "tolerance",
-        float,
-        1.0e-8,
-        "Newton stops when ||residual|| / ||F_ext|| <= tolerance (eta_0)",
-        Range(0.0, 1.0, lo_open=True, hi_open=True),
-    ),
-    Option(
-        "max_iterations", int, 30, "Newton iterations per load step", Range(1, 10_000)
-    ),
-    Option(
-        "tangent",
-        str,
-        "consistent",
-        "contact tangent: 'consistent' (Newton) or 'secant' (paper eq. 28)",
-        ("consistent", "secant"),
-    ),
-    Option(
-        "contact_patch",
-        float,
-        CONTACT_PATCH_CELLS,
-        "length of a contact patch in cell sizes: the contact law acts on the jump "
-        "averaged over each patch, which removes the traction oscillation of "
-        "pointwise penalty XFEM; 0 = pointwise (every Gauss point on its own)",
-        Range(0.0, 100.0),
-    ),
-    Option(
-        "max_step_cuts",
-        int,
-        5,
-        "bisections of a load step that does not converge (0: none); the "
-        "smallest sub-step is 1/2**max_step_cuts of the step",
-        Range(0, 30),
-    ),
-    Option(
-        "linear_solver",
-        str,
-        "auto",
-        "linear solver of the Newton systems: 'superlu' (sparse LU, factorization "
-        "kept), 'amg' (pyamg-preconditioned GMRES) or 'auto' (amg from 50,000 "
-        "free dofs on cells up to 4:1)",
-        ("auto", "superlu", "amg"),
-    ),
-    Option(
-        "kernels",
-        str,
-        "auto",
-        "how the cell and contact loops run: 'numpy' (whole-array NumPy, no "
-        "Numba start-up), 'numba' (compiled, cached once per install) or 'auto' "
-        "(numpy unless the enriched cells are many; the answer is the same to "
-        "round-off)",
-        ("auto", "numba", "numpy"),
-    ),
-)
+__all__ = ["load_case", "loads_case"]
 
 
 # --------------------------------------------------------------------------- #
@@ -237,7 +58,7 @@ SOLVER_OPTIONS: tuple[Option, ...] = (
 # --------------------------------------------------------------------------- #
 
 
-def _read_name(root: _Table, path: Path) -> str | None:
+def _read_name(root: Table, path: Path) -> str | None:
     """``name``, default the file's stem; it becomes a directory name."""
     name = root.string("name", path.stem)
     if name is None or not root.has("name"):
@@ -261,12 +82,12 @@ def _read_name(root: _Table, path: Path) -> str | None:
     return name
 
 
-def _read_material(root: _Table) -> MaterialSpec | None:
+def _read_material(root: Table) -> MaterialSpec | None:
     """[material]: E > 0, 0 <= nu < 0.5, model."""
     table = root.table("material", ("E", "nu", "model"), required=True)
     if table is None:
         return None
-    E = table.number("E", rule=_POSITIVE)
+    E = table.number("E", rule=POSITIVE)
     nu = table.number("nu", rule=Range(0.0, 0.5, hi_open=True))
     model = table.choice("model", MATERIAL_MODELS, "plane_strain")
     if E is None or nu is None or model is None:
@@ -279,7 +100,7 @@ def _read_material(root: _Table) -> MaterialSpec | None:
 # --------------------------------------------------------------------------- #
 
 
-def _read_stress(loading: _Table, name: str) -> tuple[float, float, float] | None:
+def _read_stress(loading: Table, name: str) -> tuple[float, float, float] | None:
     """``{ xx = .., yy = .., xy = .. }`` [Pa]; xy defaults to 0."""
     table = loading.table(name, STRESS_KEYS)
     if table is None or not table.present:
@@ -289,7 +110,7 @@ def _read_stress(loading: _Table, name: str) -> tuple[float, float, float] | Non
     return None if None in (xx, yy, xy) else (xx, yy, xy)
 
 
-def _read_loading(root: _Table, needs_stress: list[str]) -> LoadingSpec | None:
+def _read_loading(root: Table, needs_stress: list[str]) -> LoadingSpec | None:
     """[loading]; ``stress`` is required when an edge carries a traction."""
     table = root.table("loading", ("stress", "initial_stress", "steps"))
     if table is None:
@@ -309,7 +130,7 @@ def _read_loading(root: _Table, needs_stress: list[str]) -> LoadingSpec | None:
     return LoadingSpec(stress=stress, initial_stress=initial_stress, steps=steps)
 
 
-def _read_solver(root: _Table) -> SolverSpec | None:
+def _read_solver(root: Table) -> SolverSpec | None:
     """[solver], validated against SOLVER_OPTIONS."""
     table = root.table("solver", tuple(o.name for o in SOLVER_OPTIONS))
     if table is None:
@@ -333,18 +154,18 @@ def _read_solver(root: _Table) -> SolverSpec | None:
     return SolverSpec(**values)
 
 
-def _read_formats(table: _Table) -> tuple[str, ...] | None:
+def _read_formats(table: Table) -> tuple[str, ...] | None:
     """``output.formats``: a non-empty list of distinct formats including "h5"."""
     value = table.data.get("formats", list(OUTPUT_FORMATS))
     if not isinstance(value, list) or not value:
         table.error(
             "formats",
-            f'expected a non-empty array of formats ("h5", "vtu"), got {_show(value)}',
+            f'expected a non-empty array of formats ("h5", "vtu"), got {show(value)}',
         )
         return None
     key = table.key("formats")
     formats = [
-        _check_choice(v, f"{key}[{i}]", table.problems, OUTPUT_FORMATS)
+        check_choice(v, f"{key}[{i}]", table.problems, OUTPUT_FORMATS)
         for i, v in enumerate(value)
     ]
     if any(f is None for f in formats):
@@ -360,15 +181,15 @@ def _read_formats(table: _Table) -> tuple[str, ...] | None:
     return tuple(formats)
 
 
-def _with_network(root: _Table, grid, folder: Path, fractures):
-    """The inline [[fractures]] followed by those of [network] (case_network)."""
-    network = _read_network(root, grid, folder, fractures or ())
+def _with_network(root: Table, grid, folder: Path, fractures):
+    """The inline [[fractures]] followed by those of [network] (network.py)."""
+    network = read_network(root, grid, folder, fractures or ())
     if fractures is None or network is None:
         return None
     return fractures + network
 
 
-def _read_output(root: _Table, name: str | None) -> OutputSpec | None:
+def _read_output(root: Table, name: str | None) -> OutputSpec | None:
     """[output]: directory (default out/<name>, relative to the cwd) and formats."""
     table = root.table("output", ("directory", "formats"))
     if table is None:
@@ -376,7 +197,7 @@ def _read_output(root: _Table, name: str | None) -> OutputSpec | None:
     directory = table.string("directory", None)
     problem = path_problem(directory) if directory is not None else None
     if problem:
-        table.error("directory", f"{problem}, got {_show(directory)}")
+        table.error("directory", f"{problem}, got {show(directory)}")
         directory = None
     formats = _read_formats(table)
     if formats is None or (
@@ -419,18 +240,18 @@ def loads_case(text: str, path: str | Path = "<string>") -> CaseSpec:
     path = Path(path)
     document = parse_toml(text, path)
     problems: list[tuple[str, str]] = []
-    root = _Table(document, "", problems, TOP_KEYS)
+    root = Table(document, "", problems, TOP_KEYS)
     name = _read_name(root, path)
-    grid = _read_grid(root)
+    grid = read_grid(root)
     material = _read_material(root)
-    fractures = _read_fractures(root, grid)
+    fractures = read_fractures(root, grid)
     fractures = _with_network(root, grid, path.parent, fractures)
-    boundary, needs_stress = _read_boundary(root, grid, path.parent)
+    boundary, needs_stress = read_boundary(root, grid, path.parent)
     loading = _read_loading(root, needs_stress)
     solver = _read_solver(root)
     output = _read_output(root, name)
-    pore_pressure = _read_pore_pressure(root)
-    reservoir = _read_reservoir(root, grid)
+    pore_pressure = read_pore_pressure(root)
+    reservoir = read_reservoir(root, grid)
     if problems:
         raise CaseError(path, problems)
     return CaseSpec(

@@ -1,8 +1,4 @@
-"""Typed reading of TOML tables: value checks, message helpers, ``_Table``.
-
-Private helper of :mod:`xfemslip.case`, which stays the ONLY entry point for
-validating user input (house style: case.py is the only place user input is
-validated); import the public names from ``xfemslip.case``, not from here.
+"""Typed reading of TOML tables: value checks, message helpers, ``Table``.
 
 Each check returns the clean value, or None after recording a
 ``(key path, message)`` problem in the caller's list.
@@ -36,15 +32,15 @@ class Option(NamedTuple):
     allowed: Range | tuple[str, ...]
 
 
-_REQUIRED = object()  # sentinel default: the key must be given
+REQUIRED = object()  # sentinel default: the key must be given
 MAX_SUGGESTIONS = 20  # unknown keys of one table that get a 'did you mean'
 
-_POSITIVE = Range(0.0, lo_open=True)
-_NON_NEGATIVE = Range(0.0)
+POSITIVE = Range(0.0, lo_open=True)
+NON_NEGATIVE = Range(0.0)
 # |x|, |y| of every point of a case [m]: the geometry squares distances, which
 # must stay finite (1e150**2 = 1e300); a kilometre-scale model is at 1e3.
 MAX_COORDINATE = 1e150
-_COORDINATE = Range(-MAX_COORDINATE, MAX_COORDINATE)
+COORDINATE = Range(-MAX_COORDINATE, MAX_COORDINATE)
 
 
 # --------------------------------------------------------------------------- #
@@ -52,7 +48,7 @@ _COORDINATE = Range(-MAX_COORDINATE, MAX_COORDINATE)
 # --------------------------------------------------------------------------- #
 
 
-def _show(value: Any) -> str:
+def show(value: Any) -> str:
     """Type and value of a TOML value, for 'got ...' in messages."""
     if isinstance(value, bool):
         return f"boolean {'true' if value else 'false'}"
@@ -70,17 +66,17 @@ def _show(value: Any) -> str:
     return f"{type(value).__name__} {value}"
 
 
-def _exact(value: float) -> str:
+def exact(value: float) -> str:
     """Shortest text that reads back to the same float (numpy scalars too)."""
     return repr(float(value))
 
 
-def _fmt(value: float) -> str:
+def fmt(value: float) -> str:
     """Short form of a number for messages and summaries."""
     return str(value) if isinstance(value, int) else f"{value:.6g}"
 
 
-def _range_problem(value: float, rule: Range | None, label: str) -> str | None:
+def range_problem(value: float, rule: Range | None, label: str) -> str | None:
     """Message if ``value`` is outside ``rule``, else None."""
     if rule is None:
         return None
@@ -94,20 +90,20 @@ def _range_problem(value: float, rule: Range | None, label: str) -> str | None:
         return None
     lo_op, hi_op = ("<" if rule.lo_open else "<="), ("<" if rule.hi_open else "<=")
     if rule.hi is None:
-        text = f"must be {'>' if rule.lo_open else '>='} {_fmt(rule.lo)}"
+        text = f"must be {'>' if rule.lo_open else '>='} {fmt(rule.lo)}"
     elif rule.lo is None:
-        text = f"must be {hi_op} {_fmt(rule.hi)}"
+        text = f"must be {hi_op} {fmt(rule.hi)}"
     else:
-        text = f"must satisfy {_fmt(rule.lo)} {lo_op} {label} {hi_op} {_fmt(rule.hi)}"
+        text = f"must satisfy {fmt(rule.lo)} {lo_op} {label} {hi_op} {fmt(rule.hi)}"
     return f"{text}, got {value!r}"
 
 
-def _check_number(
+def check_number(
     value: Any, key: str, problems: list, rule: Range | None = None, label: str = ""
 ) -> float | None:
     """A finite float (TOML integers accepted, booleans not) within ``rule``."""
     if isinstance(value, bool) or not isinstance(value, int | float):
-        problems.append((key, f"expected a number, got {_show(value)}"))
+        problems.append((key, f"expected a number, got {show(value)}"))
         return None
     try:
         number = float(value)
@@ -116,28 +112,28 @@ def _check_number(
     if not math.isfinite(number):
         problems.append((key, f"must be finite, got {number!r}"))
         return None
-    message = _range_problem(number, rule, label or key.rsplit(".", 1)[-1])
+    message = range_problem(number, rule, label or key.rsplit(".", 1)[-1])
     if message:
         problems.append((key, message))
         return None
     return number
 
 
-def _check_integer(
+def check_integer(
     value: Any, key: str, problems: list, rule: Range | None = None, label: str = ""
 ) -> int | None:
     """A TOML integer (not a float, not a boolean) within ``rule``."""
     if isinstance(value, bool) or not isinstance(value, int):
-        problems.append((key, f"expected an integer, got {_show(value)}"))
+        problems.append((key, f"expected an integer, got {show(value)}"))
         return None
-    message = _range_problem(value, rule, label or key.rsplit(".", 1)[-1])
+    message = range_problem(value, rule, label or key.rsplit(".", 1)[-1])
     if message:
         problems.append((key, message))
         return None
     return value
 
 
-def _suggest(word: str, allowed: tuple[str, ...]) -> str:
+def suggest(word: str, allowed: tuple[str, ...]) -> str:
     """'; did you mean ...?' or the list of allowed words (pypa/build _find_typo)."""
     close = difflib.get_close_matches(word, allowed, n=1)
     if close:
@@ -145,13 +141,13 @@ def _suggest(word: str, allowed: tuple[str, ...]) -> str:
     return "; allowed: " + ", ".join(allowed)
 
 
-def _check_choice(
+def check_choice(
     value: Any, key: str, problems: list, choices: tuple[str, ...]
 ) -> str | None:
     """One of the strings ``choices``."""
     if not isinstance(value, str):
         allowed = ", ".join(f'"{c}"' for c in choices)
-        problems.append((key, f"expected one of {allowed}, got {_show(value)}"))
+        problems.append((key, f"expected one of {allowed}, got {show(value)}"))
         return None
     if value not in choices:
         allowed = ", ".join(f'"{c}"' for c in choices)
@@ -162,23 +158,23 @@ def _check_choice(
     return value
 
 
-def _check_vector(value: Any, key: str, problems: list, n: int, check) -> tuple | None:
+def check_vector(value: Any, key: str, problems: list, n: int, check) -> tuple | None:
     """An array of exactly ``n`` items, each passed through ``check(item, key)``."""
     if not isinstance(value, list) or len(value) != n:
-        problems.append((key, f"expected an array of {n} numbers, got {_show(value)}"))
+        problems.append((key, f"expected an array of {n} numbers, got {show(value)}"))
         return None
     items = [check(item, f"{key}[{i}]") for i, item in enumerate(value)]
     return None if any(item is None for item in items) else tuple(items)
 
 
-def _frozen(values) -> np.ndarray:
+def frozen(values) -> np.ndarray:
     """A read-only float64 copy (specs are immutable, arrays included)."""
     array = np.array(values, dtype=np.float64)
     array.setflags(write=False)
     return array
 
 
-class _Table:
+class Table:
     """Typed access to one TOML table; records every problem with its key path."""
 
     def __init__(
@@ -198,7 +194,7 @@ class _Table:
         for k, name in enumerate(unknown):
             # a suggestion for the first few; thousands of unknown keys are
             # a wrong file, and difflib on each would take seconds
-            hint = _suggest(name, allowed) if k < MAX_SUGGESTIONS else ""
+            hint = suggest(name, allowed) if k < MAX_SUGGESTIONS else ""
             self.error(name, f"unknown key {name!r}{where}{hint}")
 
     def key(self, name: str | None) -> str:
@@ -219,68 +215,68 @@ class _Table:
         """(found, value); a missing required key is recorded."""
         if name in self.data:
             return True, self.data[name]
-        if default is _REQUIRED:
+        if default is REQUIRED:
             self.error(name, "required key missing" + hint)
             return False, None
         return False, default
 
-    def number(self, name, default=_REQUIRED, rule=None, hint=""):
+    def number(self, name, default=REQUIRED, rule=None, hint=""):
         """A finite number (float) within ``rule``."""
         found, value = self._get(name, default, hint)
         if not found:
             return value
-        return _check_number(value, self.key(name), self.problems, rule)
+        return check_number(value, self.key(name), self.problems, rule)
 
-    def integer(self, name, default=_REQUIRED, rule=None):
+    def integer(self, name, default=REQUIRED, rule=None):
         """An integer within ``rule``."""
         found, value = self._get(name, default)
         if not found:
             return value
-        return _check_integer(value, self.key(name), self.problems, rule)
+        return check_integer(value, self.key(name), self.problems, rule)
 
-    def choice(self, name, choices, default=_REQUIRED):
+    def choice(self, name, choices, default=REQUIRED):
         """One of the strings ``choices``."""
         found, value = self._get(name, default)
         if not found:
             return value
-        return _check_choice(value, self.key(name), self.problems, choices)
+        return check_choice(value, self.key(name), self.problems, choices)
 
-    def boolean(self, name, default=_REQUIRED):
+    def boolean(self, name, default=REQUIRED):
         """true or false."""
         found, value = self._get(name, default)
         if found and not isinstance(value, bool):
-            self.error(name, f"expected true or false, got {_show(value)}")
+            self.error(name, f"expected true or false, got {show(value)}")
             return None
         return value
 
-    def string(self, name, default=_REQUIRED):
+    def string(self, name, default=REQUIRED):
         """A non-empty string."""
         found, value = self._get(name, default)
         if found and (not isinstance(value, str) or not value.strip()):
-            self.error(name, f"expected a non-empty string, got {_show(value)}")
+            self.error(name, f"expected a non-empty string, got {show(value)}")
             return None
         return value
 
-    def numbers(self, name, n, default=_REQUIRED, rule=None, hint=""):
+    def numbers(self, name, n, default=REQUIRED, rule=None, hint=""):
         """A fixed-length array of finite numbers, e.g. ``size = [1.0, 1.0]``."""
         found, value = self._get(name, default, hint)
         if not found:
             return value
 
         def check(item, key):
-            return _check_number(item, key, self.problems, rule)
+            return check_number(item, key, self.problems, rule)
 
-        return _check_vector(value, self.key(name), self.problems, n, check)
+        return check_vector(value, self.key(name), self.problems, n, check)
 
-    def table(self, name, allowed, required=False) -> _Table | None:
+    def table(self, name, allowed, required=False) -> Table | None:
         """Sub-table reader; an absent optional table reads as empty."""
         if name not in self.data:
             if required:
                 self.error(name, "required key missing")
                 return None
-            return _Table({}, self.key(name), self.problems, present=False)
+            return Table({}, self.key(name), self.problems, present=False)
         value = self.data[name]
         if not isinstance(value, dict):
-            self.error(name, f"expected a table, got {_show(value)}")
+            self.error(name, f"expected a table, got {show(value)}")
             return None
-        return _Table(value, self.key(name), self.problems, allowed)
+        return Table(value, self.key(name), self.problems, allowed)

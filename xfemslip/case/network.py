@@ -1,10 +1,6 @@
 """``[network]``: many fractures from a CSV file of segments and/or a random
 network (``[network.generate]``) -> more ``FractureSpec`` entries.
 
-Private helper of :mod:`xfemslip.case`, which stays the ONLY entry point for
-validating user input (house style: case.py is the only place user input is
-validated); import the public names from ``xfemslip.case``, not from here.
-
 Numbering (``FractureSpec.index``, ``/fractures/<i>`` of result.h5): the
 inline ``[[fractures]]`` first, in file order; then the fractures of
 ``network.file`` in the order of their first row; then the generated ones in
@@ -18,17 +14,17 @@ from pathlib import Path
 
 import numpy as np
 
-from xfemslip.case_fractures import _read_tip
-from xfemslip.case_generate import GENERATE_KEYS, _read_generate, _realize
-from xfemslip.case_grid import _Grid
-from xfemslip.case_segments import PROPERTY_RULES, _read_segments_file
-from xfemslip.case_specs import FractureSpec
-from xfemslip.case_tables import _frozen, _Table
+from xfemslip.case.fractures import read_tip
+from xfemslip.case.generate import GENERATE_KEYS, read_generate, realize
+from xfemslip.case.grid import Grid
+from xfemslip.case.segments import PROPERTY_RULES, read_segments_file
+from xfemslip.case.specs import FractureSpec
+from xfemslip.case.tables import Table, frozen
 
 NETWORK_KEYS = ("file", "generate", "friction", "cohesion", "kn", "kt", "tip")
 
 
-def network_table(root: _Table) -> _Table | None:
+def network_table(root: Table) -> Table | None:
     """The [network] table reader (None if not a table)."""
     return root.table("network", NETWORK_KEYS)
 
@@ -39,8 +35,8 @@ def _segments_of(polylines) -> np.ndarray:
     return np.concatenate(parts) if parts else np.zeros((0, 2, 2))
 
 
-def _read_network(
-    root: _Table, grid: _Grid | None, folder: Path, inline: tuple
+def read_network(
+    root: Table, grid: Grid | None, folder: Path, inline: tuple
 ) -> tuple[FractureSpec, ...] | None:
     """``[network]``: the CSV file's fractures, then the generated ones,
     numbered after the ``inline`` [[fractures]] (which, with the file's,
@@ -55,15 +51,15 @@ def _read_network(
     defaults = {
         name: table.number(name, None, rule) for name, rule in PROPERTY_RULES.items()
     }
-    tip, radius = _read_tip(table)
+    tip, radius = read_tip(table)
     if not table.has("file") and not table.has("generate"):
         table.error(None, 'expected file = "segments.csv" and/or a generate table')
     found: list[tuple[np.ndarray, dict, str]] = []
     if table.has("file"):
-        found += _read_segments_file(table, grid, folder, defaults) or []
+        found += read_segments_file(table, grid, folder, defaults) or []
     if table.has("generate"):
         gen = table.table("generate", GENERATE_KEYS)
-        params = _read_generate(gen) if gen is not None else None
+        params = read_generate(gen) if gen is not None else None
         if (
             params is not None
             and defaults["friction"] is None
@@ -75,7 +71,7 @@ def _read_network(
             )
         if params is not None and grid is not None and len(table.problems) == start:
             others = [f.points for f in inline] + [p for p, _, _ in found]
-            network = _realize(gen, params, grid, _segments_of(others))
+            network = realize(gen, params, grid, _segments_of(others))
             for k, seg in enumerate(network.segments if network is not None else ()):
                 found.append(
                     (
@@ -89,7 +85,7 @@ def _read_network(
     return tuple(
         FractureSpec(
             index=first_index + k,
-            points=_frozen(points),
+            points=frozen(points),
             friction=props["friction"],
             cohesion=props["cohesion"] if props["cohesion"] is not None else 0.0,
             kn=props["kn"],

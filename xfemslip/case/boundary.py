@@ -1,30 +1,28 @@
-"""Boundary CSV files (``{ file = "edge.csv" }``): read the rows, check that the
-points lie on the edge, interpolate the values to the edge's nodes.
-
-Private helper of :mod:`xfemslip.case`, which stays the ONLY entry point for
-validating user input (house style: case.py is the only place user input is
-validated); import the public names from ``xfemslip.case``, not from here.
+"""``[boundary]`` -> ``BoundarySpec``: one ``EdgeSpec`` per edge, from a word
+(``"traction"``, ``"free"``), a table of components or a CSV file of
+``x,y,ux,uy`` rows (the points must lie on the edge; the values are
+interpolated to the edge's nodes).
 """
 
 from __future__ import annotations
 
+import difflib
 import math
 from pathlib import Path
 from typing import NamedTuple
 
 import numpy as np
 
-from xfemslip.case_files import MAX_CSV_BYTES, UnreadableInput, read_input
-from xfemslip.case_grid import _Grid
-from xfemslip.case_specs import EdgeSpec
-from xfemslip.case_tables import _exact, _frozen, _Table
+from xfemslip.case.files import CSV_TOLERANCE, add_capped, csv_lines, quote
+from xfemslip.case.grid import Grid
+from xfemslip.case.specs import EDGES, BoundarySpec, EdgeSpec
+from xfemslip.case.tables import Table, exact, frozen, show
+
+EDGE_KEYS = ("ux", "uy", "traction", "file")
+EDGE_WORDS = ("traction", "free")
+
 
 CSV_HEADER = ("x", "y", "ux", "uy")
-# CSV points count as on an edge / at its ends within this fraction of the
-# largest domain size (rounding of coordinates printed by another program).
-CSV_TOLERANCE = 1e-9
-# At most this many row problems are listed per CSV file (then a count).
-MAX_CSV_PROBLEMS = 10
 
 
 class _EdgeFrame(NamedTuple):
@@ -35,7 +33,7 @@ class _EdgeFrame(NamedTuple):
     nodes: np.ndarray  # node coordinates along the edge, increasing [m]
 
 
-def _edge_frame(edge: str, grid: _Grid) -> _EdgeFrame:
+def _edge_frame(edge: str, grid: Grid) -> _EdgeFrame:
     """Geometry of one edge of the rectilinear mesh."""
     x, y = grid.mesh.x, grid.mesh.y
     return {
@@ -50,45 +48,27 @@ def _csv_row(line: str) -> list[float] | str:
     """Four finite numbers of one CSV row, or what is wrong with it."""
     fields = line.split(",")
     if len(fields) != 4:
-        return f"expected 4 values x,y,ux,uy, got {len(fields)}: {_quote(line)}"
+        return f"expected 4 values x,y,ux,uy, got {len(fields)}: {quote(line)}"
     row = []
     for name, text in zip(CSV_HEADER, fields, strict=True):
         try:
             value = float(text)
         except ValueError:
-            return f"{name} is not a number: {_quote(text)}"
+            return f"{name} is not a number: {quote(text)}"
         if not math.isfinite(value):
-            return f"{name} must be finite, got {_quote(text)}"
+            return f"{name} must be finite, got {quote(text)}"
         row.append(value)
     return row
 
 
-def _csv_lines(file: Path, key: str, problems: list) -> list[str] | None:
-    """The lines of a CSV input file (read with the MAX_CSV_BYTES cap), or
-    None after recording why it cannot be read."""
-    try:
-        return read_input(file, MAX_CSV_BYTES).splitlines()
-    except UnreadableInput as exc:
-        problems.append((key, f"cannot read {file}: {exc}"))
-        return None
-
-
-def _quote(text: str, limit: int = 60) -> str:
-    """``repr`` of a CSV line or field for a message, cut to ``limit`` chars."""
-    text = text.strip()
-    if len(text) <= limit:
-        return repr(text)
-    return f"{text[:limit]!r}... ({len(text)} characters)"
-
-
 def _read_csv(file: Path, key: str, problems: list) -> tuple[np.ndarray, list] | None:
     """Rows (m, 4) ``[x, y, ux, uy]`` of a boundary CSV file and their line numbers."""
-    lines = _csv_lines(file, key, problems)
+    lines = csv_lines(file, key, problems)
     if lines is None:
         return None
     header = tuple(c.strip().lower() for c in lines[0].split(",")) if lines else ()
     if header != CSV_HEADER:
-        got = _quote(lines[0]) if lines else "an empty file"
+        got = quote(lines[0]) if lines else "an empty file"
         problems.append((key, f"{file} line 1: header must be x,y,ux,uy, got {got}"))
         return None
     rows, numbers, bad = [], [], []
@@ -101,17 +81,10 @@ def _read_csv(file: Path, key: str, problems: list) -> tuple[np.ndarray, list] |
         else:
             rows.append(row)
             numbers.append(number)
-    _add_capped(problems, key, bad)
+    add_capped(problems, key, bad)
     if bad:
         return None
     return np.array(rows, dtype=np.float64).reshape(-1, 4), numbers
-
-
-def _add_capped(problems: list, key: str, messages: list[str]) -> None:
-    """Record at most MAX_CSV_PROBLEMS messages, then how many were left out."""
-    problems.extend((key, m) for m in messages[:MAX_CSV_PROBLEMS])
-    if len(messages) > MAX_CSV_PROBLEMS:
-        problems.append((key, f"... and {len(messages) - MAX_CSV_PROBLEMS} more rows"))
 
 
 def _csv_points_on_edge(rows, numbers, frame, edge, file, tol) -> list[str]:
@@ -122,15 +95,15 @@ def _csv_points_on_edge(rows, numbers, frame, edge, file, tol) -> list[str]:
     bad = []
     for (x, y, _, _), number in zip(rows, numbers, strict=True):
         s, t = (x, y) if frame.along == 0 else (y, x)
-        where = f"{file} line {number}: point ({_exact(x)}, {_exact(y)})"
+        where = f"{file} line {number}: point ({exact(x)}, {exact(y)})"
         if abs(t - frame.at) > tol:
             bad.append(
-                f"{where} is not on the {edge} edge ({across} = {_exact(frame.at)})"
+                f"{where} is not on the {edge} edge ({across} = {exact(frame.at)})"
             )
         elif s < lo - tol or s > hi + tol:
             bad.append(
                 f"{where} lies beyond the {edge} edge "
-                f"({axis} in [{_exact(lo)}, {_exact(hi)}])"
+                f"({axis} in [{exact(lo)}, {exact(hi)}])"
             )
     return bad
 
@@ -143,7 +116,7 @@ def _csv_edge_values(rows, numbers, frame, edge, file, tol) -> np.ndarray | str:
     close = np.flatnonzero(np.diff(s) <= tol)
     for i in close:
         if np.any(values[i] != values[i + 1]):
-            first, second = (", ".join(map(_exact, v)) for v in values[i : i + 2])
+            first, second = (", ".join(map(exact, v)) for v in values[i : i + 2])
             return (
                 f"{file} lines {numbers[i]} and {numbers[i + 1]}: the same point "
                 f"with different values (ux, uy) = ({first}) and ({second})"
@@ -157,8 +130,8 @@ def _csv_edge_values(rows, numbers, frame, edge, file, tol) -> np.ndarray | str:
     if s[0] > lo + tol or s[-1] < hi - tol:
         axis = "xy"[frame.along]
         return (
-            f"{file}: points cover {axis} in [{_exact(s[0])}, {_exact(s[-1])}] but "
-            f"the {edge} edge spans [{_exact(lo)}, {_exact(hi)}]; the file must "
+            f"{file}: points cover {axis} in [{exact(s[0])}, {exact(s[-1])}] but "
+            f"the {edge} edge spans [{exact(lo)}, {exact(hi)}]; the file must "
             "cover the edge end to end"
         )
     return np.column_stack(
@@ -169,7 +142,7 @@ def _csv_edge_values(rows, numbers, frame, edge, file, tol) -> np.ndarray | str:
     )
 
 
-def _edge_from_csv(table: _Table, edge: str, grid: _Grid | None, folder: Path):
+def _edge_from_csv(table: Table, edge: str, grid: Grid | None, folder: Path):
     """``{ file = "edge.csv" }``: both components at every node, from the file."""
     for other in ("ux", "uy", "traction"):
         if table.has(other):
@@ -190,11 +163,92 @@ def _edge_from_csv(table: _Table, edge: str, grid: _Grid | None, folder: Path):
     frame = _edge_frame(edge, grid)
     tol = CSV_TOLERANCE * max(grid.size)
     bad = _csv_points_on_edge(rows, numbers, frame, edge, file, tol)
-    _add_capped(table.problems, key, bad)
+    add_capped(table.problems, key, bad)
     if bad:
         return None
     values = _csv_edge_values(rows, numbers, frame, edge, file, tol)
     if isinstance(values, str):
         table.error("file", values)
         return None
-    return EdgeSpec(kind="displacement", values=_frozen(values), source=str(file))
+    return EdgeSpec(kind="displacement", values=frozen(values), source=str(file))
+
+
+def _edge_from_table(table: Table, edge: str, grid: Grid | None):
+    """``{ ux = .., uy = .., traction = .. }``: prescribed components."""
+    start = len(table.problems)
+    ux, uy = table.number("ux", None), table.number("uy", None)
+    traction = table.boolean("traction", False)
+    given = [c for c in ("ux", "uy") if table.has(c)]
+    if not given:
+        table.error(
+            None,
+            'prescribes nothing: give ux and/or uy, or file = "..."; '
+            'for no constraint write "free" or "traction"',
+        )
+        return None
+    if traction and len(given) == 2:
+        table.error(
+            "traction",
+            "traction = true needs a free component, but ux and uy are both prescribed",
+        )
+        return None
+    if len(table.problems) > start or grid is None:
+        return None
+    values = np.full((_edge_frame(edge, grid).nodes.size, 2), np.nan)  # NaN: free
+    for component, value in enumerate((ux, uy)):
+        if value is not None:
+            values[:, component] = value
+    return EdgeSpec(
+        kind="displacement", values=frozen(values), traction=traction, source="table"
+    )
+
+
+def _read_edge(boundary: Table, edge: str, grid: Grid | None, folder: Path):
+    """One edge entry -> EdgeSpec (None after recording a problem)."""
+    if not boundary.has(edge):
+        return EdgeSpec(kind="free", source="default")
+    value = boundary.data[edge]
+    if isinstance(value, str) and value in EDGE_WORDS:
+        return EdgeSpec(kind=value)
+    if not isinstance(value, dict):
+        close = (
+            difflib.get_close_matches(value, EDGE_WORDS, n=1)
+            if isinstance(value, str)
+            else []
+        )
+        hint = f"; did you mean {close[0]!r}?" if close else ""
+        boundary.error(
+            edge,
+            f'must be "traction", "free", a table such as '
+            f'{{ ux = 0.0, uy = 0.0 }} or {{ file = "{edge}.csv" }}, '
+            f"got {show(value)}{hint}",
+        )
+        return None
+    table = boundary.table(edge, EDGE_KEYS)
+    if table.has("file"):
+        return _edge_from_csv(table, edge, grid, folder)
+    return _edge_from_table(table, edge, grid)
+
+
+def read_boundary(root: Table, grid: Grid | None, folder: Path):
+    """[boundary] -> (BoundarySpec or None, edges that need loading.stress)."""
+    table = root.table("boundary", EDGES, required=True)
+    if table is None:
+        return None, []
+    edges = {edge: _read_edge(table, edge, grid, folder) for edge in EDGES}
+    needs_stress = [
+        e
+        for e in EDGES
+        if edges[e] is not None and (edges[e].kind == "traction" or edges[e].traction)
+    ]
+    if any(spec is None for spec in edges.values()):
+        return None, needs_stress
+    if not any(spec.kind == "displacement" for spec in edges.values()):
+        table.error(
+            None,
+            "no displacement is prescribed on any edge: the body can move "
+            "freely; prescribe at least one component (e.g. bottom = "
+            "{ uy = 0.0 })",
+        )
+        return None, needs_stress
+    return BoundarySpec(**edges), needs_stress

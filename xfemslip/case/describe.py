@@ -1,9 +1,4 @@
-"""``describe``: the resolved SI summary of a case printed by ``xfemslip check``.
-
-Private helper of :mod:`xfemslip.case`, which stays the ONLY entry point for
-validating user input (house style: case.py is the only place user input is
-validated); import the public names from ``xfemslip.case``, not from here.
-"""
+"""``describe``: the resolved SI summary of a case printed by ``xfemslip check``."""
 
 from __future__ import annotations
 
@@ -12,7 +7,8 @@ from typing import Any
 
 import numpy as np
 
-from xfemslip.case_specs import (
+from xfemslip.case.options import SOLVER_OPTIONS
+from xfemslip.case.specs import (
     AUTO_PENALTY,
     EDGES,
     CaseSpec,
@@ -23,13 +19,13 @@ from xfemslip.case_specs import (
     MeshSpec,
     SolverSpec,
 )
-from xfemslip.case_tables import _fmt
+from xfemslip.case.tables import fmt
 from xfemslip.screen import coulomb_margin, plane_stresses
 
 
 def _with_unit(value: Any, unit: str) -> str:
     """``5e+09 Pa``; no unit for dimensionless ("-") or unitless ("") values."""
-    text = _fmt(value) if isinstance(value, int | float) else str(value)
+    text = fmt(value) if isinstance(value, int | float) else str(value)
     return f"{text} {unit}" if unit not in ("", "-") else text
 
 
@@ -40,7 +36,7 @@ def _describe_axis(coords: np.ndarray, label: str) -> str:
     if np.ptp(h) <= 1e-9 * h.max():
         return f"d{label} = {_with_unit(float(h[0]), unit)} (uniform)"
     return (
-        f"d{label} = {_fmt(float(h.min()))} .. {_with_unit(float(h.max()), unit)} "
+        f"d{label} = {fmt(float(h.min()))} .. {_with_unit(float(h.max()), unit)} "
         "(graded)"
     )
 
@@ -50,13 +46,13 @@ def _describe_network_fracture(spec: FractureSpec) -> list[str]:
     p, units = spec.points, FractureSpec.UNITS
     length = float(np.hypot(*np.diff(p, axis=0).T).sum())
     params = ", ".join(
-        f"{k} {_fmt(getattr(spec, k))}" if getattr(spec, k) is not None else f"{k} auto"
+        f"{k} {fmt(getattr(spec, k))}" if getattr(spec, k) is not None else f"{k} auto"
         for k in ("friction", "cohesion", "kn", "kt")
     )
     ends = (
-        f"({_fmt(float(p[0, 0]))}, {_fmt(float(p[0, 1]))}) -> "
+        f"({fmt(float(p[0, 0]))}, {fmt(float(p[0, 1]))}) -> "
         + (f"{len(p) - 2} more -> " if len(p) > 2 else "")
-        + f"({_fmt(float(p[-1, 0]))}, {_fmt(float(p[-1, 1]))})"
+        + f"({fmt(float(p[-1, 0]))}, {fmt(float(p[-1, 1]))})"
     )
     return [
         f"  [{spec.index}] {ends}, length {_with_unit(length, units['points'])}; "
@@ -72,11 +68,11 @@ def _describe_fracture(spec: FractureSpec) -> list[str]:
     seg = np.diff(p, axis=0)
     angles = np.degrees(np.arctan2(seg[:, 1], seg[:, 0]))
     units = FractureSpec.UNITS
-    points = " -> ".join(f"({_fmt(float(x))}, {_fmt(float(y))})" for x, y in p)
+    points = " -> ".join(f"({fmt(float(x))}, {fmt(float(y))})" for x, y in p)
     params = ", ".join(
         f"{k} = {_with_unit(getattr(spec, k), units[k])}"
         if getattr(spec, k) is not None
-        else f"{k} = {_fmt(AUTO_PENALTY)} E/h (automatic)"
+        else f"{k} = {fmt(AUTO_PENALTY)} E/h (automatic)"
         for k in ("friction", "cohesion", "kn", "kt")
     )
     tip = spec.tip + (
@@ -91,7 +87,7 @@ def _describe_fracture(spec: FractureSpec) -> list[str]:
     return [
         f"  [{spec.index}] points [{units['points']}]: {points}",
         f"      length {_with_unit(float(np.hypot(*seg.T).sum()), units['points'])}, "
-        f"angle {', '.join(_fmt(float(a)) for a in angles)} deg",
+        f"angle {', '.join(fmt(float(a)) for a in angles)} deg",
         f"      {params}",
         f"      tip: {tip}",
     ]
@@ -126,10 +122,10 @@ def _margin_text(spec: CaseSpec, fracture: FractureSpec) -> str:
         return ""
     if sigma_n > 0.0:
         return (
-            f"in-situ: in tension across it (sigma_n' = {_fmt(sigma_n / 1e6)} MPa): "
+            f"in-situ: in tension across it (sigma_n' = {fmt(sigma_n / 1e6)} MPa): "
             "it opens in load step 1"
         )
-    text = f"in-situ Coulomb margin {_fmt(margin / 1e6)} MPa"
+    text = f"in-situ Coulomb margin {fmt(margin / 1e6)} MPa"
     if margin < 0.0:
         return text + (
             " (shear above the friction limit: the excess is released and the "
@@ -157,7 +153,7 @@ def _describe_edge(name: str, edge: EdgeSpec) -> str:
             )
         else:
             parts.append(
-                f"{label} = {_fmt(float(column.min()))} .. "
+                f"{label} = {fmt(float(column.min()))} .. "
                 f"{_with_unit(float(column.max()), EdgeSpec.UNITS['values'])}"
             )
     return (
@@ -170,7 +166,7 @@ def _describe_stress(stress: tuple[float, float, float] | None) -> str:
     """``(xx, yy, xy) = (...) Pa`` or none."""
     if stress is None:
         return "none"
-    values = ", ".join(_fmt(v) for v in stress)
+    values = ", ".join(fmt(v) for v in stress)
     return f"(xx, yy, xy) = ({values}) {LoadingSpec.UNITS['stress']}"
 
 
@@ -181,9 +177,9 @@ def _describe_pore(spec: CaseSpec) -> list[str]:
     if p is not None:
         where = "the reservoir" if p.region == "reservoir" else "the whole model"
         lines.append(
-            f"pore pressure: initial {_fmt(p.initial)} Pa, change {_fmt(p.change)} Pa "
+            f"pore pressure: initial {fmt(p.initial)} Pa, change {fmt(p.change)} Pa "
             f"over the load steps (< 0 = depletion), Biot coefficient "
-            f"{_fmt(p.biot)}, acting in {where}; "
+            f"{fmt(p.biot)}, acting in {where}; "
             "effective stress in the bulk (Biot) and on the fractures (Terzaghi)"
         )
     r = spec.reservoir
@@ -191,10 +187,10 @@ def _describe_pore(spec: CaseSpec) -> list[str]:
         rows = r.boxes if r.polygon is None else r.polygon
         where = "box(es)" if r.polygon is None else "polygon"
         shapes = "; ".join(
-            "[" + ", ".join(_fmt(float(v)) for v in b) + "]" for b in rows
+            "[" + ", ".join(fmt(float(v)) for v in b) + "]" for b in rows
         )
         lines.append(
-            f"reservoir: E = {_fmt(r.E)} Pa, nu = {_fmt(r.nu)} in {where} "
+            f"reservoir: E = {fmt(r.E)} Pa, nu = {fmt(r.nu)} in {where} "
             f"{shapes} m (cells whose centre is inside); [material] is the host rock"
         )
     return lines
@@ -219,18 +215,17 @@ def describe(spec: CaseSpec) -> str:
     material, fractures, loading, every edge's condition (edges not given in the
     file are reported as free), solver options (from SOLVER_OPTIONS) and output.
     """
-    from xfemslip.case import SOLVER_OPTIONS  # lazy: case.py imports this module
 
     (x0, y0), (w, h) = spec.origin, spec.size
     nx, ny = spec.mesh.x.size - 1, spec.mesh.y.size - 1
     m = spec.material
     lines = [
         f"case {spec.name!r} ({spec.path})",
-        f"domain: [{_fmt(x0)}, {_fmt(x0 + w)}] x [{_fmt(y0)}, {_fmt(y0 + h)}] m "
-        f"(size {_fmt(w)} x {_fmt(h)} m)",
+        f"domain: [{fmt(x0)}, {fmt(x0 + w)}] x [{fmt(y0)}, {fmt(y0 + h)}] m "
+        f"(size {fmt(w)} x {fmt(h)} m)",
         f"mesh: {nx} x {ny} Q4 elements, {(nx + 1) * (ny + 1)} nodes; "
         f"{_describe_axis(spec.mesh.x, 'x')}; {_describe_axis(spec.mesh.y, 'y')}",
-        f"material: E = {_with_unit(m.E, MaterialSpec.UNITS['E'])}, nu = {_fmt(m.nu)}, "
+        f"material: E = {_with_unit(m.E, MaterialSpec.UNITS['E'])}, nu = {fmt(m.nu)}, "
         f"{m.model}",
         f"fractures: {len(spec.fractures)}{_network_count(spec)}",
     ]
