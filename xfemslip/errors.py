@@ -1,7 +1,7 @@
 """Exceptions of xfemslip.
 
-Library code raises these; only ``cli.py`` turns them into messages and exit
-codes (``CaseError`` and ``UsageError`` -> exit 2, the others -> exit 1).
+Library code raises these; only :mod:`xfemslip.cli` turns them into messages
+and exit codes (``CaseError`` and ``UsageError`` -> exit 2, the others -> exit 1).
 """
 
 from __future__ import annotations

@@ -255,7 +255,7 @@ def available_bytes() -> tuple[float, str]:
     """The memory limit [B] and where it comes from."""
     text = os.environ.get(ENV_LIMIT, "").strip()
     if text:
-        value = _parse_bytes(text)
+        value = parse_bytes(text)
         if value is None:
             raise UsageError(
                 f"environment variable {ENV_LIMIT} = {text!r}: expected a number of "
@@ -271,7 +271,7 @@ def available_bytes() -> tuple[float, str]:
         return math.inf, "unknown"
 
 
-def _parse_bytes(text: str) -> float | None:
+def parse_bytes(text: str) -> float | None:
     number, suffix = text, ""
     if text[-1:].lower() in "kmgt" and text[-1:].isalpha():
         number, suffix = text[:-1], text[-1].lower()

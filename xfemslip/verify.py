@@ -520,38 +520,3 @@ def run_verification(
             else []
         )
     return Report(rows=rows, window=sweep, failures=check_targets(rows, sweep), tip=tip)
-
-
-def main(*, quick=False, tip=None, plot=None, csv_path=None, penalty="100") -> bool:
-    """``xfemslip verify``: run, print the table; True when every target is met."""
-    import click
-
-    from xfemslip.case.fractures import TIP_KINDS
-    from xfemslip.errors import UsageError
-
-    if plot is not None and Path(plot).suffix.lower() not in (".png", ".pdf"):
-        raise UsageError(f"--plot {plot}: expected a .png or .pdf file name")
-    if tip is not None and tip not in TIP_KINDS:
-        raise UsageError(f"--tip {tip}: expected one of {', '.join(TIP_KINDS)}")
-    if penalty == "auto":
-        ratio = None
-    else:
-        try:
-            ratio = float(penalty)
-        except ValueError:
-            ratio = -1.0
-        if not ratio > 0.0:
-            raise UsageError(
-                f"--penalty {penalty}: expected a positive number (kn h / E) or auto"
-            )
-    start = time.perf_counter()
-
-    def progress(msg):
-        click.echo(f"[{time.perf_counter() - start:6.1f} s] {msg}", err=True)
-
-    report = run_verification(quick=quick, tip=tip, penalty=ratio, progress=progress)
-    from xfemslip.verify_output import format_table, write_outputs
-
-    click.echo(format_table(report))
-    write_outputs(report, csv_path, plot)
-    return not report.failures

@@ -1,4 +1,4 @@
-"""Command ``xfemslip deplete`` (registered in :mod:`xfemslip.cli`).
+"""Command ``xfemslip deplete``.
 
 Parses arguments and prints; the work is in :mod:`xfemslip.depletion`.
 """
@@ -7,23 +7,23 @@ from __future__ import annotations
 
 import click
 
-from xfemslip.cli import (
-    _case_argument,
-    _configure_logging,
-    _debug_option,
-    _FiniteFloat,
-    _load,
-    _reported_errors,
-    _solve_options,
+from xfemslip.cli.common import (
+    FiniteFloat,
+    case_argument,
+    configure_logging,
+    debug_option,
+    load_case_file,
+    reported_errors,
+    solve_options,
 )
 
 
 @click.command()
-@_case_argument
-@_solve_options
+@case_argument
+@solve_options
 @click.option(
     "--tolerance",
-    type=_FiniteFloat(min=0.0, min_open=True),
+    type=FiniteFloat(min=0.0, min_open=True),
     default=None,
     help="Bisection tolerance on the critical pore-pressure change [Pa] "
     "[default: 0.1 % of |pore_pressure.change|; a value below |change| x "
@@ -34,14 +34,14 @@ from xfemslip.cli import (
     is_flag=True,
     help="Also draw slip_vs_depletion.png and depletion_field.png.",
 )
-@_debug_option
+@debug_option
 def deplete(case, output, tolerance, plot, overwrite, verbose, quiet, debug) -> None:
     """Critical depletion of every fracture of CASE: the pore-pressure change
     at which it first slips (bisection on the load), and slip vs depletion
     (result.h5, critical_depletion.csv, slip_vs_depletion.csv)."""
-    with _reported_errors(debug):
-        _configure_logging(verbose, quiet)
-        spec = _load(case)
+    with reported_errors(debug):
+        configure_logging(verbose, quiet)
+        spec = load_case_file(case)
         from xfemslip.depletion import deplete as run_deplete
         from xfemslip.depletion import format_report
 

@@ -1,5 +1,5 @@
 """The environment variables xfemslip and Numba read, checked before a command
-runs (called from :mod:`xfemslip.cli`).
+runs (by the command group of :mod:`xfemslip.cli`).
 
 Numba parses its variables when it is first imported: ``NUMBA_NUM_THREADS=0``
 then raises ``ValueError`` from inside ``import numba``, and a value it cannot
@@ -15,6 +15,7 @@ from __future__ import annotations
 import os
 
 from xfemslip.errors import UsageError
+from xfemslip.memory import parse_bytes
 
 
 def _positive_int(text: str) -> bool:
@@ -33,9 +34,7 @@ def _int(text: str) -> bool:
 
 
 def _byte_count(text: str) -> bool:
-    from xfemslip.memory import _parse_bytes
-
-    return not text.strip() or _parse_bytes(text.strip()) is not None
+    return not text.strip() or parse_bytes(text.strip()) is not None
 
 
 def _kernels(text: str) -> bool:

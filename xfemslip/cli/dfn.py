@@ -1,7 +1,6 @@
-"""Command ``xfemslip dfn``: realize a case's fracture network without solving
-(registered in :mod:`xfemslip.cli`).
+"""Command ``xfemslip dfn``: realize a case's fracture network without solving.
 
-Parses the arguments, prints, maps errors (through ``cli._reported_errors``);
+Parses the arguments, prints, maps errors (through ``cli.common.reported_errors``);
 the network is built by the case loader (:mod:`xfemslip.case.network`,
 :mod:`xfemslip.dfn`), the figure by :mod:`xfemslip.dfn_plot`.
 """
@@ -12,13 +11,13 @@ from pathlib import Path
 
 import click
 
-from xfemslip.cli import (
-    _case_argument,
-    _debug_option,
-    _figure_path,
-    _load,
-    _Path,
-    _reported_errors,
+from xfemslip.cli.common import (
+    PathParam,
+    case_argument,
+    debug_option,
+    figure_path,
+    load_case_file,
+    reported_errors,
 )
 from xfemslip.errors import OutputError, UsageError
 
@@ -35,11 +34,11 @@ def _write_text(path: Path, text: str) -> None:
 
 
 @click.command()
-@_case_argument
+@case_argument
 @click.option(
     "--csv",
     "csv_path",
-    type=_Path(dir_okay=False, path_type=Path, empty_ok=False),
+    type=PathParam(dir_okay=False, path_type=Path, empty_ok=False),
     help="Write the fractures as a CSV of segments (the network.file format).",
 )
 @click.option(
@@ -50,26 +49,26 @@ def _write_text(path: Path, text: str) -> None:
 )
 @click.option(
     "--plot",
-    type=_Path(dir_okay=False, path_type=Path, empty_ok=False),
-    callback=_figure_path,
+    type=PathParam(dir_okay=False, path_type=Path, empty_ok=False),
+    callback=figure_path,
     help="Draw the network (.png or .pdf).",
 )
 @click.option(
     "--result",
-    type=_Path(dir_okay=False, exists=True, path_type=Path),
+    type=PathParam(dir_okay=False, exists=True, path_type=Path),
     help="A result.h5 of this case: colour the figure by |slip|.",
 )
 @click.option(
     "--summary",
-    type=_Path(dir_okay=False, exists=True, path_type=Path),
+    type=PathParam(dir_okay=False, exists=True, path_type=Path),
     help="A sweep's summary.csv: add the histogram of slipping fractures.",
 )
-@_debug_option
+@debug_option
 def dfn(case, csv_path, include_inline, plot, result, summary, debug) -> None:
     """Realize the fracture network of CASE (its [network] table) and print its
     statistics; optionally export it as CSV and draw it.  Nothing is solved."""
-    with _reported_errors(debug):
-        spec = _load(case)
+    with reported_errors(debug):
+        spec = load_case_file(case)
         from xfemslip.dfn import network_stats, segments_csv_text
 
         (x0, y0), (w, h) = spec.origin, spec.size

@@ -1,7 +1,7 @@
-"""Commands ``xfemslip sweep | plot | screen`` (registered in :mod:`xfemslip.cli`).
+"""Commands ``xfemslip sweep | plot | screen``.
 
-Like ``cli.py`` these only parse arguments, print and map errors to exit codes
-(through ``cli._reported_errors``); the work is in :mod:`xfemslip.sweep`,
+These only parse arguments, print and map errors to exit codes
+(through ``cli.common.reported_errors``); the work is in :mod:`xfemslip.sweep`,
 :mod:`xfemslip.sweep_run`, :mod:`xfemslip.plot` and :mod:`xfemslip.screen`.
 matplotlib is imported only when a figure is drawn, Dask only with
 ``--scheduler``.
@@ -17,15 +17,15 @@ from pathlib import Path
 import click
 
 from xfemslip.case.files import path_problem
-from xfemslip.cli import (
+from xfemslip.cli.common import (
     EXIT_FAILURE,
-    _configure_logging,
-    _debug_option,
-    _FiniteFloat,
-    _load,
-    _Path,
-    _reported_errors,
-    _shown_path,
+    FiniteFloat,
+    PathParam,
+    configure_logging,
+    debug_option,
+    load_case_file,
+    reported_errors,
+    shown_path,
 )
 from xfemslip.errors import UsageError
 
@@ -43,11 +43,11 @@ KINDS = ("displacement", "principal_stress", "deformed_mesh", "slip", "mohr")
 
 
 @click.command()
-@click.argument("sweep_file", metavar="SWEEP", type=_Path(path_type=Path))
+@click.argument("sweep_file", metavar="SWEEP", type=PathParam(path_type=Path))
 @click.option(
     "-o",
     "--output",
-    type=_Path(file_okay=False, path_type=Path, empty_ok=False),
+    type=PathParam(file_okay=False, path_type=Path, empty_ok=False),
     default=None,
     help="Sweep folder [default: output.directory of the sweep, else "
     "out/sweeps/<name>].",
@@ -69,7 +69,7 @@ KINDS = ("displacement", "principal_stress", "deformed_mesh", "slip", "mohr")
 )
 @click.option("--force", is_flag=True, help="Rerun cases that already have a result.")
 @click.option("-v", "--verbose", is_flag=True, help="Log every case's messages.")
-@_debug_option
+@debug_option
 def sweep(sweep_file, output, jobs, scheduler, force, verbose, debug) -> None:
     """Run the cases of the sweep file SWEEP (base case + varied parameters).
 
@@ -78,11 +78,11 @@ def sweep(sweep_file, output, jobs, scheduler, force, verbose, debug) -> None:
     reported and not run.  A table of the results is printed and written to
     <folder>/summary.csv.  Exit 1 if a case failed or was refused.
     """
-    with _reported_errors(debug):
-        _configure_logging(verbose, not verbose)
+    with reported_errors(debug):
+        configure_logging(verbose, not verbose)
         problem = path_problem(sweep_file)
         if problem:
-            raise UsageError(f"{_shown_path(sweep_file)}: the path {problem}")
+            raise UsageError(f"{shown_path(sweep_file)}: the path {problem}")
         if not sweep_file.is_file():
             raise UsageError(f"{sweep_file}: no such file")
         from xfemslip.sweep import load_sweep
@@ -148,11 +148,11 @@ def _default_figure_dir(results: list[Path]) -> Path:
 
 
 @click.command()
-@click.argument("results", nargs=-1, required=True, type=_Path(path_type=Path))
+@click.argument("results", nargs=-1, required=True, type=PathParam(path_type=Path))
 @click.option(
     "-o",
     "--output",
-    type=_Path(file_okay=False, path_type=Path, empty_ok=False),
+    type=PathParam(file_okay=False, path_type=Path, empty_ok=False),
     default=None,
     help="Folder for the figures [default: <result folder>/figures, or the "
     "results' common folder /figures].",
@@ -179,22 +179,22 @@ def _default_figure_dir(results: list[Path]) -> Path:
 )
 @click.option(
     "--scale",
-    type=_FiniteFloat(min=0.0, min_open=True),
+    type=FiniteFloat(min=0.0, min_open=True),
     default=None,
     help="Displacement magnification of the deformed mesh [default: auto].",
 )
 @click.option(
     "--dpi",
-    type=_FiniteFloat(min=10.0, max=MAX_DPI),
+    type=FiniteFloat(min=10.0, max=MAX_DPI),
     default=110.0,
     show_default=True,
     help="Resolution of the PNG files.",
 )
-@_debug_option
+@debug_option
 def plot(results, output, kinds, formats, labels, scale, dpi, debug) -> None:
     """Draw the paper's figures of one or several RESULTS (result.h5 files or
     their folders); several results are drawn side by side or overlaid."""
-    with _reported_errors(debug):
+    with reported_errors(debug):
         from xfemslip.plot import plot_results
 
         out_dir = output or _default_figure_dir(list(results))
@@ -225,11 +225,11 @@ def plot_run(out_dir: Path) -> None:
 
 
 @click.command()
-@click.argument("case", required=False, type=_Path(path_type=Path))
+@click.argument("case", required=False, type=PathParam(path_type=Path))
 @click.option(
     "--stress",
     nargs=3,
-    type=_FiniteFloat(),
+    type=FiniteFloat(),
     default=None,
     metavar="XX YY XY",
     help="Total far-field stress [Pa], tension positive "
@@ -238,7 +238,7 @@ def plot_run(out_dir: Path) -> None:
 @click.option(
     "-p",
     "--pore-pressure",
-    type=_FiniteFloat(),
+    type=FiniteFloat(),
     default=None,
     help="Pore pressure p [Pa]; effective stress = stress + p I "
     "[default: the final far-field pore pressure of CASE's [pore_pressure], "
@@ -246,13 +246,13 @@ def plot_run(out_dir: Path) -> None:
 )
 @click.option(
     "--friction",
-    type=_FiniteFloat(min=0.0),
+    type=FiniteFloat(min=0.0),
     default=None,
     help="Friction coefficient f [default: the first fracture's].",
 )
 @click.option(
     "--cohesion",
-    type=_FiniteFloat(min=0.0),
+    type=FiniteFloat(min=0.0),
     default=None,
     help="Cohesion c [Pa] [default: the first fracture's, else 0].",
 )
@@ -260,13 +260,13 @@ def plot_run(out_dir: Path) -> None:
     "--angle",
     "angles",
     multiple=True,
-    type=_FiniteFloat(),
+    type=FiniteFloat(),
     help="A fracture angle to screen [deg, CCW from +x] (repeatable) "
     "[default: the fractures of CASE].",
 )
 @click.option(
     "--step",
-    type=_FiniteFloat(min=0.1, max=90.0),
+    type=FiniteFloat(min=0.1, max=90.0),
     default=5.0,
     show_default=True,
     help="Angle step of the orientation table [deg].",
@@ -274,14 +274,14 @@ def plot_run(out_dir: Path) -> None:
 @click.option(
     "--csv",
     "csv_path",
-    type=_Path(dir_okay=False, path_type=Path, empty_ok=False),
+    type=PathParam(dir_okay=False, path_type=Path, empty_ok=False),
     default=None,
     help="Also write the orientation table as CSV.",
 )
 @click.option(
     "--plot",
     "plot_dir",
-    type=_Path(file_okay=False, path_type=Path, empty_ok=False),
+    type=PathParam(file_okay=False, path_type=Path, empty_ok=False),
     default=None,
     help="Also draw the Mohr diagram into this folder.",
 )
@@ -292,7 +292,7 @@ def plot_run(out_dir: Path) -> None:
     type=click.Choice(("png", "pdf")),
     help="Format of the --plot files (repeatable) [default: png and pdf].",
 )
-@_debug_option
+@debug_option
 def screen(
     case,
     stress,
@@ -310,7 +310,7 @@ def screen(
     CASE): slip tendency, Coulomb margin, the band that slips and the
     pore-pressure change at which each fracture slips.  Stresses in Pa,
     tension positive."""
-    with _reported_errors(debug):
+    with reported_errors(debug):
         from xfemslip import screen as scr
 
         stress, fractures = _screen_inputs(case, stress, friction, cohesion, angles)
@@ -360,7 +360,7 @@ def _angles(step: float):
 def _case_pore_pressure(case) -> float:
     """Final far-field pore pressure of CASE's [pore_pressure] (initial, plus
     the change when it acts in the whole model), else 0 [Pa]."""
-    spec = _load(case) if case is not None else None
+    spec = load_case_file(case) if case is not None else None
     pp = None if spec is None else spec.pore_pressure
     if pp is None:
         return 0.0
@@ -370,7 +370,7 @@ def _case_pore_pressure(case) -> float:
 def _screen_inputs(case, stress, friction, cohesion, angles):
     """(stress, [(label, theta, f, c)]) from CASE and the options; a
     fracture-less entry (label "") carries the defaults of f and c."""
-    spec = _load(case) if case is not None else None
+    spec = load_case_file(case) if case is not None else None
     if stress is None:
         if spec is None or spec.loading.stress is None:
             raise UsageError(

@@ -1,7 +1,5 @@
-"""Command-line interface: ``xfemslip run | check | info | verify``.
-
-This module parses arguments, configures logging, calls the library and maps
-its errors to messages and exit codes.  It does no numerics.
+"""What every command of the CLI shares: logging set-up, error reporting,
+exit codes, parameter types and the common options.
 
 Exit codes:
 
@@ -25,15 +23,12 @@ from __future__ import annotations
 import contextlib
 import logging
 import math
-import platform
-import sys
 import traceback
 from collections.abc import Iterator
 from pathlib import Path
 
 import click
 
-from xfemslip import __version__
 from xfemslip.case.files import path_problem
 from xfemslip.errors import (
     CaseError,
@@ -43,8 +38,6 @@ from xfemslip.errors import (
     XfemslipError,
 )
 from xfemslip.interrupt import Terminated, sigterm_as_interrupt
-
-logger = logging.getLogger(__name__)
 
 EXIT_FAILURE = 1
 EXIT_USAGE = 2
@@ -78,7 +71,7 @@ class _CompactFormatter(logging.Formatter):
         return message
 
 
-def _configure_logging(verbose: bool, quiet: bool) -> None:
+def configure_logging(verbose: bool, quiet: bool) -> None:
     """Log ``xfemslip.*`` to stderr: INFO by default, -q WARNING, -v DEBUG."""
     if verbose and quiet:
         raise UsageError("--verbose and --quiet cannot be used together")
@@ -94,14 +87,14 @@ def _configure_logging(verbose: bool, quiet: bool) -> None:
     package_logger.setLevel(level)
 
 
-def _one_line(err: BaseException) -> str:
+def one_line(err: BaseException) -> str:
     """The error's message on one line (falls back to the class name)."""
     text = " ".join(str(err).split())
     return text or type(err).__name__
 
 
 @contextlib.contextmanager
-def _reported_errors(debug: bool) -> Iterator[None]:
+def reported_errors(debug: bool) -> Iterator[None]:
     """Turn library errors, Ctrl-C and SIGTERM into ``Error: ...`` and an exit
     code (``xfemslip.interrupt``: a signal always ends the command)."""
     try:
@@ -110,7 +103,7 @@ def _reported_errors(debug: bool) -> Iterator[None]:
     except XfemslipError as err:
         if debug:
             click.secho(traceback.format_exc().rstrip(), err=True, dim=True)
-        click.echo(f"Error: {_one_line(err)}", err=True)
+        click.echo(f"Error: {one_line(err)}", err=True)
         usage = isinstance(err, CaseError | UsageError | GeometryError | MeshError)
         raise click.exceptions.Exit(EXIT_USAGE if usage else EXIT_FAILURE) from None
     except KeyboardInterrupt as err:
@@ -130,13 +123,13 @@ def _reported_errors(debug: bool) -> Iterator[None]:
         ) from None
 
 
-def _load(case: Path):
+def load_case_file(case: Path):
     """Load and validate a case file (``CaseError`` on any problem)."""
     from xfemslip.case import load_case
 
     problem = path_problem(case)
     if problem:
-        raise UsageError(f"{_shown_path(case)}: the path {problem}")
+        raise UsageError(f"{shown_path(case)}: the path {problem}")
     if not case.exists():
         raise UsageError(f"{case}: no such file")
     if case.is_dir():
@@ -144,13 +137,13 @@ def _load(case: Path):
     return load_case(case)
 
 
-def _shown_path(path) -> str:
+def shown_path(path) -> str:
     """A path for a message: NUL bytes escaped, cut to 80 characters."""
     text = repr(str(path))[1:-1]
     return text if len(text) <= 80 else text[:77] + "..."
 
 
-class _Path(click.Path):
+class PathParam(click.Path):
     """``click.Path`` that refuses a path no file system can hold (a NUL byte,
     which click's own ``os.stat`` turns into a ValueError; a name over 255
     bytes) and, with ``empty_ok=False``, an empty path (``-o ""`` would write
@@ -166,11 +159,11 @@ class _Path(click.Path):
                 self.fail("the path is empty", param, ctx)
             problem = path_problem(value)
             if problem:
-                self.fail(f"{_shown_path(value)}: {problem}", param, ctx)
+                self.fail(f"{shown_path(value)}: {problem}", param, ctx)
         return super().convert(value, param, ctx)
 
 
-class _FiniteFloat(click.FloatRange):
+class FiniteFloat(click.FloatRange):
     """``click.FloatRange`` without NaN and infinities (``float("nan")``
     passes every range test)."""
 
@@ -181,7 +174,7 @@ class _FiniteFloat(click.FloatRange):
         return number
 
 
-def _figure_path(ctx, param, value):
+def figure_path(ctx, param, value):
     """A figure file whose suffix matplotlib can write (checked before any
     work; matplotlib is imported only when a figure is asked for)."""
     if value is None:
@@ -191,13 +184,13 @@ def _figure_path(ctx, param, value):
     known = FigureCanvasBase.get_supported_filetypes()
     if value.suffix.lstrip(".").lower() not in known:
         raise click.BadParameter(
-            f"{_shown_path(value)}: the suffix must be one of "
+            f"{shown_path(value)}: the suffix must be one of "
             + ", ".join(f".{k}" for k in sorted(known))
         )
     return value
 
 
-class _OneLineUsageError(click.UsageError):
+class OneLineUsageError(click.UsageError):
     """A click usage error shown as one line ``Error: ...`` (no usage block),
     like every other refusal of the CLI."""
 
@@ -208,50 +201,37 @@ class _OneLineUsageError(click.UsageError):
 
 
 @contextlib.contextmanager
-def _one_line_usage() -> Iterator[None]:
+def one_line_usage() -> Iterator[None]:
     """Re-raise click's usage errors (bad options, arguments) as one line."""
     try:
         yield
-    except _OneLineUsageError:
+    except OneLineUsageError:
         raise
     except getattr(click.exceptions, "NoArgsIsHelpError", ()):
         raise  # `xfemslip` alone prints the help
     except click.UsageError as err:
-        raise _OneLineUsageError(err.format_message(), err.ctx) from None
+        raise OneLineUsageError(err.format_message(), err.ctx) from None
 
 
-class _Group(click.Group):
+class Group(click.Group):
     """The command group; its usage errors and its subcommands' are one line."""
 
     def make_context(self, info_name, args, parent=None, **extra):
-        with _one_line_usage():
+        with one_line_usage():
             return super().make_context(info_name, args, parent, **extra)
 
     def invoke(self, ctx):
-        with _one_line_usage():
+        with one_line_usage():
             return super().invoke(ctx)
 
 
-_debug_option = click.option(
+debug_option = click.option(
     "--debug", is_flag=True, help="Show the traceback of a reported error."
 )
-_case_argument = click.argument("case", type=_Path(path_type=Path))
+case_argument = click.argument("case", type=PathParam(path_type=Path))
 
 
-@click.group(cls=_Group, context_settings={"help_option_names": ["-h", "--help"]})
-@click.version_option(__version__, prog_name="xfemslip")
-def cli() -> None:
-    """XFEM frictional contact on 2D fractures, driven by TOML case files."""
-    from xfemslip.cli_env import check_environment
-
-    try:  # not inside _reported_errors: the command installs the signal handlers
-        check_environment()
-    except UsageError as err:
-        click.echo(f"Error: {_one_line(err)}", err=True)
-        raise click.exceptions.Exit(EXIT_USAGE) from None
-
-
-def _solve_options(command):
+def solve_options(command):
     """-o/--output, --overwrite, -v/--verbose and -q/--quiet: the options of
     every command that solves a case and writes its results (run, deplete)."""
     for option in reversed(
@@ -260,7 +240,7 @@ def _solve_options(command):
                 "-o",
                 "--output",
                 "output",
-                type=_Path(file_okay=False, path_type=Path, empty_ok=False),
+                type=PathParam(file_okay=False, path_type=Path, empty_ok=False),
                 default=None,
                 help="Output directory [default: output.directory of the case, "
                 "else out/<name>].",
@@ -278,148 +258,3 @@ def _solve_options(command):
     ):
         command = option(command)
     return command
-
-
-@cli.command()
-@_case_argument
-@_solve_options
-@click.option(
-    "--plot", is_flag=True, help="Also draw the figures into <output>/figures."
-)
-@_debug_option
-def run(
-    case: Path,
-    output: Path | None,
-    overwrite: bool,
-    verbose: bool,
-    quiet: bool,
-    plot: bool,
-    debug: bool,
-) -> None:
-    """Run the case file CASE and write its results."""
-    with _reported_errors(debug):
-        _configure_logging(verbose, quiet)
-        spec = _load(case)
-        from xfemslip.simulation import run_case
-
-        summary = run_case(spec, output, overwrite=overwrite)
-        status = "converged" if summary.converged else "did NOT converge"
-        click.echo(
-            f"{spec.name}: {status} in {summary.load_steps} step(s), "
-            f"{summary.newton_iterations} Newton iterations, "
-            f"{summary.wall_time_s:.2f} s -> {summary.out_dir}"
-        )
-        if not summary.converged:
-            raise click.exceptions.Exit(EXIT_FAILURE)
-        if plot:  # matplotlib is imported only here
-            from xfemslip.cli_studies import plot_run
-
-            plot_run(summary.out_dir)
-
-
-@cli.command()
-@_case_argument
-@_debug_option
-def check(case: Path, debug: bool) -> None:
-    """Validate CASE and print its settings in SI units.
-
-    Besides the keys, the geometry is checked (fractures against the mesh,
-    boundary corners); nothing is assembled or solved.
-    """
-    with _reported_errors(debug):
-        spec = _load(case)
-        from xfemslip.case import describe
-        from xfemslip.simulation import check_geometry
-
-        check_geometry(spec)
-        click.echo(describe(spec))
-
-
-@cli.command()
-def info() -> None:
-    """Print versions and Numba settings."""
-    from xfemslip.kernels._config import numba_settings
-
-    rows = [("xfemslip", __version__), ("python", platform.python_version())]
-    rows += [
-        (name, _dist_version(name))
-        for name in ("numpy", "scipy", "numba", "pyamg", "h5py", "meshio", "click")
-    ]
-    rows += numba_settings()
-    rows += [("executable", sys.executable)]
-    width = max(len(name) for name, _ in rows)
-    for name, value in rows:
-        click.echo(f"{name:<{width}}  {value}")
-
-
-@cli.command()
-@click.option("--quick", is_flag=True, help="CI-sized: fewer problems and meshes.")
-@click.option(
-    "--tip",
-    default=None,
-    help="Crack-tip treatment, e.g. branch or ramp [default: the case default].",
-)
-@click.option(
-    "--plot",
-    type=_Path(dir_okay=False, path_type=Path, empty_ok=False),
-    help="Write error vs h and error vs wall time (.png or .pdf).",
-)
-@click.option(
-    "--csv",
-    "csv_path",
-    type=_Path(dir_okay=False, path_type=Path, empty_ok=False),
-    help="Write the table as CSV.",
-)
-@click.option(
-    "--penalty",
-    default="100",
-    show_default=True,
-    help="kn h / E of the problems, or auto: leave kn, kt to the case default.",
-)
-@_debug_option
-def verify(quick, tip, plot, csv_path, penalty, debug) -> None:
-    """Run the verification problems against closed forms; exit 1 if a target
-    is missed (see README, Verification)."""
-    with _reported_errors(debug):
-        from xfemslip.verify import main as verify_main
-
-        if not verify_main(
-            quick=quick, tip=tip, plot=plot, csv_path=csv_path, penalty=penalty
-        ):
-            raise click.exceptions.Exit(EXIT_FAILURE)
-
-
-def _dist_version(name: str) -> str:
-    """Installed version of a distribution, or 'not installed'."""
-    import importlib.metadata  # only here: 0.05 s of imports that a run skips
-
-    try:
-        return importlib.metadata.version(name)
-    except importlib.metadata.PackageNotFoundError:
-        return "not installed"
-
-
-# sweep | plot | screen: their code is in cli_studies, which imports the helpers
-# above (so this import stays below them).
-from xfemslip.cli_studies import plot, screen, sweep  # noqa: E402
-
-cli.add_command(sweep)
-cli.add_command(plot)
-cli.add_command(screen)
-
-# deplete: its code is in cli_deplete (issue 6, depletion)
-from xfemslip.cli_deplete import deplete  # noqa: E402
-
-cli.add_command(deplete)
-
-from xfemslip.cli_dfn import dfn  # noqa: E402  (random fracture networks)
-
-cli.add_command(dfn)
-
-
-def main() -> None:
-    """Console-script entry point (``xfemslip``)."""
-    from xfemslip import interrupt
-
-    interrupt.for_process()
-    cli(prog_name="xfemslip")
