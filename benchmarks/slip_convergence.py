@@ -51,7 +51,7 @@ from xfemslip import peer as oc
 from xfemslip import quadrature as Q
 from xfemslip.case import loads_case
 from xfemslip.closed_form import relative_l2, slip_profile
-from xfemslip.post import fracture_fields
+from xfemslip.post.fields import fracture_fields
 from xfemslip.simulation import build_model, newton_solver
 
 HALF = 200.0  # [m] half-width of the box

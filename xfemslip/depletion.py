@@ -21,7 +21,7 @@ Outputs (in ``out_dir``): ``result.h5`` (and VTU) of the steps as ``run``
 writes them, ``critical_depletion.csv``, ``slip_vs_depletion.csv``, and with
 ``plot=True`` ``slip_vs_depletion.png`` and ``depletion_field.png``
 (matplotlib imported only then); all of them one output set, swapped into
-``out_dir`` whole (:mod:`xfemslip.writers.folder`).
+``out_dir`` whole (:mod:`xfemslip.io.folder`).
 """
 
 from __future__ import annotations
@@ -36,8 +36,8 @@ import numpy as np
 
 from xfemslip.conventions import SLIP
 from xfemslip.errors import ConvergenceError, UsageError
+from xfemslip.io.atomic import atomic_path
 from xfemslip.simulation import solve_and_write
-from xfemslip.writers.atomic import atomic_path
 
 logger = logging.getLogger(__name__)
 
@@ -156,21 +156,21 @@ def _table_rows(model, results, change) -> list:
     return rows
 
 
-def critical_depletion(solver, model, steps, tolerance):
+def critical_depletion(solver, model, steps, tolerance, onsets=None):
     """Run the steps with bisection of every fracture's first slip.
 
     Returns (onsets, results).  ``tolerance`` [Pa] is the final bracket width
-    in pore pressure.  A ConvergenceError carries the onsets found so far as
-    its ``onsets`` attribute.
+    in pore pressure.  ``onsets``: a list to fill with one FractureOnset per
+    fracture (a new one when None); after a ConvergenceError it holds the
+    onsets found before.
     """
-    onsets = [FractureOnset(fracture=fr.index) for fr in model.fractures]
+    if onsets is None:
+        onsets = []
+    onsets[:] = [FractureOnset(fracture=fr.index) for fr in model.fractures]
     try:
         _step_and_bisect(solver, model, steps, tolerance, onsets)
-    except ConvergenceError as exc:
+    finally:
         _drop_nonlinear(onsets)
-        exc.onsets = onsets
-        raise
-    _drop_nonlinear(onsets)
     return onsets, solver.completed
 
 
@@ -375,11 +375,6 @@ def deplete(spec, out_dir=None, *, tolerance=None, plot=False, overwrite=False):
     def finish(done, folder: Path) -> None:
         """The tables and figures, into the output set before it is swapped in."""
         # a failed step keeps what converged, as `run` does
-        report.onsets = (
-            done.value
-            if done.value is not None
-            else getattr(done.failure, "onsets", [])
-        )
         report.rows = _table_rows(done.model, done.results, change)
         report.out_dir = done.out_dir
         names = write_tables(report, folder)
@@ -396,8 +391,8 @@ def deplete(spec, out_dir=None, *, tolerance=None, plot=False, overwrite=False):
         out_dir,
         overwrite,
         lambda solver, model: critical_depletion(
-            solver, model, spec.loading.steps, tolerance
-        )[0],
+            solver, model, spec.loading.steps, tolerance, report.onsets
+        ),
         finish,
     )
     report.wall_time_s = time.perf_counter() - start

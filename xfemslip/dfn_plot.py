@@ -12,7 +12,6 @@ from __future__ import annotations
 import csv
 from pathlib import Path
 
-import h5py
 import numpy as np
 from matplotlib.collections import LineCollection
 from matplotlib.colors import Normalize
@@ -20,6 +19,7 @@ from matplotlib.figure import Figure
 
 from xfemslip.conventions import SLIP
 from xfemslip.errors import OutputError, UsageError
+from xfemslip.io.read import read_result
 
 PANEL = 4.2  # inches
 
@@ -36,20 +36,14 @@ def _domain_frame(ax, spec) -> None:
 
 def read_result_slip(result: Path, n_fractures: int) -> list[tuple]:
     """[(points (K, 2), slip (K,), state (K,))] per fracture of a result.h5."""
-    try:
-        with h5py.File(result, "r") as f:
-            out = []
-            for i in range(n_fractures):
-                group = f.get(f"fractures/{i}")
-                if group is None:
-                    raise UsageError(
-                        f"{result}: no /fractures/{i}: not a result of this case "
-                        f"({n_fractures} fractures)"
-                    )
-                out.append(tuple(group[k][()] for k in ("points", "slip", "state")))
-            return out
-    except OSError as exc:
-        raise UsageError(f"{result}: cannot read the result: {exc}") from None
+    read = read_result(result)
+    fractures = read.fractures if read.steps else []
+    if len(fractures) < n_fractures:
+        raise UsageError(
+            f"{result}: no /fractures/{len(fractures)}: not a result of this case "
+            f"({n_fractures} fractures)"
+        )
+    return [(f.points, f.slip, f.state) for f in fractures[:n_fractures]]
 
 
 def _draw_slip(fig, ax, fields) -> None:

@@ -34,7 +34,7 @@ from matplotlib.tri import Triangulation
 
 from xfemslip.conventions import SLIP
 from xfemslip.errors import UsageError
-from xfemslip.plot_data import ResultData, read_result
+from xfemslip.plot_data import ResultData, figure_data
 from xfemslip.plot_mohr import add_legend, draw_mohr, mohr_figsize
 
 logger = logging.getLogger(__name__)
@@ -381,10 +381,10 @@ def figure_mohr(results: Sequence[ResultData]) -> Figure:
 
 def _save_all(out_dir: Path, makers: dict, formats, dpi=DPI) -> list[Path]:
     """Write ``<out_dir>/<name>.<fmt>`` for each figure ``makers[name]()`` and
-    format, as one set (:func:`xfemslip.writers.fileset.replace_files`: no
+    format, as one set (:func:`xfemslip.io.fileset.replace_files`: no
     figure of an earlier command is left beside the new ones half-replaced);
     returns the paths in the order of ``makers`` and ``formats``."""
-    from xfemslip.writers.fileset import replace_files
+    from xfemslip.io.fileset import replace_files
 
     figures: dict[str, Figure] = {}
 
@@ -466,7 +466,7 @@ def plot_results(
     if labels and len(labels) != len(paths):
         raise UsageError(f"got {len(labels)} labels for {len(paths)} results")
     results = [
-        read_result(p, labels[i] if labels else None) for i, p in enumerate(paths)
+        figure_data(p, labels[i] if labels else None) for i, p in enumerate(paths)
     ]
     makers = {
         "displacement": lambda: figure_displacement(results),

@@ -1,7 +1,8 @@
 """What the figures need from a run, read from its documented output files.
 
-``read_result(path)`` reads ``result.h5`` (output-format.md) and, when it lies
-beside it, ``result.vtu``: its split mesh (cut elements as triangles on each
+``figure_data(path)`` reads ``result.h5`` (through
+:func:`xfemslip.io.read.read_result`) and, when it lies beside it,
+``result.vtu``: its split mesh (cut elements as triangles on each
 side of the fracture, with their own points) is what lets a contour or a
 deformed mesh show the displacement jump.  No matplotlib here.
 """
@@ -14,10 +15,10 @@ import tomllib
 from dataclasses import dataclass, field
 from pathlib import Path
 
-import h5py
 import numpy as np
 
 from xfemslip.errors import UsageError
+from xfemslip.io.read import read_result
 
 
 @dataclass
@@ -99,26 +100,24 @@ def _far_pore_pressure(case: dict) -> float:
     return float(pp.get("initial", 0.0)) + float(change)
 
 
-def _read_fractures(h5, case: dict) -> list[FractureData]:
+def _fracture_data(result, case: dict) -> list[FractureData]:
+    """The fractures of the case's [[fractures]] tables, final step."""
     tables = case.get("fractures", [])
     out = []
-    for i, table in enumerate(tables):
-        group = h5.get(f"fractures/{i}")
-        if group is None:
-            continue
+    for i, (table, ff) in enumerate(zip(tables, result.fractures, strict=False)):
         out.append(
             FractureData(
                 index=i,
-                s=group["s"][()],
-                points=group["points"][()],
-                slip=group["slip"][()],
-                normal_traction=group[
-                    "effective_normal_traction"
-                    if "effective_normal_traction" in group
-                    else "normal_traction"
-                ][()],
-                shear_traction=group["shear_traction"][()],
-                state=group["state"][()],
+                s=ff.s,
+                points=ff.points,
+                slip=ff.slip,
+                normal_traction=(
+                    ff.effective_normal_traction
+                    if ff.effective_normal_traction is not None
+                    else ff.normal_traction
+                ),
+                shear_traction=ff.shear_traction,
+                state=ff.state,
                 theta=_chord_angle(table),
                 friction=float(table.get("friction", 0.0)),
                 cohesion=float(table.get("cohesion", 0.0)),
@@ -197,42 +196,37 @@ def _piece_outlines(pts, tris, cell_id, fractures) -> np.ndarray:
     return np.array([first[k] for k, n in count.items() if n == 1]).reshape(-1, 2)
 
 
-def read_result(path: str | Path, label: str | None = None) -> ResultData:
-    """Read ``result.h5`` (and ``result.vtu`` beside it).  UsageError when the
-    file is missing, not HDF5, or holds no converged fields."""
+def figure_data(path: str | Path, label: str | None = None) -> ResultData:
+    """What the figures need of ``result.h5`` (read by
+    :func:`xfemslip.io.read.read_result`) and of ``result.vtu`` beside it.
+    UsageError when the file is missing, not HDF5, or holds no converged
+    fields."""
     path = Path(path)
     if path.is_dir():
         path = path / "result.h5"
-    if not path.is_file():
-        raise UsageError(f"{path}: no such file (expected a result.h5)")
-    try:
-        h5 = h5py.File(path, "r")
-    except OSError as exc:
-        raise UsageError(f"{path}: not a readable result.h5: {exc}") from None
-    with h5:
-        if "fields" not in h5:
-            raise UsageError(f"{path}: holds no converged load step to plot")
-        case = tomllib.loads(str(h5.attrs.get("case_toml", "")))
-        points, cells = h5["mesh/points"][()], h5["mesh/cells"][()]
-        stress = h5["fields/stress"][()]
-        d1 = points[cells[:, 2]] - points[cells[:, 0]]
-        d2 = points[cells[:, 3]] - points[cells[:, 1]]
-        area = 0.5 * np.abs(d1[:, 0] * d2[:, 1] - d1[:, 1] * d2[:, 0])
-        state, source = _stress_state(case, stress, area)
-        data = ResultData(
-            path=path,
-            label=label or default_label(path, case),
-            converged=bool(h5.attrs.get("converged", False)),
-            points=points,
-            cells=cells,
-            displacement=h5["fields/displacement"][()],
-            stress=stress,
-            principal=h5["fields/principal_stress"][()],
-            stress_state=state,
-            stress_source=source,
-            pore_pressure=_far_pore_pressure(case),
-            fractures=_read_fractures(h5, case),
-        )
+    result = read_result(path)
+    if not result.steps:
+        raise UsageError(f"{path}: holds no converged load step to plot")
+    case = tomllib.loads(str(result.attrs.get("case_toml", "")))
+    points, cells = result.points, result.cells
+    d1 = points[cells[:, 2]] - points[cells[:, 0]]
+    d2 = points[cells[:, 3]] - points[cells[:, 1]]
+    area = 0.5 * np.abs(d1[:, 0] * d2[:, 1] - d1[:, 1] * d2[:, 0])
+    state, source = _stress_state(case, result.stress, area)
+    data = ResultData(
+        path=path,
+        label=label or default_label(path, case),
+        converged=result.converged,
+        points=points,
+        cells=cells,
+        displacement=result.displacement,
+        stress=result.stress,
+        principal=result.principal_stress,
+        stress_state=state,
+        stress_source=source,
+        pore_pressure=_far_pore_pressure(case),
+        fractures=_fracture_data(result, case),
+    )
     vtu = path.with_name("result.vtu")
     if vtu.is_file():
         _read_vtu(data, vtu)

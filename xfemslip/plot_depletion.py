@@ -51,7 +51,7 @@ def plot_slip_vs_depletion(report, out_dir: Path, dpi: float = 110.0) -> Path:
 def plot_field(model, result, out_dir: Path, dpi: float = 110.0) -> Path:
     """Shear stress change and effective horizontal stress at the last step,
     reservoir outline, fractures coloured stick / slip."""
-    from xfemslip.simulation import step_fields
+    from xfemslip.post.fields import step_fields
 
     plt = _pyplot()
     f = step_fields(model, result)

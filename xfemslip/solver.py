@@ -244,7 +244,7 @@ class NewtonSolver:
             try:
                 u_new, res, log = self._newton(u, lam, k, steps)
             except ConvergenceError as err:
-                if not getattr(err, "retryable", True) or size == 1:
+                if not err.retryable or size == 1:
                     if cuts:
                         raise self._after_cuts(err, cuts, size / units) from None
                     raise
@@ -261,7 +261,7 @@ class NewtonSolver:
                     self.max_cuts,
                     lam_from,
                     lam_to,
-                    _short_reason(err),
+                    err.reason,
                 )
                 continue
             self.p.contact.commit(res)
@@ -308,19 +308,20 @@ class NewtonSolver:
 
     def _after_cuts(self, err, cuts, fraction):
         """The error of the last attempt, saying that bisection did not help."""
-        text = str(err)
-        marker = " did not converge: "
-        head, _, tail = text.partition(marker)
-        new = ConvergenceError(
-            f"{head}{marker}even after cutting the load step {cuts} time(s) "
-            f"(sub-steps down to {fraction:.3g} of it): {tail}",
+        why = (
+            f"even after cutting the load step {cuts} time(s) (sub-steps down to "
+            f"{fraction:.3g} of it): {err.reason}"
+        )
+        return ConvergenceError(
+            self._message(err.step, why, err.iteration, err.residual, err.flips),
             step=err.step,
             iteration=err.iteration,
             residual=err.residual,
             increment=err.increment,
             flips=err.flips,
+            reason=why,
+            retryable=err.retryable,
         )
-        return new
 
     def _newton(self, u, lam, k, steps):
         """Newton to load factor lam from u and the committed history.
@@ -636,7 +637,7 @@ class NewtonSolver:
         """A block held only by a fracture with no sticking point slides unbounded."""
         for index, mask in self.p.floating or []:
             if mask.any() and not np.any(res.state[mask] == STICK):
-                raise self._fail_final(
+                raise self._fail(
                     k,
                     it,
                     eta,
@@ -650,6 +651,7 @@ class NewtonSolver:
                     "Prescribe a displacement on that part (e.g. on its edge) or raise "
                     "the "
                     "friction or cohesion",
+                    retryable=False,
                 )
 
     def _solve(self, res, r, k, it, eta):
@@ -669,12 +671,6 @@ class NewtonSolver:
         if not np.all(np.isfinite(du)):
             raise self._fail(k, it, eta, 0, "the linear solve gave non-finite values")
         return du
-
-    def _fail_final(self, k, it, eta, flips, why):
-        """A failure that a smaller load step cannot cure (no bisection)."""
-        err = self._fail(k, it, eta, flips, why)
-        err.retryable = False
-        return err
 
     def _penalty_note(self) -> str:
         """Names a penalty above PENALTY_RATIO_MEASURED and the value to use
@@ -697,18 +693,26 @@ class NewtonSolver:
             "moves the slip of the shipped cases by at most 0.04 % of its maximum)"
         )
 
-    def _fail(self, k, it, eta, flips, why):
+    def _fail(self, k, it, eta, flips, why, *, retryable=True):
+        """The ConvergenceError of load step k; ``retryable`` False when a
+        smaller load step cannot cure it (no bisection)."""
         why += self._penalty_note()
         return ConvergenceError(
-            f"load step {k} did not converge: {why}; iteration {it}, residual eta = "
-            f"{eta:.3e} "
-            f"(tolerance {self.tol:.1e}), {flips} stick/slip switches in the last "
-            "iteration; "
-            f"{len(self.completed)} converged step(s) kept",
+            self._message(k, why, it, eta, flips),
             step=k,
             iteration=it,
             residual=eta,
             flips=flips,
+            reason=why,
+            retryable=retryable,
+        )
+
+    def _message(self, k, why, it, eta, flips) -> str:
+        """The one-line message of a ConvergenceError."""
+        return (
+            f"load step {k} did not converge: {why}; iteration {it}, residual eta = "
+            f"{eta:.3e} (tolerance {self.tol:.1e}), {flips} stick/slip switches in "
+            f"the last iteration; {len(self.completed)} converged step(s) kept"
         )
 
 
@@ -735,13 +739,6 @@ def _finite(res: ContactResult) -> bool:
     return all(
         np.all(np.isfinite(a)) for a in (res.force, res.gn, res.gt, res.pn, res.pt)
     )
-
-
-def _short_reason(err) -> str:
-    """The 'why' part of a ConvergenceError message, for the log."""
-    text = str(err)
-    why = text.partition(" did not converge: ")[2]
-    return why.partition("; iteration ")[0] or text
 
 
 def _cycling(history):

@@ -9,11 +9,9 @@ min, median and max.  Failed and refused cases are left out and counted.
 
 from __future__ import annotations
 
-import csv
-
 import numpy as np
 
-from xfemslip.writers.atomic import atomic_path
+from xfemslip.io.csv import write_csv
 
 DFN_SUMMARY = "dfn_summary.csv"
 AGGREGATED = (
@@ -63,10 +61,7 @@ def _text(value) -> str:
 def write_dfn_summary(path, rows) -> list[dict]:
     """Write ``dfn_summary.csv`` atomically; return the aggregate."""
     table = aggregate(rows)
-    with atomic_path(path) as tmp, open(tmp, "w", newline="", encoding="utf-8") as fh:
-        writer = csv.writer(fh)
-        writer.writerow(COLUMNS)
-        writer.writerows([_text(row[c]) for c in COLUMNS] for row in table)
+    write_csv(path, COLUMNS, ([_text(row[c]) for c in COLUMNS] for row in table))
     return table
 
 

@@ -12,7 +12,7 @@ Each case of a :class:`~xfemslip.sweep.SweepSpec` runs in its own folder
 
 A case whose folder holds a whole converged result of the same case text
 (:func:`is_done`) is skipped; any other case runs (again). Each member's
-folder is written as one set (:mod:`xfemslip.writers.folder`), the sweep
+folder is written as one set (:mod:`xfemslip.io.folder`), the sweep
 folder is locked while a sweep runs, and ``summary.csv`` with
 ``dfn_summary.csv`` are replaced together (``replace_files``). A failed case
 is reported in its row and the others go on; so is a case the sweep refused
@@ -27,9 +27,7 @@ slip, that fraction, the mean over those of their length-weighted mean |slip|
 
 from __future__ import annotations
 
-import csv
 import logging
-import math
 import os
 import traceback
 from collections.abc import Callable, Iterable
@@ -38,30 +36,16 @@ from dataclasses import dataclass, field
 from multiprocessing import get_context
 from pathlib import Path
 
-import h5py
-import numpy as np
-
-from xfemslip.conventions import SLIP
 from xfemslip.errors import OutputError, UsageError, XfemslipError
+from xfemslip.io.csv import write_rows
+from xfemslip.io.fileset import replace_files
+from xfemslip.io.lock import folder_lock
+from xfemslip.io.read import read_attrs, read_result
+from xfemslip.post.metrics import METRICS, result_metrics
 from xfemslip.sweep_dfn import DFN_SUMMARY, is_dfn_sweep, write_dfn_summary
-from xfemslip.writers.fileset import replace_files
-from xfemslip.writers.lock import folder_lock
 
 logger = logging.getLogger(__name__)
 
-METRICS = (
-    "converged",
-    "max_abs_slip_m",
-    "slip_length_m",
-    "slip_share",
-    "newton_iterations",
-    "wall_time_s",
-    # per fracture (networks, README "Random fracture networks"):
-    "fractures",
-    "slipping_fractures",
-    "slipping_fraction",
-    "mean_slip_m",
-)
 SUMMARY = "summary.csv"
 
 
@@ -87,84 +71,8 @@ class CaseRow:
 
 
 # --------------------------------------------------------------------------- #
-# Metrics of one result
+# Reruns
 # --------------------------------------------------------------------------- #
-
-
-def arc_extent(points: np.ndarray, box: tuple) -> tuple[float, float]:
-    """Arc-length range [s_lo, s_hi] of a polyline inside box (x0, x1, y0, y1)."""
-    from xfemslip.geometry import clip_segment
-
-    points = np.asarray(points, dtype=float)
-    seg = np.linalg.norm(np.diff(points, axis=0), axis=1)
-    start = np.concatenate([[0.0], np.cumsum(seg)[:-1]])
-    lo, hi = math.inf, -math.inf
-    for k in range(len(seg)):
-        ta, tb = clip_segment(points[k], points[k + 1], np.asarray([box], float))
-        if tb[0] > ta[0]:
-            lo = min(lo, start[k] + ta[0] * seg[k])
-            hi = max(hi, start[k] + tb[0] * seg[k])
-    return lo, hi
-
-
-def point_stretches(s, s_lo: float, s_hi: float) -> np.ndarray:
-    """Length [m] each contact point stands for: the stretch between the
-    midpoints to its neighbours (the ends reach s_lo and s_hi)."""
-    s = np.asarray(s, dtype=float)
-    if s.size == 0:
-        return np.zeros(0)
-    mid = 0.5 * (s[1:] + s[:-1])
-    return np.diff(np.concatenate([[min(s_lo, s[0])], mid, [max(s_hi, s[-1])]]))
-
-
-def slipping_length(s, state, s_lo: float, s_hi: float) -> float:
-    """Length [m] of fracture in slip: each point stands for the stretch between
-    the midpoints to its neighbours (the ends reach s_lo and s_hi)."""
-    stretch = point_stretches(s, s_lo, s_hi)
-    return float(np.sum(stretch[np.asarray(state) == SLIP]))
-
-
-def result_metrics(h5_path: Path, spec) -> dict:
-    """The summary metrics of ``result.h5`` (read back, so a skipped case
-    reports what its run wrote)."""
-    box = (
-        spec.origin[0],
-        spec.origin[0] + spec.size[0],
-        spec.origin[1],
-        spec.origin[1] + spec.size[1],
-    )
-    slip_max, length, n_slip, n_points = 0.0, 0.0, 0, 0
-    slipping_means = []  # mean |slip| of each fracture with a point in slip
-    with h5py.File(h5_path, "r") as f:
-        attrs = dict(f.attrs)
-        for i, fracture in enumerate(spec.fractures):
-            group = f.get(f"fractures/{i}")
-            if group is None:
-                continue
-            s, slip, state = (group[k][()] for k in ("s", "slip", "state"))
-            if slip.size:
-                slip_max = max(slip_max, float(np.max(np.abs(slip))))
-            stretch = point_stretches(s, *arc_extent(fracture.points, box))
-            length += float(np.sum(stretch[state == SLIP]))
-            if np.any(state == SLIP):
-                slipping_means.append(
-                    float(np.sum(stretch * np.abs(slip)) / np.sum(stretch))
-                )
-            n_slip += int(np.sum(state == SLIP))
-            n_points += int(state.size)
-    n_fractures = len(spec.fractures)
-    return {
-        "converged": bool(attrs.get("converged", False)),
-        "max_abs_slip_m": slip_max,
-        "slip_length_m": length,
-        "slip_share": n_slip / n_points if n_points else 0.0,
-        "newton_iterations": int(attrs.get("newton_iterations", 0)),
-        "wall_time_s": float(attrs.get("wall_time_s", math.nan)),
-        "fractures": n_fractures,
-        "slipping_fractures": len(slipping_means),
-        "slipping_fraction": len(slipping_means) / n_fractures if n_fractures else 0.0,
-        "mean_slip_m": float(np.mean(slipping_means)) if slipping_means else 0.0,
-    }
 
 
 def is_done(out_dir: Path, text: str, spec=None) -> bool:
@@ -172,7 +80,7 @@ def is_done(out_dir: Path, text: str, spec=None) -> bool:
 
     ``result.h5`` must say ``converged = true``, hold the same case text and a
     ``run_id`` (written only by a run that swapped its whole set in, see
-    :mod:`xfemslip.writers.folder`).  Given the case ``spec``, the VTU and PVD
+    :mod:`xfemslip.io.folder`).  Given the case ``spec``, the VTU and PVD
     files its ``output.formats`` call for must be there with the same
     ``run_id``: a folder with a result.h5 but no (or another run's) VTU is run
     again.
@@ -181,9 +89,8 @@ def is_done(out_dir: Path, text: str, spec=None) -> bool:
     if not path.is_file():
         return False
     try:
-        with h5py.File(path, "r") as f:
-            attrs = dict(f.attrs)
-    except OSError:  # unreadable: run it again
+        attrs = read_attrs(path)
+    except UsageError:  # unreadable: run it again
         return False
     if not (
         bool(attrs.get("converged", False))
@@ -196,7 +103,7 @@ def is_done(out_dir: Path, text: str, spec=None) -> bool:
 
 def _vtu_set_whole(out_dir: Path, spec, run_id: int) -> bool:
     """Whether the VTU/PVD files of ``spec``'s output are there, of ``run_id``."""
-    from xfemslip.writers.vtu import pvd_files, read_run_id
+    from xfemslip.io.vtu import pvd_files, read_run_id
 
     if "vtu" not in spec.output.formats:
         return True
@@ -228,17 +135,17 @@ def run_task(task: CaseTask) -> tuple[str, str, dict, str]:
     spec = None
     try:
         spec = loads_case(task.text, Path(task.path))
-        run_case(spec, out_dir, overwrite=True)
-        return task.case_id, "ok", result_metrics(out_dir / "result.h5", spec), ""
+        result = run_case(spec, out_dir, overwrite=True)
+        return task.case_id, "ok", result_metrics(result, spec), ""
     except XfemslipError as err:
         error = " ".join(str(err).split())
     except Exception:  # a bug: keep the other cases, show where it happened
         error = " | ".join(traceback.format_exc().strip().splitlines()[-3:])
     metrics = {}
     if spec is not None and (out_dir / "result.h5").is_file():
-        try:
-            metrics = result_metrics(out_dir / "result.h5", spec)
-        except OSError:
+        try:  # the converged steps of a failed run
+            metrics = result_metrics(read_result(out_dir), spec)
+        except UsageError:
             metrics = {}
     return task.case_id, "failed", metrics, error
 
@@ -264,7 +171,7 @@ def _prepare(sweep, directory: Path, force: bool) -> tuple[list, list[CaseRow]]:
             continue
         if not force and is_done(out_dir, case.text, case.spec):
             row = CaseRow(case.case_id, case.params, "skipped")
-            row.metrics = result_metrics(out_dir / "result.h5", case.spec)
+            row.metrics = result_metrics(read_result(out_dir), case.spec)
             skipped.append(row)
             continue
         _write_case(sweep, out_dir, case.text)
@@ -443,10 +350,7 @@ def summary_table(keys, rows: list[CaseRow]) -> tuple[list[str], list[list[str]]
 def write_summary(path: Path, keys, rows: list[CaseRow]) -> None:
     """``summary.csv`` (run_sweep writes it through ``replace_files``)."""
     header, body = summary_table(keys, rows)
-    with open(path, "w", newline="", encoding="utf-8") as fh:
-        writer = csv.writer(fh)
-        writer.writerow(header)
-        writer.writerows(body)
+    write_rows(path, header, body)
 
 
 def format_table(keys, rows: list[CaseRow]) -> str:

@@ -6,12 +6,13 @@ The rows, the window sweep and the missed targets come from
 
 from __future__ import annotations
 
-import csv
 import math
 from pathlib import Path
 
 import numpy as np
 
+from xfemslip.io.csv import write_rows
+from xfemslip.io.fileset import replace_files
 from xfemslip.verify import (
     HALF_LENGTH,
     SLIP_TARGET,
@@ -86,8 +87,6 @@ CSV_FIELDS = (
 
 def write_outputs(report: Report, csv_path: Path | None, plot: Path | None) -> None:
     """``--csv`` and ``--plot``, written as one set (``replace_files``)."""
-    from xfemslip.writers.fileset import replace_files
-
     writes = {}
     if csv_path is not None:
         writes[Path(csv_path)] = lambda tmp: write_csv(report, tmp)
@@ -98,11 +97,10 @@ def write_outputs(report: Report, csv_path: Path | None, plot: Path | None) -> N
 
 
 def write_csv(report: Report, path: Path) -> None:
-    with open(path, "w", newline="") as fh:
-        w = csv.writer(fh)
-        w.writerow([*CSV_FIELDS, "tip"])
-        for r in report.rows:
-            w.writerow([getattr(r, k) for k in CSV_FIELDS] + [report.tip or "default"])
+    """The table as CSV (one row per problem and mesh) into ``path``."""
+    tip = report.tip or "default"
+    rows = ([getattr(r, k) for k in CSV_FIELDS] + [tip] for r in report.rows)
+    write_rows(path, [*CSV_FIELDS, "tip"], rows)
 
 
 def write_plot(report: Report, path: Path, fmt: str | None = None) -> None:

@@ -2,7 +2,7 @@
 
 Real processes are killed (SIGKILL, SIGTERM, SIGINT) while they write, at
 points chosen by the writer's test hook (``XFEMSLIP_TEST_PAUSE``, see
-``xfemslip.writers.folder``: the process stops exactly between two renames
+``xfemslip.io.folder``: the process stops exactly between two renames
 until the signal arrives) and at a sweep of delays over the write phase; two
 runs race into one folder; disks fill; folders are read-only.  After each
 fault the folder is compared, file by file, with the complete earlier and the
@@ -25,9 +25,9 @@ from click.testing import CliRunner
 
 from tests.faults import harness
 from xfemslip.cli import cli
-from xfemslip.writers import folder as folder_module
-from xfemslip.writers.fileset import replace_files
-from xfemslip.writers.lock import folder_lock
+from xfemslip.io import folder as folder_module
+from xfemslip.io.fileset import replace_files
+from xfemslip.io.lock import folder_lock
 
 
 @pytest.fixture(scope="module")

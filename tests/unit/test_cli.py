@@ -138,7 +138,8 @@ class FakeSimulation:
         self.calls = []
 
     def load_case(self, path):
-        return types.SimpleNamespace(name="tiny", path=Path(path))
+        output = types.SimpleNamespace(directory=Path("out/tiny"))
+        return types.SimpleNamespace(name="tiny", path=Path(path), output=output)
 
     def run_case(self, spec, out_dir=None, *, overwrite=False):
         self.calls.append((spec, out_dir, overwrite))
@@ -149,7 +150,7 @@ class FakeSimulation:
         if isinstance(self.outcome, BaseException):
             raise self.outcome
         return types.SimpleNamespace(
-            out_dir=Path(out_dir or "out/tiny"),
+            out_dir=Path(out_dir),
             converged=True,
             load_steps=1,
             newton_iterations=4,
@@ -177,7 +178,8 @@ def test_run_success_prints_summary(runner, fake, case_file):
         + str(Path("out/tiny"))
     ]
     ((spec, out_dir, overwrite),) = fake.calls
-    assert spec.name == "tiny" and out_dir is None and overwrite is False
+    # without -o: output.directory of the case
+    assert spec.name == "tiny" and out_dir == Path("out/tiny") and overwrite is False
 
 
 def test_run_passes_output_and_overwrite(runner, fake, case_file, tmp_path):

@@ -1,4 +1,4 @@
-"""The interaction integral (xfemslip.jintegral) against known fields.
+"""The interaction integral (xfemslip.post.jintegral) against known fields.
 
 - The Williams auxiliary fields: gradient by finite differences of the
   displacement, stress by Hooke's law of that gradient, traction-free faces.
@@ -18,10 +18,10 @@ import numpy as np
 import pytest
 
 from xfemslip import closed_form as cf
-from xfemslip import jintegral as J
 from xfemslip import verify as V
 from xfemslip.case import load_case
 from xfemslip.material import elasticity_matrix
+from xfemslip.post import jintegral as J
 from xfemslip.simulation import build_model
 
 E, NU = V.E, V.NU
@@ -223,7 +223,7 @@ def test_tip_in_the_reservoir_uses_the_reservoir_material(monkeypatch, caplog):
     n = model.ip.n
     zero = _Tractions(np.zeros(n), np.zeros(n))
     u = np.zeros(model.problem.n_dofs)
-    caplog.set_level("WARNING", logger="xfemslip.jintegral")
+    caplog.set_level("WARNING", logger="xfemslip.post.jintegral")
     out = J.stress_intensity_factors(model, u, zero, radius_cells=3.0)
     k = [t for t in out if t.end == tip.end][0]
     assert k.k_i == pytest.approx(K1, rel=1e-4)

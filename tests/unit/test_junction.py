@@ -311,7 +311,7 @@ def test_network_figure_is_written(tmp_path):
 
     from xfemslip.case import loads_case
     from xfemslip.plot import figure_network, plot_results
-    from xfemslip.plot_data import read_result
+    from xfemslip.plot_data import figure_data
     from xfemslip.simulation import run_case
 
     text = _case_text([MAIN, [[0.47, 0.53], [0.47, 0.86]]], n=16)
@@ -322,7 +322,7 @@ def test_network_figure_is_written(tmp_path):
     )
     assert [p.name for p in written] == ["network.png"]
     assert written[0].stat().st_size > 10_000
-    data = read_result(tmp_path / "out")
+    data = figure_data(tmp_path / "out")
     fig = figure_network(data)
     slip_axes = fig.axes[0]
     top = max(float(np.abs(f.slip).max()) for f in data.fractures)

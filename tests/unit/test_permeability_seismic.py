@@ -9,14 +9,14 @@ import numpy as np
 import pytest
 
 from xfemslip import closed_form as cf
-from xfemslip.permeability import ApertureLaw, oda_tensor, transmissivity
-from xfemslip.seismic import (
+from xfemslip.post.metrics import point_stretches
+from xfemslip.post.permeability import ApertureLaw, oda_tensor, transmissivity
+from xfemslip.post.seismic import (
     moment_magnitude,
     moment_per_length,
     shear_modulus,
     stress_drop,
 )
-from xfemslip.sweep_run import point_stretches
 
 
 def test_uniform_slip_dilates_by_slip_times_tan_psi_until_it_stops():

@@ -19,7 +19,7 @@ from xfemslip.cli import cli
 from xfemslip.closed_form import angle_to_sigma1, principal
 from xfemslip.errors import UsageError
 from xfemslip.plot import KINDS, auto_scale, figure_slip, plot_results
-from xfemslip.plot_data import FractureData, _piece_outlines, read_result
+from xfemslip.plot_data import FractureData, _piece_outlines, figure_data
 from xfemslip.plot_mohr import _circle_point
 from xfemslip.screen import plane_stresses
 
@@ -66,7 +66,7 @@ def test_run_plot_writes_every_figure_as_png_and_pdf(two_runs):
 
 
 def test_slip_figure_draws_the_result_data(two_runs):
-    results = [read_result(out / "result.h5") for out in two_runs]
+    results = [figure_data(out / "result.h5") for out in two_runs]
     assert [r.label for r in results] == ["angle=45", "angle=63"]
     fig = figure_slip(results)
     lines = [ln for ln in fig.axes[0].lines if ln.get_linestyle() == "-"]
@@ -92,7 +92,7 @@ def test_plot_command_several_results(two_runs, tmp_path, runner):
 
 
 def test_deformed_mesh_uses_the_split_mesh(two_runs):
-    data = read_result(two_runs[0] / "result.h5")
+    data = figure_data(two_runs[0] / "result.h5")
     assert data.vis_edges is not None and data.vis_points.shape[0] > len(data.points)
     # the jump: the vis mesh holds points at the same place with different
     # displacements (one copy per side of the fracture)
@@ -142,7 +142,7 @@ def test_piece_outlines_drop_inner_edges_of_one_side():
 
 
 def test_auto_scale(two_runs):
-    data = read_result(two_runs[0] / "result.h5")
+    data = figure_data(two_runs[0] / "result.h5")
     size = 1.0
     slip = np.abs(data.fractures[0].slip).max()
     u_max = np.abs(data.displacement).max()
@@ -166,12 +166,12 @@ def test_mohr_circle_point_is_the_plane_traction(stress):
         assert y == pytest.approx(abs(float(tau)), abs=1e-6 * s1)
 
 
-def test_read_result_errors(tmp_path):
+def test_figure_data_errors(tmp_path):
     with pytest.raises(UsageError, match="no such file"):
-        read_result(tmp_path / "result.h5")
+        figure_data(tmp_path / "result.h5")
     (tmp_path / "result.h5").write_text("not hdf5")
     with pytest.raises(UsageError, match="not a readable result.h5"):
-        read_result(tmp_path)
+        figure_data(tmp_path)
     with pytest.raises(UsageError, match="2 labels for 1 results"):
         plot_results([tmp_path], tmp_path / "f", labels=["a", "b"])
 

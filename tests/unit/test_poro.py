@@ -258,14 +258,14 @@ def test_deplete_writes_tables_and_fields(runner, tmp_path):
 def test_plots_and_screen_use_the_effective_stress(runner, tmp_path):
     """The Mohr figure reads the effective normal traction, and ``screen``
     defaults to the case's far-field pore pressure (region "all": p0 + dp)."""
-    from xfemslip.plot_data import read_result
+    from xfemslip.plot_data import figure_data
 
     extra = FRACTURE + PORE.replace('region = "reservoir"', 'region = "all"')
     case = tmp_path / "all.toml"
     case.write_text(BASE.format(extra=extra))
     out = tmp_path / "out"
     assert runner.invoke(cli, ["run", str(case), "-o", str(out), "-q"]).exit_code == 0
-    data = read_result(out / "result.h5")
+    data = figure_data(out / "result.h5")
     assert data.pore_pressure == 10.0e6
     with h5py.File(out / "result.h5", "r") as f:
         eff = f["fractures/0/effective_normal_traction"][()]

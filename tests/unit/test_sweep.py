@@ -17,6 +17,7 @@ from click.testing import CliRunner
 from xfemslip.case.tables import Table
 from xfemslip.cli import cli
 from xfemslip.errors import CaseError
+from xfemslip.post.metrics import arc_extent, slipping_length
 from xfemslip.sweep import (
     case_id,
     expand_range,
@@ -25,7 +26,7 @@ from xfemslip.sweep import (
     parse_key_path,
     set_key_path,
 )
-from xfemslip.sweep_run import arc_extent, run_sweep, slipping_length
+from xfemslip.sweep_run import run_sweep
 from xfemslip.sweep_vary import _check_overlaps, case_count, read_vary
 
 # A small, fast case: 10 x 10 cells, a 45-degree fracture that slips (f = 0.1).

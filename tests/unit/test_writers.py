@@ -13,10 +13,10 @@ import pytest
 
 from xfemslip import __version__
 from xfemslip.errors import OutputError
-from xfemslip.writers import FractureFields, StepFields, VisMesh
-from xfemslip.writers.atomic import atomic_path
-from xfemslip.writers.hdf5 import write_result
-from xfemslip.writers.vtu import write_bulk, write_fractures, write_pvd
+from xfemslip.io.atomic import atomic_path
+from xfemslip.io.hdf5 import write_result
+from xfemslip.io.vtu import write_bulk, write_fractures, write_pvd
+from xfemslip.post.fields import FractureFields, StepFields, VisMesh
 
 FRACTURE_UNITS = {
     "s": "m",

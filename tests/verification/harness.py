@@ -10,9 +10,9 @@ import math
 from dataclasses import dataclass, field
 from pathlib import Path
 
-import h5py
 import numpy as np
 
+import xfemslip
 from xfemslip.case import load_case
 from xfemslip.conventions import OPEN, SLIP, STICK  # noqa: F401 (re-exported)
 from xfemslip.simulation import run_case
@@ -122,22 +122,17 @@ def case_text(
 
 
 def read_result(path: Path, summary=None) -> Result:
-    """Read the final-step datasets of a result.h5."""
-    with h5py.File(path, "r") as h:
-        frs = []
-        i = 0
-        while f"fractures/{i}" in h:
-            frs.append({k: h[f"fractures/{i}/{k}"][()] for k in FRACTURE_KEYS})
-            i += 1
-        return Result(
-            summary=summary,
-            attrs=dict(h.attrs),
-            points=h["mesh/points"][()],
-            cells=h["mesh/cells"][()],
-            displacement=h["fields/displacement"][()],
-            stress=h["fields/stress"][()],
-            fractures=frs,
-        )
+    """The final step of a result.h5 (read by xfemslip.read_result)."""
+    read = xfemslip.read_result(path)
+    return Result(
+        summary=summary,
+        attrs=read.attrs,
+        points=read.points,
+        cells=read.cells,
+        displacement=read.displacement,
+        stress=read.stress,
+        fractures=[{k: getattr(f, k) for k in FRACTURE_KEYS} for f in read.fractures],
+    )
 
 
 def run_text(text: str, folder: Path, name: str = "case") -> Result:

@@ -21,7 +21,7 @@ import pytest
 
 from xfemslip import closed_form as cf
 from xfemslip import verify as V
-from xfemslip.jintegral import stress_intensity_factors
+from xfemslip.post.jintegral import stress_intensity_factors
 
 pytestmark = pytest.mark.verification
 

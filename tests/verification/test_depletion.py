@@ -39,7 +39,8 @@ from xfemslip.closed_form_depletion import (
 )
 from xfemslip.depletion import critical_depletion
 from xfemslip.poro import fluid_pressure
-from xfemslip.simulation import build_model, newton_solver, step_fields
+from xfemslip.post.fields import step_fields
+from xfemslip.simulation import build_model, newton_solver
 
 pytestmark = pytest.mark.verification
 

@@ -36,7 +36,7 @@ import pytest
 
 from xfemslip import peer
 from xfemslip.case import loads_case
-from xfemslip.post import fracture_fields
+from xfemslip.post.fields import fracture_fields
 from xfemslip.simulation import build_model, newton_solver
 
 pytestmark = pytest.mark.verification

@@ -110,7 +110,7 @@ def reported_errors(debug: bool) -> Iterator[None]:
         if debug:
             click.secho(traceback.format_exc().rstrip(), err=True, dim=True)
         term = isinstance(err, Terminated)
-        # the notes say what each output folder holds (xfemslip.writers.folder)
+        # the notes say what each output folder holds (xfemslip.io.folder)
         left = "; ".join(getattr(err, "__notes__", ())) or (
             "no partial file is left under a final name"
         )

@@ -19,18 +19,7 @@ from xfemslip.cli.common import (
     load_case_file,
     reported_errors,
 )
-from xfemslip.errors import OutputError, UsageError
-
-
-def _write_text(path: Path, text: str) -> None:
-    """Write ``text`` atomically (no partial file under the final name)."""
-    from xfemslip.writers.atomic import atomic_path
-
-    try:
-        with atomic_path(path) as tmp:
-            Path(tmp).write_text(text, encoding="utf-8")
-    except OSError as exc:
-        raise OutputError(f"{path}: cannot write: {exc.strerror or exc}") from None
+from xfemslip.errors import UsageError
 
 
 @click.command()
@@ -70,6 +59,7 @@ def dfn(case, csv_path, include_inline, plot, result, summary, debug) -> None:
     with reported_errors(debug):
         spec = load_case_file(case)
         from xfemslip.dfn import network_stats, segments_csv_text
+        from xfemslip.io.csv import write_text
 
         (x0, y0), (w, h) = spec.origin, spec.size
         box = (x0, x0 + w, y0, y0 + h)
@@ -88,7 +78,7 @@ def dfn(case, csv_path, include_inline, plot, result, summary, debug) -> None:
                 "[[fractures]] too)"
             )
         if csv_path is not None:
-            _write_text(csv_path, segments_csv_text(chosen))
+            write_text(csv_path, segments_csv_text(chosen))
             click.echo(f"{len(chosen)} fractures -> {csv_path}")
         if plot is not None:
             from xfemslip.dfn_plot import figure_network, save

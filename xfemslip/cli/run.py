@@ -46,7 +46,8 @@ def run(
         spec = load_case_file(case)
         from xfemslip.simulation import run_case
 
-        summary = run_case(spec, output, overwrite=overwrite)
+        out_dir = output if output is not None else spec.output.directory
+        summary = run_case(spec, out_dir, overwrite=overwrite)
         status = "converged" if summary.converged else "did NOT converge"
         click.echo(
             f"{spec.name}: {status} in {summary.load_steps} step(s), "

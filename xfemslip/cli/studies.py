@@ -9,7 +9,6 @@ matplotlib is imported only when a figure is drawn, Dask only with
 
 from __future__ import annotations
 
-import csv
 import os
 import sys
 from pathlib import Path
@@ -397,18 +396,14 @@ def _screen_inputs(case, stress, friction, cohesion, angles):
 
 
 def _write_screen_csv(path: Path, table: dict) -> None:
-    from xfemslip.writers.atomic import atomic_path
+    from xfemslip.io.csv import write_csv
 
     names = list(table)
-    with atomic_path(path) as tmp, open(tmp, "w", newline="", encoding="utf-8") as fh:
-        writer = csv.writer(fh)
-        writer.writerow(names)
-        for i in range(len(table[names[0]])):
-            writer.writerow(
-                [
-                    f"{table[n][i]:.9g}"
-                    if n != "slips"
-                    else str(bool(table[n][i])).lower()
-                    for n in names
-                ]
-            )
+    rows = (
+        [
+            f"{table[n][i]:.9g}" if n != "slips" else str(bool(table[n][i])).lower()
+            for n in names
+        ]
+        for i in range(len(table[names[0]]))
+    )
+    write_csv(path, names, rows)

@@ -1,14 +1,14 @@
 """ParaView output via meshio: ``result.vtu``, ``fractures.vtu``, ``result.pvd``.
 
 - ``write_bulk``: the bulk mesh with cut elements split along the fractures
-  (:class:`~xfemslip.writers.VisMesh`), so that "Warp By Vector" on the point
+  (:class:`~xfemslip.post.fields.VisMesh`), so that "Warp By Vector" on the point
   field ``displacement`` shows the jump.  Points and displacement are padded to
   3D with z = 0, as ParaView expects.
 - ``write_fractures``: every fracture as a polyline through its contact
   integration points, with the contact fields as point data.
 - ``write_pvd``: a ParaView collection (time series over load steps).
 
-Every file is written atomically (:mod:`xfemslip.writers.atomic`).  meshio is
+Every file is written atomically (:mod:`xfemslip.io.atomic`).  meshio is
 given ``file_format="vtu"`` explicitly because the temporary name has another
 suffix.  Given a ``run_id``, each file carries it: the VTU files as the field
 data array ``run_id`` (1,) int64, the PVD as a comment.
@@ -26,8 +26,8 @@ from xml.sax.saxutils import quoteattr
 import meshio
 import numpy as np
 
-from xfemslip.writers import FractureFields, VisMesh
-from xfemslip.writers.atomic import atomic_path, refuse_non_finite
+from xfemslip.io.atomic import atomic_path, refuse_non_finite
+from xfemslip.post.fields import FractureFields, VisMesh
 
 logger = logging.getLogger(__name__)
 

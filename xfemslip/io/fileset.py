@@ -14,7 +14,7 @@ from pathlib import Path
 
 from xfemslip import interrupt
 from xfemslip.errors import OutputError
-from xfemslip.writers.lock import folder_lock, reason, remove_tree, sibling
+from xfemslip.io.lock import folder_lock, reason, remove_tree, sibling
 
 
 def replace_files(writes: Mapping[Path, Callable[[Path], None] | None]) -> list[Path]:

@@ -2,14 +2,14 @@
 
 The rule (``output-format.md``, *Output folders*), for every command that
 writes a set of files into a folder ``DIR`` (``run``, ``deplete``, a sweep
-member); sets of single files are :mod:`xfemslip.writers.fileset`:
+member); sets of single files are :mod:`xfemslip.io.fileset`:
 
 1. **Lock.** The process takes an exclusive ``flock`` on ``.DIR.lock`` beside
    ``DIR`` (the file holds its pid) and keeps it until the set is in place.  A
    second process is refused at once (``UsageError``, exit 2) naming that pid.
    The kernel drops the lock of a process that dies, so a stale lock file
    never blocks; the holder deletes it when it is done
-   (:mod:`xfemslip.writers.lock`).
+   (:mod:`xfemslip.io.lock`).
 2. **Leftovers.** A lock file found with the lock free names a killed
    process; holding the lock, the process deletes what that one left beside
    ``DIR`` (``.DIR.tmp-<pid>``, ``.DIR.old-<pid>``) and logs a warning naming
@@ -63,7 +63,7 @@ from pathlib import Path
 
 from xfemslip import interrupt
 from xfemslip.errors import OutputError, UsageError
-from xfemslip.writers.lock import folder_lock, reason, remove_tree, sibling
+from xfemslip.io.lock import folder_lock, reason, remove_tree, sibling
 
 logger = logging.getLogger(__name__)
 

@@ -28,9 +28,9 @@ who think compression-positive; it is *named* so and never replaces
 
 When ``steps`` is empty (the first load step did not converge) the file holds
 the mesh and the root attributes only: no ``/fields``, ``/fractures`` or
-``/steps``.  The file is written atomically (:mod:`xfemslip.writers.atomic`) and
+``/steps``.  The file is written atomically (:mod:`xfemslip.io.atomic`) and
 carries no timestamps, so the same input gives the same bytes.  The root
-attribute ``run_id`` (:func:`xfemslip.writers.run_id`, given by the caller)
+attribute ``run_id`` (:func:`xfemslip.post.result.run_id`, given by the caller)
 is the id that every file of its output set carries.
 """
 
@@ -46,8 +46,8 @@ import numpy as np
 
 from xfemslip import __version__, interrupt
 from xfemslip.conventions import STATE_CODES
-from xfemslip.writers import FractureFields, StepFields
-from xfemslip.writers.atomic import atomic_path, refuse_non_finite
+from xfemslip.io.atomic import atomic_path, refuse_non_finite
+from xfemslip.post.fields import FractureFields, StepFields
 
 logger = logging.getLogger(__name__)
 

@@ -93,8 +93,9 @@ def oda_tensor(fractures, area: float, matrix_permeability: float = 0.0):
     """Equivalent permeability tensor (2, 2) [m^2] of a block (module doc).
 
     fractures : iterable of (stretches (K,) [m], tangents (K, 2), apertures
-    (K,) [m]): the length each contact point stands for (the metrics'
-    point_stretches), the unit tangent there, and the hydraulic aperture.
+    (K,) [m]): the length each contact point stands for
+    (:func:`xfemslip.post.metrics.point_stretches`), the unit tangent there,
+    and the hydraulic aperture.
     """
     k = matrix_permeability * np.eye(2)
     for w, t, a in fractures:

@@ -1,19 +1,78 @@
-"""Post-processing into the output sign convention (tension positive).
+"""The fields of a converged load step, in the output sign convention.
+
+The containers (``StepFields``, ``FractureFields``, ``VisMesh``) hold plain
+arrays, tension positive (``output-format.md``); ``step_fields`` fills them
+from a model and a converged step, and the writers (:mod:`xfemslip.io`) and
+:class:`xfemslip.post.result.Result` carry them.
 
 Stress: sigma = sigma0 + D eps (- alpha (p - p0) I with pore pressure, see
 xfemslip.poro), averaged over each element (sub-cells included
 for enriched elements).  Out-of-plane stress in plane strain:
 sigma_zz = nu (sigma_xx + sigma_yy) (the in-situ sigma_zz is taken as
 nu (sigma0_xx + sigma0_yy), consistent with plane strain); zero in plane stress.
-Fracture fields: slip = [[u]] . t, opening = [[u]] . n, p_N, p_T, state codes
+Fracture fields: slip = [[u]] . t, opening = [[u]] . n, p_N, p_T and the state
 codes of :mod:`xfemslip.conventions`.
 """
 
 from __future__ import annotations
 
+from dataclasses import dataclass, field
+
 import numpy as np
 
-from xfemslip.writers import FractureFields, VisMesh
+from xfemslip.poro import fluid_pressure
+
+
+@dataclass
+class FractureFields:
+    """Contact fields of one fracture at its K integration points, sorted by s."""
+
+    s: np.ndarray  # (K,) arc length from the first point [m]
+    points: np.ndarray  # (K, 2) [m]
+    slip: np.ndarray  # (K,) [[u]].t [m]
+    opening: np.ndarray  # (K,) [[u]].n [m]
+    normal_traction: np.ndarray  # (K,) p_N [Pa], compression negative
+    shear_traction: np.ndarray  # (K,) p_T along t [Pa]
+    state: np.ndarray  # (K,) int8: 0 open, 1 stick, 2 slip
+    # with [pore_pressure] only (xfemslip.poro); normal_traction is then total
+    fluid_pressure: np.ndarray | None = None  # (K,) p_f [Pa]
+    effective_normal_traction: np.ndarray | None = None  # (K,) p_N + p_f [Pa]
+
+
+@dataclass
+class StepFields:
+    """Fields of one converged load step."""
+
+    step: int  # 1-based
+    load_factor: float  # lambda in (0, 1]
+    newton_iterations: int
+    displacement: np.ndarray  # (N, 2) [m]
+    # (None for a step other than the last one read back from result.h5,
+    # which stores them for the final step only)
+    stress: np.ndarray | None  # (M, 3) [Pa] element average sxx, syy, sxy
+    stress_zz: np.ndarray | None  # (M,) [Pa]
+    principal_stress: np.ndarray | None  # (M, 2) [Pa] s_max, s_min
+    fractures: list[FractureFields] = field(default_factory=list)
+    # with [pore_pressure] only (xfemslip.poro)
+    effective_stress: np.ndarray | None = None  # (M, 3) sigma + alpha p I [Pa]
+    pore_pressure: np.ndarray | None = None  # (M,) [Pa]
+
+
+@dataclass
+class VisMesh:
+    """Bulk mesh for ParaView with cut elements split along the fractures.
+
+    Uncut elements are quads on shared points; each cut element is replaced by
+    triangles on points of its own, so the displacement can jump across the
+    fracture.  ``*_cell`` maps every vis cell to its bulk element (for cell data).
+    """
+
+    points: np.ndarray  # (P, 2) [m]
+    displacement: np.ndarray  # (P, 2) [m]
+    quads: np.ndarray  # (Q, 4) int64
+    quad_cell: np.ndarray  # (Q,) int64
+    triangles: np.ndarray  # (T, 3) int64
+    triangle_cell: np.ndarray  # (T,) int64
 
 
 def cell_strain(mesh, bulk, u) -> np.ndarray:
@@ -155,3 +214,65 @@ def vis_mesh(mesh, ec, bulk, u) -> VisMesh:
         triangles=triangles,
         triangle_cell=cell.astype(np.int64),
     )
+
+
+def step_fields(model, r) -> StepFields:
+    """The fields of the converged step ``r`` (a ``StepResult``) of ``model``
+    (a :class:`xfemslip.simulation.Model`)."""
+    spec = model.spec
+    mats, pore = model.materials, model.pore
+    hetero = spec.reservoir is not None
+    biot_p = None
+    if pore is not None:
+        p = pore.cell_pressure(r.load_factor)
+        biot_p = (pore.biot * pore.initial, pore.biot * p)
+    stress, szz, principal = bulk_fields(
+        model.mesh,
+        model.bulk,
+        mats.D if hetero else model.D,
+        r.u,
+        spec.loading.initial_stress,
+        mats.nu if hetero else spec.material.nu,
+        spec.material.model,
+        cell_material=mats.cell if hetero else None,
+        biot_p=biot_p,
+    )
+    extra = {}
+    fluid = None
+    if pore is not None:
+        extra = {
+            "effective_stress": stress + biot_p[1][:, None] * [1.0, 1.0, 0.0],
+            "pore_pressure": p,
+        }
+        fluid = fluid_pressure(model.ip, pore, r.load_factor)
+    n_std = 2 * model.mesh.n_nodes
+    return StepFields(
+        step=r.step,
+        load_factor=r.load_factor,
+        newton_iterations=r.iterations,
+        displacement=r.u[:n_std].reshape(-1, 2).copy(),
+        stress=stress,
+        stress_zz=szz,
+        principal_stress=principal,
+        fractures=fracture_fields(model.ip, r.contact, len(model.fractures), fluid),
+        **extra,
+    )
+
+
+def first_non_finite(steps) -> tuple[int, str] | None:
+    """(index, field name) of the first of ``steps`` (StepFields) holding NaN
+    or inf, or None: such a step is never written."""
+    for index, f in enumerate(steps):
+        arrays = {
+            "displacement": f.displacement,
+            "stress": f.stress,
+            "stress_zz": f.stress_zz,
+            "principal_stress": f.principal_stress,
+        }
+        for i, fr in enumerate(f.fractures):
+            for name in ("slip", "opening", "normal_traction", "shear_traction"):
+                arrays[f"fractures[{i}].{name}"] = getattr(fr, name)
+        for name, value in arrays.items():
+            if not np.all(np.isfinite(value)):
+                return index, name
+    return None

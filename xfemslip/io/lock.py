@@ -2,7 +2,7 @@
 
 ``folder_lock(final)`` takes an exclusive ``flock`` on ``.NAME.lock`` beside
 ``final`` and keeps it while the set is written (rule 1 and 2 of
-:mod:`xfemslip.writers.folder`).  A second process is refused at once
+:mod:`xfemslip.io.folder`).  A second process is refused at once
 (``UsageError``, exit 2) naming the holder's pid.  The kernel drops the lock
 of a process that dies, so a stale lock file never blocks: it names the
 killed process, whose staging folder or temporary files beside ``final``

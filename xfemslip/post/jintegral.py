@@ -61,7 +61,7 @@ import numpy as np
 
 from xfemslip.closed_form import kolosov
 from xfemslip.poro import HOST, RESERVOIR
-from xfemslip.post import fracture_fields
+from xfemslip.post.fields import fracture_fields
 from xfemslip.regions import in_region
 
 logger = logging.getLogger(__name__)

@@ -31,7 +31,7 @@ def shear_modulus(E: float, nu: float) -> float:
 
 def moment_per_length(mu: float, stretch, slip) -> float:
     """M0' = mu int |s| ds [N m / m]; ``stretch`` (K,) is the length [m] each
-    contact point stands for (the metrics' point_stretches)."""
+    contact point stands for (:func:`xfemslip.post.metrics.point_stretches`)."""
     return mu * float(np.sum(np.asarray(stretch, float) * np.abs(slip)))
 
 
