@@ -47,8 +47,8 @@ import h5py
 import numpy as np
 from xfem_process import timed_run
 
-from xfemslip import closed_form as cf
-from xfemslip import verify as V
+from xfemslip.reference import closed_form as cf
+from xfemslip.reference import verify as V
 from xfemslip.case.fractures import TIP_KINDS
 from xfemslip.errors import XfemslipError
 

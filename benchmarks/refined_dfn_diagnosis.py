@@ -20,8 +20,8 @@ import sys
 import numpy as np
 import scipy.sparse.linalg as spla
 
-from xfemslip import solver as S
-from xfemslip.assembly import coo_block
+from xfemslip.solve import newton as S
+from xfemslip.fem.assembly import coo_block
 from xfemslip.case import load_case
 from xfemslip.conventions import SLIP
 from xfemslip.simulation import build_model, newton_solver

@@ -181,7 +181,7 @@ def enriched_footprint(spec, mesh, fractures, cand) -> Footprint:
     their slots exactly (the cells around each enriched node, as
     enrichment.build_enriched_cells takes them), the quadrature points from
     the fracture pieces per cell (QP_CELL ...)."""
-    from xfemslip.enrichment import HEAVISIDE
+    from xfemslip.fem.enrichment import HEAVISIDE
     from xfemslip.kernels import choose
 
     nx = mesh.nx

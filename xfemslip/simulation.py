@@ -17,18 +17,16 @@ from pathlib import Path
 import numpy as np
 
 from xfemslip import __version__, interrupt, kernels
-from xfemslip.assembly import BulkSystem, assemble_bulk
-from xfemslip.boundary import dirichlet, hold_enriched, traction_load
-from xfemslip.contact import ContactSet, build_contact
+from xfemslip.contact.interface import ContactSet, build_contact
+from xfemslip.contact.predictor import stress_increment
 from xfemslip.conventions import OPEN, SLIP, STATE_CODES, STICK
-from xfemslip.enrichment import EnrichedCells, build_enriched_cells, find_candidates
 from xfemslip.errors import ConvergenceError, GeometryError
-from xfemslip.geometry import build_fractures
-from xfemslip.io.results import run_folder, write_results
-from xfemslip.material import elasticity_matrix
-from xfemslip.memory import check_memory, enriched_footprint, model_footprint
-from xfemslip.mesh import Mesh, build_mesh
-from xfemslip.poro import (
+from xfemslip.fem.assembly import BulkSystem, assemble_bulk
+from xfemslip.fem.boundary import dirichlet, hold_enriched, traction_load
+from xfemslip.fem.enrichment import EnrichedCells, build_enriched_cells, find_candidates
+from xfemslip.fem.material import elasticity_matrix
+from xfemslip.fem.mesh import Mesh, build_mesh
+from xfemslip.fem.poro import (
     Materials,
     PorePressure,
     body_load,
@@ -37,11 +35,13 @@ from xfemslip.poro import (
     fracture_load,
     make_contact_effective,
 )
+from xfemslip.fem.quadrature import InterfacePoints, interface_points
+from xfemslip.geometry.fracture import build_fractures
+from xfemslip.io.results import run_folder, write_results
+from xfemslip.memory import check_memory, enriched_footprint, model_footprint
 from xfemslip.post.fields import first_non_finite, step_fields, vis_mesh
 from xfemslip.post.result import Result, run_id
-from xfemslip.predictor import stress_increment
-from xfemslip.quadrature import InterfacePoints, interface_points
-from xfemslip.solver import NewtonSolver, Problem
+from xfemslip.solve.newton import NewtonSolver, Problem
 
 logger = logging.getLogger(__name__)
 
@@ -134,7 +134,7 @@ def build_model(spec) -> Model:
     F = traction_load(
         mesh, spec.boundary, spec.loading, ec, cand, bulk.dofmap, fractures
     )
-    if pore is not None:  # Biot body load and fracture fluid load (xfemslip.poro)
+    if pore is not None:  # Biot body load and fracture fluid load (xfemslip.fem.poro)
         make_contact_effective(contact, pore)
         F = F + body_load(mesh, bulk, pore, ec) + fracture_load(contact, ip, pore)
     problem = Problem(

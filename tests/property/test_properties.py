@@ -19,11 +19,11 @@ from hypothesis import strategies as st
 
 from xfemslip.case import loads_case
 from xfemslip.conventions import OPEN, SLIP, STICK
+from xfemslip.fem.quadrature import cell_subtriangles, polygon_area, split_polygon
 from xfemslip.kernels.contact import coulomb_return_map
 from xfemslip.kernels.shape import q4_shape
-from xfemslip.quadrature import cell_subtriangles, polygon_area, split_polygon
 from xfemslip.simulation import build_model
-from xfemslip.solver import NewtonSolver
+from xfemslip.solve.newton import NewtonSolver
 
 TOL = 1e-10
 unit = st.floats(0.0, 1.0, allow_nan=False)

@@ -186,7 +186,7 @@ def test_output_contract(runs, case):
         scale = np.max(np.abs(stress))
         np.testing.assert_allclose(principal, eig, rtol=0, atol=1e-9 * scale)
         szz = f["fields/stress_zz"][()]
-        if "pore_pressure" in doc:  # effective stress, per-cell nu (xfemslip.poro)
+        if "pore_pressure" in doc:  # effective stress, per-cell nu (xfemslip.fem.poro)
             check_poro_fields(f, doc, points, cells, scale)
         elif (
             doc["material"]["model"] == "plane_strain"

@@ -9,7 +9,7 @@ switches, the load-step cuts and ping-pong freezes, and max |slip|.
 References (all independent of the XFEM code):
 
 - ``crack``: a straight crack of half-length A in a 2 m box whose edges get the
-  exact displacements of the cracked infinite plane (``xfemslip.closed_form``,
+  exact displacements of the cracked infinite plane (``xfemslip.reference.closed_form``,
   Westergaard mode II with friction and cohesion); the reference is the
   closed-form slip profile, compared as a relative L2 error along the crack;
   a crack that the closed form says sticks must show no SLIP point;
@@ -29,12 +29,12 @@ from pathlib import Path
 
 import numpy as np
 
-from xfemslip import closed_form as cf
 from xfemslip.case import loads_case
 from xfemslip.conventions import OPEN, SLIP, STICK  # noqa: F401 (re-exported)
 from xfemslip.errors import ConvergenceError
+from xfemslip.reference import closed_form as cf
 from xfemslip.simulation import build_model
-from xfemslip.solver import NewtonSolver
+from xfemslip.solve.newton import NewtonSolver
 
 ROOT = Path(__file__).resolve().parents[2]
 RESERVOIR = ROOT / "cases" / "reservoir_depletion.toml"

@@ -30,9 +30,9 @@ from matrix import (
     window_reference,
 )
 
-from xfemslip import closed_form as cf
 from xfemslip.case import loads_case
 from xfemslip.errors import GeometryError
+from xfemslip.reference import closed_form as cf
 from xfemslip.simulation import build_model
 
 pytestmark = pytest.mark.verification

@@ -30,9 +30,9 @@ from matrix import (
     solve,
 )
 
-import xfemslip.solver as solver_module
+import xfemslip.solve.newton as solver_module
 from xfemslip.errors import ConvergenceError
-from xfemslip.solver import _cycling, _frozen_law
+from xfemslip.solve.newton import _cycling, _frozen_law
 
 pytestmark = pytest.mark.verification
 

@@ -62,7 +62,7 @@ def sweep_member(path=SHIPPED_DFN, index=0, **keys) -> str:
 
     import tomli_w
 
-    from xfemslip.sweep import load_sweep, parse_key_path, set_key_path
+    from xfemslip.studies.sweep import load_sweep, parse_key_path, set_key_path
 
     document = tomllib.loads(load_sweep(path).cases[index].text)
     for key, value in keys.items():

@@ -174,9 +174,9 @@ def estimates(path) -> list[float]:
     limit applied."""
     from xfemslip import memory
     from xfemslip.case import load_case
-    from xfemslip.enrichment import find_candidates
-    from xfemslip.geometry import build_fractures
-    from xfemslip.mesh import build_mesh
+    from xfemslip.fem.enrichment import find_candidates
+    from xfemslip.fem.mesh import build_mesh
+    from xfemslip.geometry.fracture import build_fractures
     from xfemslip.simulation import build_model
 
     spec = load_case(path)

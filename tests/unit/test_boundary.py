@@ -1,4 +1,4 @@
-"""Tests of xfemslip.boundary: edge tractions, prescribed displacements, pins.
+"""Tests of xfemslip.fem.boundary: edge tractions, prescribed displacements, pins.
 
 References: closed-form edge loads (sigma . n_out times the edge length, split
 evenly between the two nodes of each element edge), the work of the load on a
@@ -13,14 +13,14 @@ from types import SimpleNamespace
 import numpy as np
 import pytest
 
-from xfemslip.assembly import assemble_bulk
-from xfemslip.boundary import dirichlet, rigid_body_pins, traction_load
 from xfemslip.case import BoundarySpec, EdgeSpec, loads_case
-from xfemslip.enrichment import HEAVISIDE, build_enriched_cells, find_candidates
 from xfemslip.errors import GeometryError
-from xfemslip.geometry import build_fractures
-from xfemslip.material import elasticity_matrix
-from xfemslip.mesh import build_mesh
+from xfemslip.fem.assembly import assemble_bulk
+from xfemslip.fem.boundary import dirichlet, rigid_body_pins, traction_load
+from xfemslip.fem.enrichment import HEAVISIDE, build_enriched_cells, find_candidates
+from xfemslip.fem.material import elasticity_matrix
+from xfemslip.fem.mesh import build_mesh
+from xfemslip.geometry.fracture import build_fractures
 from xfemslip.simulation import build_model
 
 N = 8  # 8 x 8 cells on the unit square, h = 0.125

@@ -1,4 +1,4 @@
-"""Tests of xfemslip.branch: the four near-tip functions, their gradients and jumps.
+"""Tests of xfemslip.fem.branch: the four near-tip functions, their gradients and jumps.
 
 References: closed forms sqrt(r) {sin, cos}(theta/2) [sin theta] in the tip
 frame, central finite differences for the gradients.
@@ -11,10 +11,10 @@ import math
 import numpy as np
 import pytest
 
-from xfemslip.branch import b1_jump, branch_functions, tip_frame
 from xfemslip.case import FractureSpec
-from xfemslip.geometry import build_fracture
-from xfemslip.mesh import build_mesh
+from xfemslip.fem.branch import b1_jump, branch_functions, tip_frame
+from xfemslip.fem.mesh import build_mesh
+from xfemslip.geometry.fracture import build_fracture
 
 
 def _fracture(points=((0.2, 0.3), (0.8, 0.6))):

@@ -9,8 +9,8 @@ from click.testing import CliRunner
 
 from xfemslip.case import describe, load_case
 from xfemslip.cli import cli
-from xfemslip.dfn import segments_csv_text
 from xfemslip.errors import CaseError
+from xfemslip.geometry.dfn import segments_csv_text
 
 HEAD = """
 [domain]
@@ -303,7 +303,7 @@ def test_two_hundred_generated_fractures_build(tmp_path, monkeypatch):
     monkeypatch.syspath_prepend(Path(__file__).resolve().parents[2] / "benchmarks")
     from dfn_build import case_text
 
-    from xfemslip.dfn import intersecting_pairs
+    from xfemslip.geometry.dfn import intersecting_pairs
     from xfemslip.simulation import check_geometry
 
     path = tmp_path / "dfn200.toml"
@@ -321,9 +321,9 @@ def test_allow_network_that_crosses_is_built_with_a_junction_per_crossing(tmp_pa
     """An "allow" network whose fractures cross is accepted (exit 0) and every
     crossing found by the generator's own segment test (dfn.intersecting_pairs,
     independent of the geometry code) becomes a junction of the model."""
-    from xfemslip.dfn import intersecting_pairs
-    from xfemslip.geometry import GEOMETRY_TOL, find_junctions
-    from xfemslip.mesh import build_mesh
+    from xfemslip.fem.mesh import build_mesh
+    from xfemslip.geometry.dfn import intersecting_pairs
+    from xfemslip.geometry.fracture import GEOMETRY_TOL, find_junctions
 
     network = GENERATE.replace('intersections = "avoid"', 'intersections = "allow"')
     network = network.replace("count = 5", "count = 40")

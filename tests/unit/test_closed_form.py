@@ -1,4 +1,4 @@
-"""xfemslip.closed_form against independent facts of elasticity.
+"""xfemslip.reference.closed_form against independent facts of elasticity.
 
 Every check below uses a property the closed form must have, not its own
 formulas: Hooke's law and equilibrium by finite differences of the
@@ -14,7 +14,7 @@ import math
 import numpy as np
 import pytest
 
-from xfemslip import closed_form as cf
+from xfemslip.reference import closed_form as cf
 
 E, NU = 5.0e9, 0.3
 A = 0.5

@@ -1,4 +1,4 @@
-"""Closed forms of depletion (xfemslip.closed_form_depletion), checked
+"""Closed forms of depletion (xfemslip.reference.closed_form_depletion), checked
 independently: numerical integration of the potential behind (J1), the
 Griffith crack for the dislocation kernel, cancellation of (J1) by the slip
 (J2), symmetry, limits and the sign of the released energy."""
@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 from scipy import integrate
 
-from xfemslip.closed_form_depletion import (
+from xfemslip.reference.closed_form_depletion import (
     critical_change_uniaxial,
     dislocation_shear,
     offset_fault_shear,

@@ -1,4 +1,4 @@
-"""Tests of xfemslip.contact: contact patches, their jump operators, the
+"""Tests of xfemslip.contact.interface: contact patches, their jump operators, the
 automatic penalty."""
 
 from __future__ import annotations
@@ -8,7 +8,7 @@ import pytest
 
 from xfemslip.case import loads_case
 from xfemslip.case.specs import AUTO_PENALTY
-from xfemslip.contact import _point_jumps, contact_patches
+from xfemslip.contact.interface import _point_jumps, contact_patches
 from xfemslip.simulation import build_model
 
 CASE = """

@@ -6,13 +6,13 @@ from __future__ import annotations
 import numpy as np
 from casegen import fracture_spec
 
-from xfemslip.enrichment import (
+from xfemslip.fem.enrichment import (
     build_enriched_cells,
     candidate_values,
     find_candidates,
 )
-from xfemslip.geometry import GEOMETRY_TOL, build_fractures
-from xfemslip.mesh import build_mesh
+from xfemslip.fem.mesh import build_mesh
+from xfemslip.geometry.fracture import GEOMETRY_TOL, build_fractures
 
 
 def _network(n=24):

@@ -1,4 +1,4 @@
-"""Tests of xfemslip.enrichment (and the assembled bulk matrix it leads to).
+"""Tests of xfemslip.fem.enrichment (and the assembled bulk matrix it leads to).
 
 Dof map: counts, order, no duplicates.  Candidates: cut-cell nodes (ramp),
 tip-radius nodes (branch).  Sliver rule: exactly the enrichments whose
@@ -20,9 +20,9 @@ import scipy.sparse.linalg as spla
 from casegen import fracture_case
 
 from xfemslip import conventions
-from xfemslip.assembly import _enriched_matrices
 from xfemslip.case import loads_case
-from xfemslip.enrichment import ENRICHMENT_DIAG_RATIO, HEAVISIDE, find_candidates
+from xfemslip.fem.assembly import _enriched_matrices
+from xfemslip.fem.enrichment import ENRICHMENT_DIAG_RATIO, HEAVISIDE, find_candidates
 from xfemslip.simulation import build_model
 
 _case = fracture_case
@@ -128,7 +128,7 @@ def test_branch_radius_is_capped_so_supports_stay_on_the_tip_segment():
 def test_too_short_for_branch_falls_back_to_ramp(caplog):
     """8 x 8: half the fracture (2.7 cells) is less than two cell diagonals."""
     pts, n, size = SMALL
-    with caplog.at_level("WARNING", logger="xfemslip.geometry"):
+    with caplog.at_level("WARNING", logger="xfemslip.geometry.fracture"):
         m = build_model(_case(pts, "branch", n, size))
     assert m.fractures[0].tip_mode == "ramp"
     assert any('uses tip = "ramp"' in r.getMessage() for r in caplog.records)

@@ -1,4 +1,5 @@
-"""Tests of xfemslip.geometry: level-set signs, tips, clipping, cell pieces, ramp.
+"""Tests of xfemslip.geometry.fracture: level-set signs, tips, clipping, cell
+pieces, ramp.
 
 Every expected number is computed by hand in the test (distances, clipping
 parameters, arc lengths) or checked by central finite differences.
@@ -13,8 +14,8 @@ import pytest
 from casegen import fracture_spec
 
 from xfemslip.errors import GeometryError
-from xfemslip.geometry import build_fracture, build_fractures, clip_segment
-from xfemslip.mesh import build_mesh
+from xfemslip.fem.mesh import build_mesh
+from xfemslip.geometry.fracture import build_fracture, build_fractures, clip_segment
 
 # 8 x 8 cells on the unit square: h = 0.125 and every node coordinate is exact
 # in binary, so fractures "on a node" or "on an edge" are exactly there.

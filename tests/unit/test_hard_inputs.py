@@ -15,15 +15,15 @@ import pytest
 from casegen import fracture_spec
 from hardcases import arc, depletion, measure, polygon, zigzag
 
-from xfemslip import depletion as depletion_module
 from xfemslip.case import loads_case
 from xfemslip.errors import GeometryError, UsageError
-from xfemslip.geometry import (
+from xfemslip.fem.mesh import build_mesh
+from xfemslip.geometry.fracture import (
     MAX_PIECES_PER_CELL,
     SIMPLIFY_MIN_SEGMENT,
     build_fractures,
 )
-from xfemslip.mesh import build_mesh
+from xfemslip.studies import depletion as depletion_module
 
 # Harness bound of one process; each ran for minutes (or for ever) when it was
 # walked point by point, and takes a few seconds now.

@@ -17,11 +17,11 @@ import math
 import numpy as np
 import pytest
 
-from xfemslip import closed_form as cf
-from xfemslip import verify as V
 from xfemslip.case import load_case
-from xfemslip.material import elasticity_matrix
+from xfemslip.fem.material import elasticity_matrix
 from xfemslip.post import jintegral as J
+from xfemslip.reference import closed_form as cf
+from xfemslip.reference import verify as V
 from xfemslip.simulation import build_model
 
 E, NU = V.E, V.NU

@@ -15,10 +15,10 @@ import numpy as np
 import pytest
 from casegen import fracture_spec
 
-from xfemslip.enrichment import HEAVISIDE, build_enriched_cells, find_candidates
 from xfemslip.errors import GeometryError
-from xfemslip.geometry import JUNCTION_SNAP_CELLS, build_fractures
-from xfemslip.mesh import build_mesh
+from xfemslip.fem.enrichment import HEAVISIDE, build_enriched_cells, find_candidates
+from xfemslip.fem.mesh import build_mesh
+from xfemslip.geometry.fracture import JUNCTION_SNAP_CELLS, build_fractures
 
 N_CELLS = 10  # h = 0.1
 H = 1.0 / N_CELLS
@@ -277,7 +277,7 @@ def test_junction_function_jumps_only_next_to_its_junction(kind):
     """Only the dofs of one arm's junction function J are non-zero: that arm
     opens; the other arm of an X does not move at all, and the main fracture
     jumps only within one cell of the junction (J is constant beyond it)."""
-    from xfemslip.contact import _point_jumps
+    from xfemslip.contact.interface import _point_jumps
 
     sec = [[0.47, 0.2], [0.47, 0.86]] if kind == "X" else [[0.47, 0.53], [0.47, 0.86]]
     m = _model([MAIN, sec])
@@ -310,8 +310,8 @@ def test_network_figure_is_written(tmp_path):
     from matplotlib.figure import Figure  # noqa: F401  (matplotlib present)
 
     from xfemslip.case import loads_case
-    from xfemslip.plot import figure_network, plot_results
-    from xfemslip.plot_data import figure_data
+    from xfemslip.plot.data import figure_data
+    from xfemslip.plot.figures import figure_network, plot_results
     from xfemslip.simulation import run_case
 
     text = _case_text([MAIN, [[0.47, 0.53], [0.47, 0.86]]], n=16)

@@ -36,9 +36,10 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from xfemslip.case import loads_case
-from xfemslip.dfn import intersecting_pairs
 from xfemslip.errors import GeometryError
-from xfemslip.geometry import (
+from xfemslip.fem.mesh import build_mesh
+from xfemslip.geometry.dfn import intersecting_pairs
+from xfemslip.geometry.fracture import (
     GEOMETRY_TOL,
     JUNCTION_MIN_ANGLE,
     JUNCTION_SNAP_CELLS,
@@ -47,7 +48,6 @@ from xfemslip.geometry import (
     build_fractures,
     find_junctions,
 )
-from xfemslip.mesh import build_mesh
 
 N_CELLS = 10
 H = 1.0 / N_CELLS
@@ -152,7 +152,7 @@ def test_near_parallel_pairs_stay_apart(gap, tilt):
 
 
 def test_ends_left_apart_are_counted_in_the_log(caplog):
-    caplog.set_level(logging.INFO, logger="xfemslip.geometry")
+    caplog.set_level(logging.INFO, logger="xfemslip.geometry.fracture")
     _check([MAIN, [[0.3, 0.51], [0.7, 0.515]]])
     assert "2 fracture end(s) within 0.05 m (h/2) of another fracture left as " in (
         caplog.text

@@ -19,14 +19,14 @@ import pytest
 from casegen import sweep_member
 
 from xfemslip import kernels
-from xfemslip.assembly import _enriched_matrices
 from xfemslip.case import load_case, loads_case
 from xfemslip.conventions import OPEN, SLIP, STICK, TANGENT_CONSISTENT, TANGENT_SECANT
-from xfemslip.enrichment import build_enriched_cells, find_candidates
+from xfemslip.fem.assembly import _enriched_matrices
+from xfemslip.fem.enrichment import build_enriched_cells, find_candidates
+from xfemslip.fem.material import elasticity_matrix
 from xfemslip.kernels import vectorized
-from xfemslip.material import elasticity_matrix
 from xfemslip.simulation import _geometry, build_model, kernel_work
-from xfemslip.solver import NewtonSolver
+from xfemslip.solve.newton import NewtonSolver
 
 ROOT = Path(__file__).resolve().parents[2]
 NUMBA = kernels.backend("numba")

@@ -15,10 +15,10 @@ import numpy as np
 import pytest
 from casegen import fracture_case
 
-from xfemslip.enrichment import HEAVISIDE, find_candidates
+from xfemslip.fem.enrichment import HEAVISIDE, find_candidates
+from xfemslip.fem.material import elasticity_matrix
 from xfemslip.kernels import enriched_cell_matrices, rectangle_stiffness
 from xfemslip.kernels.shape import q4_shape
-from xfemslip.material import elasticity_matrix
 from xfemslip.simulation import build_model
 
 D_STRAIN = elasticity_matrix(10.0e9, 0.3, "plane_strain")
@@ -312,7 +312,7 @@ def test_uncut_cell_without_slots_reproduces_the_q4(n_slots):
     """A cell integrated with the sub-cell machinery (two triangles, degree-5 rule,
     which is exact for the degree-2 integrand) and empty slots is the plain Q4
     (enriched cells have no incompatible modes, unlike rectangle_stiffness)."""
-    from xfemslip.quadrature import triangle_rule
+    from xfemslip.fem.quadrature import triangle_rule
 
     b = np.array([[1.5, 2.0, -0.5, -0.25]])
     x0, x1, y0, y1 = b[0]

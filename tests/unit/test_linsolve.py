@@ -1,4 +1,4 @@
-"""Linear solvers of the Newton systems: every path of xfemslip.linsolve gives
+"""Linear solvers of the Newton systems: every path of xfemslip.solve.linear gives
 the direct solution (scipy spsolve) of the same systems, and a whole run gives
 the same answer with each."""
 
@@ -11,13 +11,13 @@ import pytest
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
-from xfemslip import linsolve
-from xfemslip.assembly import coo_block
 from xfemslip.case import loads_case
 from xfemslip.errors import CaseError
-from xfemslip.linsolve import LinearSolver, choose, rigid_body_modes
+from xfemslip.fem.assembly import coo_block
 from xfemslip.simulation import build_model
-from xfemslip.solver import NewtonSolver
+from xfemslip.solve import linear as linsolve
+from xfemslip.solve.linear import LinearSolver, choose, rigid_body_modes
+from xfemslip.solve.newton import NewtonSolver
 
 CASE = Path(__file__).resolve().parents[2] / "cases" / "reservoir_depletion.toml"
 pytest.importorskip("pyamg")

@@ -1,4 +1,4 @@
-"""The "auto" linear-solver rule (xfemslip.linsolve.choose, system_facts) and
+"""The "auto" linear-solver rule (xfemslip.solve.linear.choose, system_facts) and
 the bounded fall-back from AMG to SuperLU."""
 
 from __future__ import annotations
@@ -12,11 +12,11 @@ import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 from casegen import sweep_member
 
-from xfemslip import linsolve
 from xfemslip.case import loads_case
-from xfemslip.linsolve import LinearSolver, choose, system_facts
 from xfemslip.simulation import build_model, run_case
-from xfemslip.solver import NewtonSolver
+from xfemslip.solve import linear as linsolve
+from xfemslip.solve.linear import LinearSolver, choose, system_facts
+from xfemslip.solve.newton import NewtonSolver
 
 ROOT = Path(__file__).resolve().parents[2]
 CASE = ROOT / "cases" / "reservoir_depletion.toml"

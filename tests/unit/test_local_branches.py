@@ -1,4 +1,4 @@
-"""Local branch search (xfemslip.local_branches): the stick/slip set it returns
+"""Local branch search (xfemslip.contact.branches): the stick/slip set it returns
 for a cluster of patches is checked against a full sparse solve of the same
 affine problem and the true return map at its solution."""
 
@@ -9,12 +9,12 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from xfemslip import local_branches
-from xfemslip.assembly import coo_block
 from xfemslip.case import loads_case
+from xfemslip.contact import branches as local_branches
 from xfemslip.conventions import SLIP
+from xfemslip.fem.assembly import coo_block
 from xfemslip.simulation import build_model
-from xfemslip.solver import NewtonSolver, _forced_law, _frozen_law
+from xfemslip.solve.newton import NewtonSolver, _forced_law, _frozen_law
 
 CASE = Path(__file__).resolve().parents[2] / "cases" / "reservoir_depletion.toml"
 

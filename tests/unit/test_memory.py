@@ -14,8 +14,8 @@ from hardcases import estimates, measure
 
 from xfemslip.case import load_case, loads_case
 from xfemslip.cli import cli
-from xfemslip.enrichment import find_candidates
 from xfemslip.errors import MeshError, UsageError
+from xfemslip.fem.enrichment import find_candidates
 from xfemslip.memory import (
     ENV_LIMIT,
     LU_BYTES,

@@ -8,7 +8,6 @@ import math
 import numpy as np
 import pytest
 
-from xfemslip import closed_form as cf
 from xfemslip.post.metrics import point_stretches
 from xfemslip.post.permeability import ApertureLaw, oda_tensor, transmissivity
 from xfemslip.post.seismic import (
@@ -17,6 +16,7 @@ from xfemslip.post.seismic import (
     shear_modulus,
     stress_drop,
 )
+from xfemslip.reference import closed_form as cf
 
 
 def test_uniform_slip_dilates_by_slip_times_tan_psi_until_it_stops():

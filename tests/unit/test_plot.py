@@ -1,4 +1,4 @@
-"""Figures (xfemslip.plot): what they draw is the data of result.h5 / .vtu,
+"""Figures (xfemslip.plot.figures): what they draw is the data of result.h5 / .vtu,
 the Mohr geometry is the closed form, ``run`` without ``--plot`` never
 imports matplotlib, and the commands write PNG and PDF."""
 
@@ -16,12 +16,12 @@ from click.testing import CliRunner
 from test_sweep import BASE
 
 from xfemslip.cli import cli
-from xfemslip.closed_form import angle_to_sigma1, principal
 from xfemslip.errors import UsageError
-from xfemslip.plot import KINDS, auto_scale, figure_slip, plot_results
-from xfemslip.plot_data import FractureData, _piece_outlines, figure_data
-from xfemslip.plot_mohr import _circle_point
-from xfemslip.screen import plane_stresses
+from xfemslip.plot.data import FractureData, _piece_outlines, figure_data
+from xfemslip.plot.figures import KINDS, auto_scale, figure_slip, plot_results
+from xfemslip.plot.mohr import _circle_point
+from xfemslip.reference.closed_form import angle_to_sigma1, principal
+from xfemslip.studies.screen import plane_stresses
 
 ROOT = Path(__file__).resolve().parents[2]
 PNG = b"\x89PNG\r\n\x1a\n"

@@ -1,4 +1,4 @@
-"""xfemslip.polyline: the segment-pair sweep against an all-pairs reference,
+"""xfemslip.geometry.polyline: the segment-pair sweep against an all-pairs reference,
 and the simplification below a mesh's resolution against its stated bounds."""
 
 from __future__ import annotations
@@ -8,8 +8,8 @@ import math
 import numpy as np
 import pytest
 
-from xfemslip.polyline import first_meeting, simplify
-from xfemslip.regions import in_polygon, polygon_problem
+from xfemslip.geometry.polyline import first_meeting, simplify
+from xfemslip.geometry.regions import in_polygon, polygon_problem
 
 
 def _cross(o, a, b) -> float:

@@ -12,9 +12,9 @@ from click.testing import CliRunner
 
 from xfemslip.case import loads_case
 from xfemslip.cli import cli
-from xfemslip.enrichment import find_candidates
 from xfemslip.errors import CaseError
-from xfemslip.poro import body_load
+from xfemslip.fem.enrichment import find_candidates
+from xfemslip.fem.poro import body_load
 from xfemslip.simulation import build_model
 
 BASE = """
@@ -258,7 +258,7 @@ def test_deplete_writes_tables_and_fields(runner, tmp_path):
 def test_plots_and_screen_use_the_effective_stress(runner, tmp_path):
     """The Mohr figure reads the effective normal traction, and ``screen``
     defaults to the case's far-field pore pressure (region "all": p0 + dp)."""
-    from xfemslip.plot_data import figure_data
+    from xfemslip.plot.data import figure_data
 
     extra = FRACTURE + PORE.replace('region = "reservoir"', 'region = "all"')
     case = tmp_path / "all.toml"
@@ -280,9 +280,9 @@ def test_plots_and_screen_use_the_effective_stress(runner, tmp_path):
 def test_bisection_trial_falls_back_to_step_cutting(monkeypatch):
     """A bisection trial whose Newton solve fails is redone by the solver's
     step cutting from the committed state: same bracket, history untouched."""
-    from xfemslip.depletion import critical_depletion
     from xfemslip.errors import ConvergenceError
     from xfemslip.simulation import newton_solver
+    from xfemslip.studies.depletion import critical_depletion
 
     def run(fail_call):
         model = build_model(loads_case(BASE.format(extra=FRACTURE + PORE), "p.toml"))
@@ -310,8 +310,8 @@ def test_bisection_trial_falls_back_to_step_cutting(monkeypatch):
 def test_deplete_failure_keeps_the_converged_steps(runner, tmp_path, monkeypatch):
     """A load step that fails: exit 1, result.h5 of the converged steps with
     converged = false, and the tables written (like `run`)."""
-    from xfemslip import solver as solver_module
     from xfemslip.errors import ConvergenceError
+    from xfemslip.solve import newton as solver_module
 
     real = solver_module.NewtonSolver._newton
 
@@ -428,7 +428,7 @@ def test_enriched_stiffness_takes_the_material_of_each_quadrature_point():
     assembly._enriched_matrices)."""
     from test_kernels_bulk import enriched_reference
 
-    from xfemslip.assembly import _enriched_matrices
+    from xfemslip.fem.assembly import _enriched_matrices
 
     model = build_model(loads_case(SPLIT.format(E=5.0e9), "split.toml"))
     ec, mats = model.ec, model.materials
@@ -553,7 +553,7 @@ def test_polygon_edge_along_an_inclined_fault(caplog):
     through the domain: the cut cells' pressure fraction is the exact area of
     the cell below the fault (half-plane clipping), no warning is logged for
     that edge, and one is for a slanted edge without a fault."""
-    caplog.set_level("WARNING", logger="xfemslip.poro")
+    caplog.set_level("WARNING", logger="xfemslip.fem.poro")
     model = build_model(loads_case(_trapezoid_case(True), "tri.toml"))
     assert "polygon edge 0" not in caplog.text
     b = model.mesh.bounds

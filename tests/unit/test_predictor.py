@@ -1,4 +1,4 @@
-"""The stick/slip predictor (xfemslip/predictor.py) saves Newton solves and
+"""The stick/slip predictor (xfemslip/contact/predictor.py) saves Newton solves and
 never changes the converged answer.
 
 Reference for "the same answer": the run without the predictor.  Both runs
@@ -21,11 +21,11 @@ from casegen import fracture_case
 
 from xfemslip import conventions
 from xfemslip.case import loads_case
-from xfemslip.closed_form import slip_window
+from xfemslip.contact.predictor import predict_state, predicted_law, stress_increment
 from xfemslip.conventions import SLIP, STICK
-from xfemslip.predictor import predict_state, predicted_law, stress_increment
+from xfemslip.reference.closed_form import slip_window
 from xfemslip.simulation import build_model
-from xfemslip.solver import NewtonSolver
+from xfemslip.solve.newton import NewtonSolver
 
 ROOT = Path(__file__).resolve().parents[2]
 RESERVOIR = ROOT / "cases" / "reservoir_depletion.toml"

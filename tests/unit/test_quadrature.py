@@ -1,4 +1,4 @@
-"""Tests of xfemslip.quadrature: polygon splitting, sub-cell rules, Duffy rule,
+"""Tests of xfemslip.fem.quadrature: polygon splitting, sub-cell rules, Duffy rule,
 interface points.
 
 References: exact monomial integrals over triangles (barycentric formula),
@@ -16,9 +16,8 @@ import pytest
 from casegen import fracture_spec
 from scipy import integrate
 
-from xfemslip.geometry import build_fracture
-from xfemslip.mesh import build_mesh
-from xfemslip.quadrature import (
+from xfemslip.fem.mesh import build_mesh
+from xfemslip.fem.quadrature import (
     cell_subtriangles,
     duffy_rule,
     interface_points,
@@ -26,6 +25,7 @@ from xfemslip.quadrature import (
     split_polygon,
     triangle_rule,
 )
+from xfemslip.geometry.fracture import build_fracture
 
 SQUARE = np.array([[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]])
 TOL = 1e-10

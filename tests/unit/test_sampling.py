@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 from scipy import stats
 
-from xfemslip.sampling import (
+from xfemslip.studies.sampling import (
     Distribution,
     draw,
     induce_correlation,

@@ -3,7 +3,7 @@
 import numpy as np
 
 from xfemslip import kernels
-from xfemslip.assembly import coo_block
+from xfemslip.fem.assembly import coo_block
 
 
 def _padded(seed, m=40, k=10, n=30):

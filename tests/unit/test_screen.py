@@ -1,5 +1,5 @@
-"""Closed-form screening (xfemslip.screen) against hand-computed numbers and
-against xfemslip.closed_form; the ``xfemslip screen`` command.
+"""Closed-form screening (xfemslip.studies.screen) against hand-computed numbers and
+against xfemslip.reference.closed_form; the ``xfemslip screen`` command.
 
 Hand numbers, stress (xx, yy, xy) = (-20, -40, 0) MPa, plane at 45 degrees:
 n = (-1, 1)/sqrt 2, t = (1, 1)/sqrt 2, so sigma_n = (-20 - 40)/2 = -30 MPa and
@@ -15,8 +15,8 @@ import pytest
 from click.testing import CliRunner
 
 from xfemslip.cli import cli
-from xfemslip.closed_form import crack_tractions, slip_window
-from xfemslip.screen import (
+from xfemslip.reference.closed_form import crack_tractions, slip_window
+from xfemslip.studies.screen import (
     coulomb_margin,
     effective_stress,
     orientation_table,

@@ -11,7 +11,7 @@ import pytest
 from xfemslip.case import loads_case
 from xfemslip.errors import ConvergenceError
 from xfemslip.simulation import build_model
-from xfemslip.solver import NewtonSolver
+from xfemslip.solve.newton import NewtonSolver
 
 CASE = Path(__file__).resolve().parents[2] / "cases" / "reservoir_depletion.toml"
 

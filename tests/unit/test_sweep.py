@@ -1,5 +1,5 @@
-"""Sweep files (xfemslip.sweep): key paths, ranges, product/zip, validation of
-every generated case, one-line errors; running (xfemslip.sweep_run): summary,
+"""Sweep files (xfemslip.studies.sweep): key paths, ranges, product/zip, validation of
+every generated case, one-line errors; running (xfemslip.studies.run): summary,
 skip on rerun, a failed case kept apart, slipping length."""
 
 from __future__ import annotations
@@ -18,7 +18,8 @@ from xfemslip.case.tables import Table
 from xfemslip.cli import cli
 from xfemslip.errors import CaseError
 from xfemslip.post.metrics import arc_extent, slipping_length
-from xfemslip.sweep import (
+from xfemslip.studies.run import run_sweep
+from xfemslip.studies.sweep import (
     case_id,
     expand_range,
     load_sweep,
@@ -26,8 +27,7 @@ from xfemslip.sweep import (
     parse_key_path,
     set_key_path,
 )
-from xfemslip.sweep_run import run_sweep
-from xfemslip.sweep_vary import _check_overlaps, case_count, read_vary
+from xfemslip.studies.vary import _check_overlaps, case_count, read_vary
 
 # A small, fast case: 10 x 10 cells, a 45-degree fracture that slips (f = 0.1).
 BASE = """\

@@ -133,8 +133,8 @@ def test_three_realizations_end_to_end(tmp_path):
 
 
 def test_aggregate_leaves_failed_cases_out():
-    from xfemslip.sweep_dfn import AGGREGATED, aggregate, is_dfn_sweep
-    from xfemslip.sweep_run import CaseRow
+    from xfemslip.studies.dfn_summary import AGGREGATED, aggregate, is_dfn_sweep
+    from xfemslip.studies.run import CaseRow
 
     rng = np.random.default_rng(2)
     rows = []

@@ -9,9 +9,9 @@ import math
 import pytest
 from click.testing import CliRunner
 
-from xfemslip import verify as V
-from xfemslip import verify_output as VO
 from xfemslip.cli import cli
+from xfemslip.reference import report as VO
+from xfemslip.reference import verify as V
 
 
 def rows(errors, kii=0.001, problem="inclined-30"):

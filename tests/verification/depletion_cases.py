@@ -50,7 +50,7 @@ def offset_fault_case(
     throw); both reach the rollers at x = +-far (laterally infinite).  The
     fault runs ON the pressure boundary x = 0, in the middle of a column of
     cells (mesh lines at x = +-h/2): the XFEM cut is mid-cell and the cut cells
-    are split between the two reservoirs per quadrature point (xfemslip.poro).
+    are split between the two reservoirs per quadrature point (xfemslip.fem.poro).
     ``on_boundary=False``: the former set-up, mesh line at x = 0 and the fault
     half a cell off it at x = h / 2.  Homogeneous rock; in-situ stress -30 MPa
     isotropic, p0 = 10 MPa.  Returns (text, (a, b, c, d), x_fault).

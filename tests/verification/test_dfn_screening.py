@@ -12,8 +12,8 @@ import h5py
 import numpy as np
 import pytest
 
-from xfemslip.sweep import loads_sweep
-from xfemslip.sweep_run import run_sweep
+from xfemslip.studies.run import run_sweep
+from xfemslip.studies.sweep import loads_sweep
 
 ROOT = Path(__file__).resolve().parents[2]
 SWEEP = ROOT / "cases" / "sweeps" / "dfn_realizations.toml"

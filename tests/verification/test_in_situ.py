@@ -16,7 +16,7 @@ it.  References:
 - the equilibrium of the whole system with the bulk initial stress included:
   int B^T sigma0 + K u + f_con(u) = the edge forces of the total stress.
 
-Box: the OpenGeoSys peer crack (a = 1 m at 45 degrees, xfemslip.peer), on a
+Box: the OpenGeoSys peer crack (a = 1 m at 45 degrees, xfemslip.reference.peer), on a
 graded mesh of half-width 40 m with cells of h = 0.1 m around the crack.
 Measured slip errors (relative L2): 1.169 % released in situ, 1.158 % loaded
 from zero through the same rollers, 1.089 % loaded from zero through traction
@@ -35,14 +35,14 @@ import pytest
 import tomli_w
 from click.testing import CliRunner
 
-from xfemslip import closed_form as cf
-from xfemslip import peer
-from xfemslip.assembly import enriched_part_bbar
 from xfemslip.case import load_case
 from xfemslip.cli import cli
 from xfemslip.conventions import OPEN, SLIP, STICK
-from xfemslip.depletion import deplete
+from xfemslip.fem.assembly import enriched_part_bbar
+from xfemslip.reference import closed_form as cf
+from xfemslip.reference import peer
 from xfemslip.simulation import build_model, newton_solver, run_case
+from xfemslip.studies.depletion import deplete
 
 pytestmark = pytest.mark.verification
 

@@ -31,7 +31,7 @@ from tests.verification.harness import case_text
 from xfemslip.case import loads_case
 from xfemslip.conventions import SLIP, STICK
 from xfemslip.simulation import build_model, newton_solver
-from xfemslip.solver import NewtonSolver
+from xfemslip.solve.newton import NewtonSolver
 
 pytestmark = pytest.mark.verification
 

@@ -43,7 +43,7 @@ import numpy as np
 import pytest
 from harness import STICK, box_edges, case_text, run_text, write_edge_csv
 
-from xfemslip import closed_form as cf
+from xfemslip.reference import closed_form as cf
 
 pytestmark = pytest.mark.verification
 

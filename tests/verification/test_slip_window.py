@@ -26,8 +26,8 @@ import pytest
 import tomli_w
 from harness import SLIP, read_result
 
-from xfemslip import closed_form as cf
 from xfemslip.case import load_case
+from xfemslip.reference import closed_form as cf
 from xfemslip.simulation import run_case
 
 pytestmark = pytest.mark.verification

@@ -24,7 +24,7 @@ from xfemslip.case.tables import (
     frozen,
     show,
 )
-from xfemslip.polyline import first_meeting
+from xfemslip.geometry.polyline import first_meeting
 
 FRACTURE_KEYS = (
     "center",

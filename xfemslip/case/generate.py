@@ -8,7 +8,6 @@ import math
 
 import numpy as np
 
-from xfemslip import dfn
 from xfemslip.case.grid import Grid
 from xfemslip.case.segments import MAX_NETWORK_FRACTURES
 from xfemslip.case.tables import (
@@ -20,6 +19,7 @@ from xfemslip.case.tables import (
     fmt,
     show,
 )
+from xfemslip.geometry import dfn
 
 GENERATE_KEYS = (
     "seed",

@@ -17,7 +17,7 @@ from xfemslip.case.tables import (
     frozen,
     show,
 )
-from xfemslip.regions import in_boxes, in_polygon, polygon_problem
+from xfemslip.geometry.regions import in_boxes, in_polygon, polygon_problem
 
 PORE_PRESSURE_KEYS = ("initial", "change", "biot", "region")
 PORE_PRESSURE_REGIONS = ("all", "reservoir")

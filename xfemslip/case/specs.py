@@ -113,7 +113,7 @@ class SolverSpec:
     tangent: str = "consistent"  # "consistent" | "secant" (paper eq. 28)
     contact_patch: float = CONTACT_PATCH_CELLS  # patch length [cells]; 0 = pointwise
     max_step_cuts: int = 5  # bisections of a failing load step
-    linear_solver: str = "auto"  # "auto" | "superlu" | "amg" (xfemslip.linsolve)
+    linear_solver: str = "auto"  # "auto" | "superlu" | "amg" (xfemslip.solve.linear)
     kernels: str = "auto"  # "auto" | "numba" | "numpy" (xfemslip.kernels)
     UNITS: ClassVar[dict[str, str]] = {
         "tolerance": "-",
@@ -160,7 +160,7 @@ class ReservoirSpec:
 
     ``boxes`` (k, 4) float64 [x0, y0, x1, y1] [m] ((0, 4) with a polygon);
     ``polygon`` (k, 2) float64 vertices [m] or None.  An intact cell belongs
-    to the reservoir when its centre lies in the region (xfemslip.poro).
+    to the reservoir when its centre lies in the region (xfemslip.fem.poro).
     """
 
     boxes: np.ndarray  # (k, 4) float64 [m]

@@ -1,6 +1,6 @@
 """Command ``xfemslip deplete``.
 
-Parses arguments and prints; the work is in :mod:`xfemslip.depletion`.
+Parses arguments and prints; the work is in :mod:`xfemslip.studies.depletion`.
 """
 
 from __future__ import annotations
@@ -42,8 +42,8 @@ def deplete(case, output, tolerance, plot, overwrite, verbose, quiet, debug) -> 
     with reported_errors(debug):
         configure_logging(verbose, quiet)
         spec = load_case_file(case)
-        from xfemslip.depletion import deplete as run_deplete
-        from xfemslip.depletion import format_report
+        from xfemslip.studies.depletion import deplete as run_deplete
+        from xfemslip.studies.depletion import format_report
 
         report = run_deplete(
             spec, output, tolerance=tolerance, plot=plot, overwrite=overwrite

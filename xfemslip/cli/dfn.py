@@ -2,7 +2,7 @@
 
 Parses the arguments, prints, maps errors (through ``cli.common.reported_errors``);
 the network is built by the case loader (:mod:`xfemslip.case.network`,
-:mod:`xfemslip.dfn`), the figure by :mod:`xfemslip.dfn_plot`.
+:mod:`xfemslip.geometry.dfn`), the figure by :mod:`xfemslip.plot.dfn`.
 """
 
 from __future__ import annotations
@@ -58,7 +58,7 @@ def dfn(case, csv_path, include_inline, plot, result, summary, debug) -> None:
     statistics; optionally export it as CSV and draw it.  Nothing is solved."""
     with reported_errors(debug):
         spec = load_case_file(case)
-        from xfemslip.dfn import network_stats, segments_csv_text
+        from xfemslip.geometry.dfn import network_stats, segments_csv_text
         from xfemslip.io.csv import write_text
 
         (x0, y0), (w, h) = spec.origin, spec.size
@@ -81,7 +81,7 @@ def dfn(case, csv_path, include_inline, plot, result, summary, debug) -> None:
             write_text(csv_path, segments_csv_text(chosen))
             click.echo(f"{len(chosen)} fractures -> {csv_path}")
         if plot is not None:
-            from xfemslip.dfn_plot import figure_network, save
+            from xfemslip.plot.dfn import figure_network, save
 
             save(figure_network(spec, result, summary), plot)
             click.echo(f"figure -> {plot}")

@@ -1,8 +1,9 @@
 """Commands ``xfemslip sweep | plot | screen``.
 
 These only parse arguments, print and map errors to exit codes
-(through ``cli.common.reported_errors``); the work is in :mod:`xfemslip.sweep`,
-:mod:`xfemslip.sweep_run`, :mod:`xfemslip.plot` and :mod:`xfemslip.screen`.
+(through ``cli.common.reported_errors``); the work is in
+:mod:`xfemslip.studies.sweep`, :mod:`xfemslip.studies.run`,
+:mod:`xfemslip.plot.figures` and :mod:`xfemslip.studies.screen`.
 matplotlib is imported only when a figure is drawn, Dask only with
 ``--scheduler``.
 """
@@ -84,8 +85,8 @@ def sweep(sweep_file, output, jobs, scheduler, force, verbose, debug) -> None:
             raise UsageError(f"{shown_path(sweep_file)}: the path {problem}")
         if not sweep_file.is_file():
             raise UsageError(f"{sweep_file}: no such file")
-        from xfemslip.sweep import load_sweep
-        from xfemslip.sweep_run import format_table, require_dask, run_sweep
+        from xfemslip.studies.run import format_table, require_dask, run_sweep
+        from xfemslip.studies.sweep import load_sweep
 
         if scheduler:
             require_dask()
@@ -126,7 +127,7 @@ def sweep(sweep_file, output, jobs, scheduler, force, verbose, debug) -> None:
 
 def _print_dfn_aggregate(keys, rows) -> None:
     """Over network realizations: the aggregate table of dfn_summary.csv."""
-    from xfemslip.sweep_dfn import aggregate, format_aggregate, is_dfn_sweep
+    from xfemslip.studies.dfn_summary import aggregate, format_aggregate, is_dfn_sweep
 
     if is_dfn_sweep(keys):
         click.echo("\nover the realizations (dfn_summary.csv):")
@@ -194,7 +195,7 @@ def plot(results, output, kinds, formats, labels, scale, dpi, debug) -> None:
     """Draw the paper's figures of one or several RESULTS (result.h5 files or
     their folders); several results are drawn side by side or overlaid."""
     with reported_errors(debug):
-        from xfemslip.plot import plot_results
+        from xfemslip.plot.figures import plot_results
 
         out_dir = output or _default_figure_dir(list(results))
         written = plot_results(
@@ -212,7 +213,7 @@ def plot(results, output, kinds, formats, labels, scale, dpi, debug) -> None:
 
 def plot_run(out_dir: Path) -> None:
     """``xfemslip run --plot``: every figure of the run into <out_dir>/figures."""
-    from xfemslip.plot import plot_results
+    from xfemslip.plot.figures import plot_results
 
     for path in plot_results([out_dir / "result.h5"], out_dir / "figures"):
         click.echo(str(path))
@@ -310,7 +311,7 @@ def screen(
     pore-pressure change at which each fracture slips.  Stresses in Pa,
     tension positive."""
     with reported_errors(debug):
-        from xfemslip import screen as scr
+        from xfemslip.studies import screen as scr
 
         stress, fractures = _screen_inputs(case, stress, friction, cohesion, angles)
         if pore_pressure is None:
@@ -336,7 +337,7 @@ def screen(
                 scr.orientation_table(stress, pore_pressure, f0, c0, _angles(step)),
             )
         if plot_dir is not None:
-            from xfemslip.plot import plot_screen
+            from xfemslip.plot.figures import plot_screen
 
             for path in plot_screen(
                 plot_dir,
@@ -379,7 +380,7 @@ def _screen_inputs(case, stress, friction, cohesion, angles):
     if angles:
         fractures = [(f"angle {a:g}", a, friction, cohesion) for a in angles]
     elif spec is not None and spec.fractures:
-        from xfemslip.screen import case_fractures
+        from xfemslip.studies.screen import case_fractures
 
         fractures = case_fractures(spec)
     else:

@@ -14,7 +14,7 @@ Layout (every dataset carries ``attrs["units"]``: ``"m"``, ``"Pa"`` or ``"-"``):
     /fractures/<i>/s, points, slip, opening, normal_traction, shear_traction,
                    state (int8: 0 open, 1 stick, 2 slip),
                    contact_pressure = max(0, -normal_traction) [Pa]
-    with [pore_pressure] (xfemslip.poro) also: /fields/effective_stress (M, 3)
+    with [pore_pressure] (xfemslip.fem.poro) also: /fields/effective_stress (M, 3)
     sigma + alpha p I, /fields/pore_pressure (M,), and per fracture
     fluid_pressure and effective_normal_traction (normal_traction is total)
     /steps/<kkkk>/            only when load_steps > 1; attrs load_factor,
@@ -195,7 +195,7 @@ def _write_bulk_fields(
         _as_array(step.principal_stress, np.float64, (n_cells, 2), "principal_stress"),
         "Pa",
     )
-    # with pore pressure only (xfemslip.poro); /fields/stress stays total
+    # with pore pressure only (xfemslip.fem.poro); /fields/stress stays total
     optional = (("effective_stress", (n_cells, 3)), ("pore_pressure", (n_cells,)))
     for name, shape in optional:
         value = getattr(step, name, None)

@@ -2,7 +2,7 @@
 
 Layering (house style): a scalar return map ``coulomb_return_map`` and a batched
 loop ``contact_response`` over the interface points; the Python driver is
-``xfemslip/contact.py``.  No fastmath here: the law is made of sign tests.
+``xfemslip/contact/interface.py``.  No fastmath here: the law is made of sign tests.
 
 Signs (tension positive): p_N = k_N g_N + p_N0 <= 0 in contact (paper eqs. 5-6,
 with p_N0 the in-situ normal traction), open when that is > 0 (no traction);

@@ -6,7 +6,7 @@ from a model and a converged step, and the writers (:mod:`xfemslip.io`) and
 :class:`xfemslip.post.result.Result` carry them.
 
 Stress: sigma = sigma0 + D eps (- alpha (p - p0) I with pore pressure, see
-xfemslip.poro), averaged over each element (sub-cells included
+xfemslip.fem.poro), averaged over each element (sub-cells included
 for enriched elements).  Out-of-plane stress in plane strain:
 sigma_zz = nu (sigma_xx + sigma_yy) (the in-situ sigma_zz is taken as
 nu (sigma0_xx + sigma0_yy), consistent with plane strain); zero in plane stress.
@@ -20,7 +20,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from xfemslip.poro import fluid_pressure
+from xfemslip.fem.poro import fluid_pressure
 
 
 @dataclass
@@ -34,7 +34,7 @@ class FractureFields:
     normal_traction: np.ndarray  # (K,) p_N [Pa], compression negative
     shear_traction: np.ndarray  # (K,) p_T along t [Pa]
     state: np.ndarray  # (K,) int8: 0 open, 1 stick, 2 slip
-    # with [pore_pressure] only (xfemslip.poro); normal_traction is then total
+    # with [pore_pressure] only (xfemslip.fem.poro); normal_traction is then total
     fluid_pressure: np.ndarray | None = None  # (K,) p_f [Pa]
     effective_normal_traction: np.ndarray | None = None  # (K,) p_N + p_f [Pa]
 
@@ -53,7 +53,7 @@ class StepFields:
     stress_zz: np.ndarray | None  # (M,) [Pa]
     principal_stress: np.ndarray | None  # (M, 2) [Pa] s_max, s_min
     fractures: list[FractureFields] = field(default_factory=list)
-    # with [pore_pressure] only (xfemslip.poro)
+    # with [pore_pressure] only (xfemslip.fem.poro)
     effective_stress: np.ndarray | None = None  # (M, 3) sigma + alpha p I [Pa]
     pore_pressure: np.ndarray | None = None  # (M,) [Pa]
 
@@ -100,11 +100,11 @@ def bulk_fields(
 ):
     """stress (M, 3), stress_zz (M,), principal_stress (M, 2) [Pa] (total).
 
-    With several materials (xfemslip.poro): D (k, 3, 3), nu (k,) and
+    With several materials (xfemslip.fem.poro): D (k, 3, 3), nu (k,) and
     ``cell_material`` (M,).  With pore pressure, ``biot_p`` = (alpha p0,
     alpha p (M,)) [Pa] at this step: sigma = sigma0 + D eps - alpha (p - p0) m
     and, in plane strain, sigma_zz = nu (sigma'_xx + sigma'_yy) - alpha p with
-    sigma' = sigma0 + alpha p0 m + D eps (see xfemslip.poro).
+    sigma' = sigma0 + alpha p0 m + D eps (see xfemslip.fem.poro).
     """
     eps = cell_strain(mesh, bulk, u)
     if cell_material is None:
@@ -135,7 +135,7 @@ def fracture_fields(ip, res, n_fractures, fluid=None) -> list[FractureFields]:
     fluid : (n,) fluid pressure at the interface points [Pa] or None.  The
     contact law gives the effective normal traction sigma_n'; with a fluid,
     ``normal_traction`` is the total sigma_n' - p_f and the effective one and
-    p_f are reported too (xfemslip.poro).
+    p_f are reported too (xfemslip.fem.poro).
     """
     out = []
     for fi in range(n_fractures):

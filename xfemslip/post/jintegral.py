@@ -42,7 +42,7 @@ With an initial stress s0 the interaction integral of the uniform s0 (with
 its own face tractions) is zero, so the integral uses D eps(u) and p - p0.
 
 Material.  E, nu (and D) are those of the material at the tip: the
-reservoir's when the tip lies in the ``[reservoir]`` region (xfemslip.poro),
+reservoir's when the tip lies in the ``[reservoir]`` region (xfemslip.fem.poro),
 the host's otherwise.  The integral assumes a homogeneous domain (it has no
 term for a material interface); a domain holding cells or quadrature points
 of the other material is computed with the tip's and logged as a warning.
@@ -59,10 +59,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from xfemslip.closed_form import kolosov
-from xfemslip.poro import HOST, RESERVOIR
+from xfemslip.fem.poro import HOST, RESERVOIR
+from xfemslip.geometry.regions import in_region
 from xfemslip.post.fields import fracture_fields
-from xfemslip.regions import in_region
+from xfemslip.reference.closed_form import kolosov
 
 logger = logging.getLogger(__name__)
 

@@ -13,7 +13,7 @@ import math
 import numpy as np
 
 from xfemslip.conventions import SLIP
-from xfemslip.geometry import clip_segment
+from xfemslip.geometry.fracture import clip_segment
 from xfemslip.post.result import Result
 
 __all__ = [

@@ -21,7 +21,7 @@ import math
 
 import numpy as np
 
-from xfemslip.closed_form import kolosov
+from xfemslip.reference.closed_form import kolosov
 
 
 def shear_modulus(E: float, nu: float) -> float:

@@ -16,7 +16,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from xfemslip.geometry import GEOMETRY_TOL
+from xfemslip.geometry.fracture import GEOMETRY_TOL
 
 # Dunavant (1985) degree-5 rule on the reference triangle: barycentric points and
 # weights (summing to 1).

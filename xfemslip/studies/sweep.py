@@ -29,12 +29,12 @@ table, a key path the base case does not have) is ONE ``CaseError`` naming
 the sweep file, the key and what was expected (exit 2), as is a sweep none of
 whose cases can be built.  A generated case that cannot be built while
 others can is *refused*: it stays in ``SweepSpec.cases`` with the reason in
-``SweepCase.refused`` (and no spec), and :mod:`xfemslip.sweep_run` reports
+``SweepCase.refused`` (and no spec), and :mod:`xfemslip.studies.run` reports
 it and runs the others.
 
 Public: ``load_sweep(path) -> SweepSpec``, ``loads_sweep(text, path)``.
-The ``[vary]`` table (key paths, ranges) is read by :mod:`xfemslip.sweep_vary`;
-the running of a sweep is :mod:`xfemslip.sweep_run`.
+The ``[vary]`` table (key paths, ranges) is read by :mod:`xfemslip.studies.vary`;
+the running of a sweep is :mod:`xfemslip.studies.run`.
 """
 
 from __future__ import annotations
@@ -52,7 +52,7 @@ from xfemslip.case import loads_case, parse_toml, path_problem, read_text
 from xfemslip.case.files import MAX_TOML_BYTES, UnreadableInput, read_input
 from xfemslip.case.tables import Table, show
 from xfemslip.errors import CaseError, GeometryError, MeshError
-from xfemslip.sweep_vary import (
+from xfemslip.studies.vary import (
     MAX_CASES,
     RANGE_KEYS,
     case_count,

@@ -17,7 +17,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from xfemslip.errors import GeometryError
-from xfemslip.polyline import first_meeting, simplify
+from xfemslip.geometry.polyline import first_meeting, simplify
 
 logger = logging.getLogger(__name__)
 

@@ -379,7 +379,7 @@ def deplete(spec, out_dir=None, *, tolerance=None, plot=False, overwrite=False):
         report.out_dir = done.out_dir
         names = write_tables(report, folder)
         if plot:
-            from xfemslip.plot_depletion import plot_field, plot_slip_vs_depletion
+            from xfemslip.plot.depletion import plot_field, plot_slip_vs_depletion
 
             names.append(plot_slip_vs_depletion(report, folder))
             if done.results:

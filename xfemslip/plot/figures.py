@@ -34,8 +34,8 @@ from matplotlib.tri import Triangulation
 
 from xfemslip.conventions import SLIP
 from xfemslip.errors import UsageError
-from xfemslip.plot_data import ResultData, figure_data
-from xfemslip.plot_mohr import add_legend, draw_mohr, mohr_figsize
+from xfemslip.plot.data import ResultData, figure_data
+from xfemslip.plot.mohr import add_legend, draw_mohr, mohr_figsize
 
 logger = logging.getLogger(__name__)
 

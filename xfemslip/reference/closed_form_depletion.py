@@ -6,7 +6,7 @@ plane strain, homogeneous isotropic elasticity (shear modulus mu, Poisson nu).
 1. Uniaxial strain (laterally infinite layer, constant overburden):
    Delta sigma_xx = -alpha dp (1 - 2 nu) / (1 - nu), Delta sigma_yy = 0,
    Delta sigma'_yy = alpha dp, Delta sigma'_xx = nu / (1 - nu) alpha dp
-   (derivation in xfemslip.poro).
+   (derivation in xfemslip.fem.poro).
 
 2. Vertical fault x = 0 through a reservoir offset across it (Jansen,
    Singhal & Vossepoel 2019, Jansen & Meulenbroek 2022, "Induced aseismic slip

@@ -15,9 +15,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from xfemslip.enrichment import HEAVISIDE, group_values
 from xfemslip.errors import GeometryError
-from xfemslip.quadrature import LINE_POINTS, LINE_WEIGHTS
+from xfemslip.fem.enrichment import HEAVISIDE, group_values
+from xfemslip.fem.quadrature import LINE_POINTS, LINE_WEIGHTS
 
 logger = logging.getLogger(__name__)
 

@@ -15,9 +15,9 @@ Tangents: "consistent" uses the exact derivative of the return map (not
 symmetric while slipping), which gives quadratic convergence once the
 stick/slip set has settled; "secant" is the paper's eq. 28 update.  With the
 consistent tangent the first solve of a step uses a predicted stick/slip set
-(xfemslip.predictor): when the guess is right the step converges in one
+(xfemslip.contact.predictor): when the guess is right the step converges in one
 solve, when it is wrong Newton goes on from there under the true law.  The linear
-systems go to xfemslip.linsolve (SuperLU with the factorization kept, or
+systems go to xfemslip.solve.linear (SuperLU with the factorization kept, or
 AMG-preconditioned GMRES), which handles the non-symmetric case.
 """
 
@@ -31,10 +31,10 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.sparse as sp
 
-from xfemslip import local_branches
-from xfemslip.assembly import coo_block
 from xfemslip.case.specs import AUTO_PENALTY
-from xfemslip.contact import ContactResult, ContactSet
+from xfemslip.contact.interface import ContactResult, ContactSet
+from xfemslip.contact import branches as local_branches
+from xfemslip.contact.predictor import predict_state, predicted_law
 from xfemslip.conventions import (
     OPEN,
     SLIP,
@@ -45,8 +45,8 @@ from xfemslip.conventions import (
     TANGENTS,
 )
 from xfemslip.errors import ConvergenceError
-from xfemslip.linsolve import LinearSolver
-from xfemslip.predictor import predict_state, predicted_law
+from xfemslip.fem.assembly import coo_block
+from xfemslip.solve.linear import LinearSolver
 
 logger = logging.getLogger(__name__)
 
@@ -78,7 +78,7 @@ PINGPONG_PERIODS = 3
 # forever (seed 1, predictor off); 2 and 3 converge on all 20 seeds both
 # ways (benchmarks/RESULTS.md, "Newton on fracture networks").
 REVERSAL_HOLDS = 2
-# Local branch searches (xfemslip.local_branches) per Newton solve: a patch
+# Local branch searches (xfemslip.contact.branches) per Newton solve: a patch
 # that reverses its slip again after REVERSAL_HOLDS holds has no consistent
 # branch while its neighbours keep theirs (refined DFN realizations:
 # benchmarks/RESULTS.md, "Refined DFN realizations (session 4)"); the
@@ -540,7 +540,7 @@ class NewtonSolver:
 
     def _local_search(self, u, res, r, law, stubborn):
         """The law with the branches of ``stubborn`` and their neighbours
-        forced to a consistent local set (xfemslip.local_branches), or None
+        forced to a consistent local set (xfemslip.contact.branches), or None
         when the search finds none or only the current set."""
         c = self.p.contact
         near = local_branches.neighbours(self.c_dofs, self.K_ff, stubborn)
@@ -724,7 +724,7 @@ class _NewtonLog:
     freezes: int = 0
     fallbacks: int = 0  # secant iterations replaced by a consistent one
     reversals: int = 0  # Newton steps that held reversing patches in stick
-    searches: int = 0  # local branch searches (xfemslip.local_branches)
+    searches: int = 0  # local branch searches (xfemslip.contact.branches)
     found: int = 0  # of them, those that found a consistent set
     predicted: int = 0  # 1 if the first solve used the predicted set
     residuals: list = None

@@ -1,6 +1,6 @@
 """The ``[vary]`` table of a sweep file: key paths, value lists and ranges.
 
-Private helper of :mod:`xfemslip.sweep` (which re-exports the public names):
+Private helper of :mod:`xfemslip.studies.sweep` (which re-exports the public names):
 ``parse_key_path`` / ``set_key_path`` address a case key such as
 ``fractures[0].angle``; ``expand_range`` turns ``{start, stop, step|num}``
 into values; ``read_vary`` checks the whole table and records each problem

@@ -17,11 +17,11 @@ from functools import cached_property
 import numpy as np
 
 from xfemslip import kernels
-from xfemslip.assembly import coo_block, scatter_vector
 from xfemslip.case.specs import AUTO_PENALTY, CONTACT_PATCH_CELLS
 from xfemslip.conventions import STICK
-from xfemslip.enrichment import HEAVISIDE, group_values
-from xfemslip.geometry import GEOMETRY_TOL
+from xfemslip.fem.assembly import coo_block, scatter_vector
+from xfemslip.fem.enrichment import HEAVISIDE, group_values
+from xfemslip.geometry.fracture import GEOMETRY_TOL
 
 logger = logging.getLogger(__name__)
 

@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from xfemslip.polyline import first_meeting
+from xfemslip.geometry.polyline import first_meeting
 
 
 def in_boxes(xy: np.ndarray, boxes: np.ndarray) -> np.ndarray:

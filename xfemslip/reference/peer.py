@@ -21,7 +21,7 @@ import math
 
 import numpy as np
 
-from xfemslip.closed_form import relative_l2, slip_profile
+from xfemslip.reference.closed_form import relative_l2, slip_profile
 
 A, E, NU, F, PSI = 1.0, 5.0e9, 0.3, 0.1, 45.0
 STRESS = (-20.0e6, -40.0e6, 0.0)

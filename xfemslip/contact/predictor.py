@@ -31,7 +31,7 @@ import math
 
 import numpy as np
 
-from xfemslip.contact import ContactSet
+from xfemslip.contact.interface import ContactSet
 from xfemslip.conventions import OPEN, SLIP, STICK
 
 

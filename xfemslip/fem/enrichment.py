@@ -43,9 +43,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from xfemslip.branch import branch_functions
-from xfemslip.geometry import GEOMETRY_TOL
-from xfemslip.quadrature import cell_subtriangles, duffy_rule, triangle_rule
+from xfemslip.fem.branch import branch_functions
+from xfemslip.fem.quadrature import cell_subtriangles, duffy_rule, triangle_rule
+from xfemslip.geometry.fracture import GEOMETRY_TOL
 
 logger = logging.getLogger(__name__)
 

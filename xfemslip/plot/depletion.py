@@ -10,7 +10,7 @@ from pathlib import Path
 import numpy as np
 
 from xfemslip.conventions import SLIP
-from xfemslip.regions import edges
+from xfemslip.geometry.regions import edges
 
 
 def _pyplot():

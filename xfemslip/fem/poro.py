@@ -63,7 +63,7 @@ tests/verification/test_depletion.py).
 
 Material regions.  An intact cell belongs to the reservoir when its centre
 lies in the ``[reservoir]`` region (its boxes or its polygon,
-xfemslip.regions); its stiffness, its stress and its pore-pressure change
+xfemslip.geometry.regions); its stiffness, its stress and its pore-pressure change
 are those of the reservoir.  Region edges that do not fall on mesh lines
 are snapped to the cells this way, and the run logs a warning naming the
 edge.  Enriched cells (cut, tip and blending cells) are classified
@@ -84,9 +84,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from xfemslip.assembly import enriched_part_bbar
-from xfemslip.material import elasticity_matrix
-from xfemslip.regions import edges, in_region
+from xfemslip.fem.assembly import enriched_part_bbar
+from xfemslip.fem.material import elasticity_matrix
+from xfemslip.geometry.regions import edges, in_region
 
 logger = logging.getLogger(__name__)
 

@@ -15,7 +15,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from xfemslip import kernels
-from xfemslip.enrichment import (
+from xfemslip.fem.enrichment import (
     Candidates,
     DofMap,
     EnrichedCells,
@@ -94,7 +94,7 @@ def _part_matrices(mesh, ec, rows, qp_w, D):
 
 def enriched_part_bbar(mesh, ec, rows, qp_w) -> np.ndarray:
     """(len(rows), 3, 8+2S) average strain operator [1/m] of the enriched cells
-    ``rows`` over the QPs with weight qp_w > 0 (xfemslip.poro's Biot load)."""
+    ``rows`` over the QPs with weight qp_w > 0 (xfemslip.fem.poro's Biot load)."""
     if len(rows) == 0:
         return np.zeros((0, 3, 8 + 2 * ec.slot_node.shape[1]))
     return _part_matrices(mesh, ec, rows, qp_w, np.eye(3))[1]
@@ -145,7 +145,7 @@ def assemble_bulk(
     """Assemble the bulk stiffness and choose the kept enrichments (sliver rule).
 
     D : (3, 3) [Pa] for one material, or (k, 3, 3) with ``cell_material``
-    (n_cells,) int64 the material index of every cell (xfemslip.poro) and,
+    (n_cells,) int64 the material index of every cell (xfemslip.fem.poro) and,
     optionally, ``qp_material`` (nq,) int64 that of every enriched-cell QP.
     """
     is_enr = np.zeros(mesh.n_cells, bool)

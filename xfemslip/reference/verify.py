@@ -37,10 +37,10 @@ from pathlib import Path
 
 import numpy as np
 
-from xfemslip import closed_form as cf
 from xfemslip.case import load_case
 from xfemslip.post.fields import fracture_fields
 from xfemslip.post.jintegral import stress_intensity_factors
+from xfemslip.reference import closed_form as cf
 from xfemslip.simulation import build_model, newton_solver
 
 logger = logging.getLogger(__name__)

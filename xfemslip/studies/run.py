@@ -1,6 +1,6 @@
 """Running a sweep: local processes or a Dask cluster, reruns, the summary.
 
-Each case of a :class:`~xfemslip.sweep.SweepSpec` runs in its own folder
+Each case of a :class:`~xfemslip.studies.sweep.SweepSpec` runs in its own folder
 ``<sweep directory>/<case id>/`` (``case.toml``, ``result.h5``, VTU files).
 
 - ``jobs = 1``: in this process, one case after the other.
@@ -22,7 +22,7 @@ slipping length [m], share of contact points in slip, converged, Newton
 iterations, wall time [s], the number of fractures, how many have a point in
 slip, that fraction, the mean over those of their length-weighted mean |slip|
 [m], status (ok, skipped, failed, refused) and error. A sweep that varies a
-``network.*`` key also gets ``dfn_summary.csv`` (:mod:`xfemslip.sweep_dfn`).
+``network.*`` key also gets ``dfn_summary.csv`` (:mod:`xfemslip.studies.dfn_summary`).
 """
 
 from __future__ import annotations
@@ -42,7 +42,7 @@ from xfemslip.io.fileset import replace_files
 from xfemslip.io.lock import folder_lock
 from xfemslip.io.read import read_attrs, read_result
 from xfemslip.post.metrics import METRICS, result_metrics
-from xfemslip.sweep_dfn import DFN_SUMMARY, is_dfn_sweep, write_dfn_summary
+from xfemslip.studies.dfn_summary import DFN_SUMMARY, is_dfn_sweep, write_dfn_summary
 
 logger = logging.getLogger(__name__)
 

@@ -34,7 +34,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from xfemslip.closed_form import angle_to_sigma1, principal, slip_window
+from xfemslip.reference.closed_form import angle_to_sigma1, principal, slip_window
 
 
 def effective_stress(stress, pore_pressure: float) -> tuple[float, float, float]:
