@@ -48,7 +48,7 @@ import numpy as np
 from xfem_process import timed_run
 
 from xfemslip.reference import closed_form as cf
-from xfemslip.reference import verify as V
+from xfemslip.verify import problems as V
 from xfemslip.case.fractures import TIP_KINDS
 from xfemslip.errors import XfemslipError
 

@@ -226,8 +226,7 @@ def study_box(hs, element, half):
 
 
 def study_exact(aohs):
-    from xfemslip.reference import verify as V
-
+    from xfemslip.verify import problems as V
     prob = next(p for p in V.PROBLEMS if p.name == "inclined-30")
     print("| radius | " + " | ".join(f"a/{n}" for n in aohs) + " |")
     print("| --- | " + " | ".join("---" for _ in aohs) + " |")

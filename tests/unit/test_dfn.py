@@ -10,8 +10,8 @@ import pytest
 from scipy import stats
 from scipy.integrate import trapezoid
 
-from xfemslip.geometry.dfn import DfnParams, FractureSet, LengthLaw, Orientation
 from xfemslip.geometry import dfn
+from xfemslip.geometry.dfn import DfnParams, FractureSet, LengthLaw, Orientation
 
 BOX = (0.0, 2.0, 0.0, 1.0)
 UNIFORM = Orientation(kind="uniform")

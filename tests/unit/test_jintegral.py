@@ -21,8 +21,8 @@ from xfemslip.case import load_case
 from xfemslip.fem.material import elasticity_matrix
 from xfemslip.post import jintegral as J
 from xfemslip.reference import closed_form as cf
-from xfemslip.reference import verify as V
 from xfemslip.simulation import build_model
+from xfemslip.verify import problems as V
 
 E, NU = V.E, V.NU
 MU = E / (2 * (1 + NU))

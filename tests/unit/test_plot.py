@@ -21,7 +21,7 @@ from xfemslip.plot.data import FractureData, _piece_outlines, figure_data
 from xfemslip.plot.figures import KINDS, auto_scale, figure_slip, plot_results
 from xfemslip.plot.mohr import _circle_point
 from xfemslip.reference.closed_form import angle_to_sigma1, principal
-from xfemslip.studies.screen import plane_stresses
+from xfemslip.reference.screen import plane_stresses
 
 ROOT = Path(__file__).resolve().parents[2]
 PNG = b"\x89PNG\r\n\x1a\n"

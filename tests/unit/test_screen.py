@@ -1,4 +1,4 @@
-"""Closed-form screening (xfemslip.studies.screen) against hand-computed numbers and
+"""Closed-form screening (xfemslip.reference.screen) against hand-computed numbers and
 against xfemslip.reference.closed_form; the ``xfemslip screen`` command.
 
 Hand numbers, stress (xx, yy, xy) = (-20, -40, 0) MPa, plane at 45 degrees:
@@ -16,7 +16,7 @@ from click.testing import CliRunner
 
 from xfemslip.cli import cli
 from xfemslip.reference.closed_form import crack_tractions, slip_window
-from xfemslip.studies.screen import (
+from xfemslip.reference.screen import (
     coulomb_margin,
     effective_stress,
     orientation_table,

@@ -10,8 +10,8 @@ import pytest
 from click.testing import CliRunner
 
 from xfemslip.cli import cli
-from xfemslip.reference import report as VO
-from xfemslip.reference import verify as V
+from xfemslip.verify import problems as V
+from xfemslip.verify import report as VO
 
 
 def rows(errors, kii=0.001, problem="inclined-30"):

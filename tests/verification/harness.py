@@ -15,8 +15,8 @@ import numpy as np
 import xfemslip
 from xfemslip.case import load_case
 from xfemslip.conventions import OPEN, SLIP, STICK  # noqa: F401 (re-exported)
-from xfemslip.reference.verify import box_edges, write_edge_csv  # noqa: F401 (re-exported)
 from xfemslip.simulation import run_case
+from xfemslip.verify.problems import box_edges, write_edge_csv  # noqa: F401 (re-exported)
 
 FRACTURE_KEYS = (
     "s",

@@ -49,12 +49,12 @@ from harness import SLIP, STICK, read_result
 
 from xfemslip.case import load_case
 from xfemslip.reference import closed_form as cf
-from xfemslip.reference import verify as V
 from xfemslip.simulation import run_case
+from xfemslip.verify import problems as V
 
 pytestmark = pytest.mark.verification
 
-# the box, crack and stress of xfemslip.reference.verify, whose case writer runs them
+# the box, crack and stress of xfemslip.verify.problems, whose case writer runs them
 HALF = V.HALF_BOX  # half-width of the box [m]
 A = V.HALF_LENGTH  # crack half-length [m]
 CENTER = V.CENTER  # off the mesh lines on purpose [m]
@@ -78,7 +78,7 @@ def run_inclined(
 ):
     """Write the case and the four boundary CSV files into folder, run, read the result.
 
-    The case is ``xfemslip.reference.verify``'s (the same box, crack and exact edges).
+    The case is ``xfemslip.verify.problems``'s (the same box, crack and exact edges).
     Returns (s, slip, state, exact slip at s).
     """
     prob = V.Problem("inclined", psi, friction, cohesion, plane)

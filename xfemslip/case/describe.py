@@ -20,7 +20,7 @@ from xfemslip.case.specs import (
     SolverSpec,
 )
 from xfemslip.case.tables import fmt
-from xfemslip.studies.screen import coulomb_margin, plane_stresses
+from xfemslip.reference.screen import coulomb_margin, plane_stresses
 
 
 def _with_unit(value: Any, unit: str) -> str:
@@ -97,7 +97,7 @@ def in_situ_margin(spec: CaseSpec, fracture: FractureSpec) -> tuple[float, float
     """(Coulomb margin [Pa], effective normal traction [Pa]) of the in-situ
     stress on the fracture's least stable segment.
 
-    margin = c + f max(0, -sigma_n') - |tau| (xfemslip.studies.screen), with
+    margin = c + f max(0, -sigma_n') - |tau| (xfemslip.reference.screen), with
     sigma_n' = sigma_n + p0 on the faces (Terzaghi); the segment with the
     smallest margin counts, and a segment in tension (sigma_n' > 0) before any
     other.  (nan, nan) without ``loading.initial_stress``.

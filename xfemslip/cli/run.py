@@ -83,7 +83,7 @@ def check(case: Path, debug: bool) -> None:
 @click.command()
 def info() -> None:
     """Print versions and Numba settings."""
-    from xfemslip.kernels._config import numba_settings
+    from xfemslip.kernels import numba_settings
 
     rows = [("xfemslip", __version__), ("python", platform.python_version())]
     rows += [

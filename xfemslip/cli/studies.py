@@ -3,7 +3,7 @@
 These only parse arguments, print and map errors to exit codes
 (through ``cli.common.reported_errors``); the work is in
 :mod:`xfemslip.studies.sweep`, :mod:`xfemslip.studies.run`,
-:mod:`xfemslip.plot.figures` and :mod:`xfemslip.studies.screen`.
+:mod:`xfemslip.plot.figures` and :mod:`xfemslip.reference.screen`.
 matplotlib is imported only when a figure is drawn, Dask only with
 ``--scheduler``.
 """
@@ -311,7 +311,7 @@ def screen(
     pore-pressure change at which each fracture slips.  Stresses in Pa,
     tension positive."""
     with reported_errors(debug):
-        from xfemslip.studies import screen as scr
+        from xfemslip.reference import screen as scr
 
         stress, fractures = _screen_inputs(case, stress, friction, cohesion, angles)
         if pore_pressure is None:
@@ -380,7 +380,7 @@ def _screen_inputs(case, stress, friction, cohesion, angles):
     if angles:
         fractures = [(f"angle {a:g}", a, friction, cohesion) for a in angles]
     elif spec is not None and spec.fractures:
-        from xfemslip.studies.screen import case_fractures
+        from xfemslip.reference.screen import case_fractures
 
         fractures = case_fractures(spec)
     else:

@@ -1,7 +1,7 @@
 """Command ``xfemslip verify``: the verification problems against closed forms.
 
 Checks the options, prints progress and the table; the problems, the
-measures and the targets are in :mod:`xfemslip.reference.verify`.
+measures and the targets are in :mod:`xfemslip.verify.problems`.
 """
 
 from __future__ import annotations
@@ -52,8 +52,8 @@ def verify(quick, tip, plot, csv_path, penalty, debug) -> None:
     with reported_errors(debug):
         ratio = _checked_options(tip, plot, penalty)
         # the library is imported here: `xfemslip --help` does not load NumPy
-        from xfemslip.reference.report import format_table, write_outputs
-        from xfemslip.reference.verify import run_verification
+        from xfemslip.verify.problems import run_verification
+        from xfemslip.verify.report import format_table, write_outputs
 
         start = time.perf_counter()
 

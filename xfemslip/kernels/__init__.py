@@ -20,6 +20,8 @@ import importlib
 import logging
 import os
 
+from xfemslip.kernels._config import numba_settings
+
 logger = logging.getLogger(__name__)
 
 BACKENDS = ("auto", "numba", "numpy")
@@ -93,6 +95,7 @@ __all__ = [
     "active",
     "backend",
     "choose",
+    "numba_settings",
     "use",
     *KERNELS,
 ]

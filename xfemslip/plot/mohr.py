@@ -6,7 +6,7 @@ circle at sigma_n' = C + R cos 2 beta, |tau| = R sin 2 beta, with
 C = -(sigma1' + sigma3') / 2 and R = (sigma1' - sigma3') / 2 (sigma1' >=
 sigma3' compressive magnitudes).  The failure line is |tau| = c - f sigma_n';
 the arc above it is the band of orientations that slip
-(:func:`xfemslip.studies.screen.slip_band`).  An inset shows those orientations in
+(:func:`xfemslip.reference.screen.slip_band`).  An inset shows those orientations in
 the x-y plane.
 """
 
@@ -17,7 +17,7 @@ import math
 import numpy as np
 
 from xfemslip.reference.closed_form import angle_to_sigma1
-from xfemslip.studies.screen import effective_stress, slip_band
+from xfemslip.reference.screen import effective_stress, slip_band
 
 
 def _circle_point(centre: float, radius: float, beta_deg):

@@ -32,8 +32,8 @@ import numpy as np
 import scipy.sparse as sp
 
 from xfemslip.case.specs import AUTO_PENALTY
-from xfemslip.contact.interface import ContactResult, ContactSet
 from xfemslip.contact import branches as local_branches
+from xfemslip.contact.interface import ContactResult, ContactSet
 from xfemslip.contact.predictor import predict_state, predicted_law
 from xfemslip.conventions import (
     OPEN,

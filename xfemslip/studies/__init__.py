@@ -1,5 +1,5 @@
-"""Studies made of many runs or none: sweeps over parameters and random networks,
-critical depletion, closed-form screening, sampling.
+"""Studies made of many runs: sweeps over parameters and random networks,
+critical depletion, sampling.
 
 Modules:
 
@@ -8,10 +8,9 @@ Modules:
 - ``sampling``: random samples of uncertain inputs;
 - ``run``: running a sweep (processes or Dask), reruns, the summary;
 - ``dfn_summary``: the aggregate of a sweep over network realizations;
-- ``depletion``: the pore-pressure drop at which each fracture first slips;
-- ``screen``: closed-form screening of fracture orientations.
+- ``depletion``: the pore-pressure drop at which each fracture first slips.
 
 The subpackage imports nothing itself: import the module you need (``from
 xfemslip.studies.sweep import ...``)."""
 
-__all__ = ["depletion", "dfn_summary", "run", "sampling", "screen", "sweep", "vary"]
+__all__ = ["depletion", "dfn_summary", "run", "sampling", "sweep", "vary"]

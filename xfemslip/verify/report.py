@@ -1,7 +1,7 @@
 """Output of ``xfemslip verify``: the table, the CSV file and the plot.
 
 The rows, the window sweep and the missed targets come from
-``xfemslip.reference.verify.run_verification``; nothing here computes an error.
+``xfemslip.verify.problems.run_verification``; nothing here computes an error.
 """
 
 from __future__ import annotations
@@ -13,7 +13,7 @@ import numpy as np
 
 from xfemslip.io.csv import write_rows
 from xfemslip.io.fileset import replace_files
-from xfemslip.reference.verify import (
+from xfemslip.verify.problems import (
     HALF_LENGTH,
     SLIP_TARGET,
     TARGET_H,
