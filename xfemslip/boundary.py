@@ -15,7 +15,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from xfemslip.enrichment import candidate_values
+from xfemslip.enrichment import HEAVISIDE, group_values
 from xfemslip.errors import GeometryError
 from xfemslip.quadrature import LINE_POINTS, LINE_WEIGHTS
 
@@ -177,6 +177,7 @@ def traction_load(mesh, boundary, loading, ec, cand, dofmap, fractures) -> np.nd
     sxx, syy, sxy = sig
     S = np.array([[sxx, sxy], [sxy, syy]])
     enr_pos = {int(c): e for e, c in enumerate(ec.cells)}
+    segments = []  # boundary edges of enriched cells: (cell, e, p, q, t)
     for name in ("bottom", "top", "left", "right"):
         edge = getattr(boundary, name)
         mask = np.ones(2)
@@ -194,19 +195,9 @@ def traction_load(mesh, boundary, loading, ec, cand, dofmap, fractures) -> np.nd
             F[2 * p : 2 * p + 2] += 0.5 * length * t
             F[2 * q : 2 * q + 2] += 0.5 * length * t
             if int(cell) in enr_pos:
-                _enriched_edge_load(
-                    F,
-                    mesh,
-                    int(cell),
-                    enr_pos[int(cell)],
-                    p,
-                    q,
-                    t,
-                    ec,
-                    cand,
-                    dofmap,
-                    fractures,
-                )
+                segments.append((int(cell), enr_pos[int(cell)], p, q, t))
+    if segments:
+        _enriched_edge_load(F, mesh, segments, ec, cand, dofmap, fractures)
     return F
 
 
@@ -222,32 +213,66 @@ def edge_cells(mesh, edge: str) -> np.ndarray:
     }[edge].astype(np.int64)
 
 
-def _enriched_edge_load(F, mesh, cell, e, p, q, t, ec, cand, dofmap, fractures):
-    """int N_a (F - F_a) t ds over a boundary edge of an enriched cell."""
-    xp, xq = mesh.nodes[p], mesh.nodes[q]
-    cuts = [0.0, 1.0]
-    for fr in fractures:  # split where the edge crosses a kink line of F
-        for point, normal in fr.kink_lines():
+def _edge_points(mesh, segments, fractures):
+    """Gauss points of the boundary edges of enriched cells, each edge split
+    where it crosses a kink line of an enrichment function.
+
+    Returns per point: the segment index (P,), x (P, 2), the midpoint of its
+    piece of edge (P, 2), which decides the side of the fracture, and the
+    weight times the length (P,) [m]."""
+    lines = [ln for fr in fractures for ln in fr.kink_lines()]
+    seg, xs, mids, coefs = [], [], [], []
+    for i, (_, _, p, q, _) in enumerate(segments):
+        xp, xq = mesh.nodes[p], mesh.nodes[q]
+        cuts = [0.0, 1.0]
+        for point, normal in lines:
             den = (xq - xp) @ normal
             if den != 0.0:
                 s = ((point - xp) @ normal) / den
                 if 0.0 < s < 1.0:
                     cuts.append(s)
-    cuts = np.sort(cuts)
-    length = np.linalg.norm(xq - xp)
-    for a0, a1 in zip(cuts[:-1], cuts[1:], strict=True):
-        mid = xp + 0.5 * (a0 + a1) * (xq - xp)
-        for g, w in zip(LINE_POINTS, LINE_WEIGHTS, strict=True):
-            s = 0.5 * (a0 + a1) + 0.5 * (a1 - a0) * g
-            x = xp + s * (xq - xp)
-            N = mesh.shape_at(np.array([cell]), x[None])[0]
-            for slot, k in enumerate(ec.slot_cand[e]):
-                if k < 0 or dofmap.cand_dof[k] < 0:
-                    continue
-                fr = fractures[cand.fracture[k]]
-                Fx = candidate_values(
-                    fractures, cand, k, x[None], fr.side(mid[None]), 0.0
-                )[0][0]
-                phi = N[ec.slot_node[e, slot]] * (Fx - ec.slot_fnode[e, slot])
-                d = dofmap.cand_dof[k]
-                F[d : d + 2] += 0.5 * (a1 - a0) * length * w * phi * t
+        cuts = np.sort(cuts)
+        a0, a1 = cuts[:-1, None], cuts[1:, None]
+        s = 0.5 * (a0 + a1) + 0.5 * (a1 - a0) * LINE_POINTS[None, :]  # (m, 4)
+        xs.append(xp + s.reshape(-1, 1) * (xq - xp))
+        mid = xp + (0.5 * (a0 + a1)) * (xq - xp)  # (m, 2)
+        mids.append(np.repeat(mid, LINE_POINTS.size, axis=0))
+        length = np.linalg.norm(xq - xp)
+        coefs.append((0.5 * (a1 - a0) * length * LINE_WEIGHTS[None, :]).ravel())
+        seg.append(np.full(s.size, i))
+    return (
+        np.concatenate(seg),
+        np.concatenate(xs),
+        np.concatenate(mids),
+        np.concatenate(coefs),
+    )
+
+
+def _enriched_edge_load(F, mesh, segments, ec, cand, dofmap, fractures):
+    """int N_a (F - F_a) t ds over the boundary edges of the enriched cells
+    (``segments``: (cell, enriched-cell position, node p, node q, traction)),
+    every function of a (fracture, tip) group evaluated at all its points at
+    once."""
+    seg, x, mid, coef = _edge_points(mesh, segments, fractures)
+    cell = np.array([g[0] for g in segments], np.int64)[seg]
+    e = np.array([g[1] for g in segments], np.int64)[seg]
+    t = np.array([g[4] for g in segments], float)[seg]
+    N = mesh.shape_at(cell, x)
+    k = ec.slot_cand[e]  # (P, S)
+    kc = np.maximum(k, 0)
+    live = (k >= 0) & (dofmap.cand_dof[kc] >= 0)
+    groups = np.where(live, cand.fracture[kc], -1), np.where(live, cand.tip[kc], 0)
+    pairs = np.unique(np.column_stack([g[live] for g in groups]), axis=0)
+    for fi, tip in pairs:
+        rows, cols = np.nonzero(live & (groups[0] == fi) & (groups[1] == tip))
+        fr = fractures[fi]
+        values = group_values(fractures, fi, tip, x[rows], fr.side(mid[rows]), 0.0)[0]
+        kk = kc[rows, cols]
+        j = np.where(cand.func[kk] == HEAVISIDE, 0, cand.func[kk] - 1)
+        Fx = values[np.arange(rows.size), j]
+        er = e[rows]
+        phi = N[rows, ec.slot_node[er, cols]] * (Fx - ec.slot_fnode[er, cols])
+        contribution = (coef[rows] * phi)[:, None] * t[rows]
+        d = dofmap.cand_dof[kk]
+        np.add.at(F, d, contribution[:, 0])
+        np.add.at(F, d + 1, contribution[:, 1])

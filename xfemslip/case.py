@@ -41,12 +41,20 @@ CSV file of segments, random networks),
 
 from __future__ import annotations
 
-import tomllib
 from pathlib import Path
 
 from xfemslip.case_boundary import EDGE_KEYS, EDGE_WORDS, _read_boundary
 from xfemslip.case_csv import CSV_HEADER, CSV_TOLERANCE, MAX_CSV_PROBLEMS
 from xfemslip.case_describe import describe
+from xfemslip.case_files import (
+    MAX_CSV_BYTES,
+    MAX_NAME_BYTES,
+    MAX_TOML_BYTES,
+    MAX_TOML_DEPTH,
+    parse_toml,
+    path_problem,
+    read_text,
+)
 from xfemslip.case_fractures import (
     FRACTURE_KEYS,
     TIP_KEYS,
@@ -102,6 +110,10 @@ __all__ = [
     "EDGE_WORDS",
     "FRACTURE_KEYS",
     "MATERIAL_MODELS",
+    "MAX_CSV_BYTES",
+    "MAX_NAME_BYTES",
+    "MAX_TOML_BYTES",
+    "MAX_TOML_DEPTH",
     "MAX_CSV_PROBLEMS",
     "MAX_ELEMENTS",
     "MAX_STEPS",
@@ -130,6 +142,8 @@ __all__ = [
     "describe",
     "load_case",
     "loads_case",
+    "parse_toml",
+    "path_problem",
     "read_text",
 ]
 
@@ -228,9 +242,21 @@ def _read_name(root: _Table, path: Path) -> str | None:
     name = root.string("name", path.stem)
     if name is None or not root.has("name"):
         return name
-    if any(c in "/\\" or ord(c) < 32 for c in name):
-        message = "must not contain a path separator or a control character"
+    if any(c in "/\\" or ord(c) < 32 for c in name) or name in (".", ".."):
+        message = (
+            "must not be . or .."
+            if name in (".", "..")
+            else "must not contain a path separator or a control character"
+        )
         root.error("name", f"{message}, got {name!r} (it names the output directory)")
+        return None
+    size = len(name.encode("utf-8", "surrogatepass"))
+    if size > MAX_NAME_BYTES:
+        root.error(
+            "name",
+            f"is {size} bytes long, more than the {MAX_NAME_BYTES} of a folder name "
+            "(it names the output directory)",
+        )
         return None
     return name
 
@@ -348,6 +374,10 @@ def _read_output(root: _Table, name: str | None) -> OutputSpec | None:
     if table is None:
         return None
     directory = table.string("directory", None)
+    problem = path_problem(directory) if directory is not None else None
+    if problem:
+        table.error("directory", f"{problem}, got {_show(directory)}")
+        directory = None
     formats = _read_formats(table)
     if formats is None or (
         directory is None and (table.has("directory") or name is None)
@@ -383,28 +413,11 @@ def load_case(path: str | Path) -> CaseSpec:
     return loads_case(read_text(path, "case file"), path)
 
 
-def read_text(path: Path, what: str) -> str:
-    """The UTF-8 text of an input file; CaseError naming it if unreadable."""
-    try:
-        return path.read_text(encoding="utf-8")
-    except OSError as exc:
-        raise CaseError(
-            path, [("", f"cannot read the {what}: {exc.strerror or exc}")]
-        ) from None
-    except UnicodeDecodeError as exc:
-        raise CaseError(
-            path, [("", f"not a UTF-8 text file: {exc.reason} at byte {exc.start}")]
-        ) from None
-
-
 def loads_case(text: str, path: str | Path = "<string>") -> CaseSpec:
     """Validate and resolve case-file ``text``; ``path`` names it in messages,
     gives the default ``name`` (its stem) and the folder of CSV files."""
     path = Path(path)
-    try:
-        document = tomllib.loads(text)
-    except tomllib.TOMLDecodeError as exc:
-        raise CaseError(path, [("", f"TOML syntax error: {exc}")]) from None
+    document = parse_toml(text, path)
     problems: list[tuple[str, str]] = []
     root = _Table(document, "", problems, TOP_KEYS)
     name = _read_name(root, path)

@@ -14,6 +14,7 @@ from typing import NamedTuple
 
 import numpy as np
 
+from xfemslip.case_files import MAX_CSV_BYTES, UnreadableInput, read_input
 from xfemslip.case_grid import _Grid
 from xfemslip.case_specs import EdgeSpec
 from xfemslip.case_tables import _exact, _frozen, _Table
@@ -49,31 +50,45 @@ def _csv_row(line: str) -> list[float] | str:
     """Four finite numbers of one CSV row, or what is wrong with it."""
     fields = line.split(",")
     if len(fields) != 4:
-        return f"expected 4 values x,y,ux,uy, got {len(fields)}: {line.strip()!r}"
+        return f"expected 4 values x,y,ux,uy, got {len(fields)}: {_quote(line)}"
     row = []
     for name, text in zip(CSV_HEADER, fields, strict=True):
         try:
             value = float(text)
         except ValueError:
-            return f"{name} is not a number: {text.strip()!r}"
+            return f"{name} is not a number: {_quote(text)}"
         if not math.isfinite(value):
-            return f"{name} must be finite, got {text.strip()!r}"
+            return f"{name} must be finite, got {_quote(text)}"
         row.append(value)
     return row
 
 
+def _csv_lines(file: Path, key: str, problems: list) -> list[str] | None:
+    """The lines of a CSV input file (read with the MAX_CSV_BYTES cap), or
+    None after recording why it cannot be read."""
+    try:
+        return read_input(file, MAX_CSV_BYTES).splitlines()
+    except UnreadableInput as exc:
+        problems.append((key, f"cannot read {file}: {exc}"))
+        return None
+
+
+def _quote(text: str, limit: int = 60) -> str:
+    """``repr`` of a CSV line or field for a message, cut to ``limit`` chars."""
+    text = text.strip()
+    if len(text) <= limit:
+        return repr(text)
+    return f"{text[:limit]!r}... ({len(text)} characters)"
+
+
 def _read_csv(file: Path, key: str, problems: list) -> tuple[np.ndarray, list] | None:
     """Rows (m, 4) ``[x, y, ux, uy]`` of a boundary CSV file and their line numbers."""
-    try:
-        lines = file.read_text(encoding="utf-8-sig").splitlines()
-    except (OSError, UnicodeDecodeError) as exc:
-        problems.append(
-            (key, f"cannot read {file}: {getattr(exc, 'strerror', None) or exc}")
-        )
+    lines = _csv_lines(file, key, problems)
+    if lines is None:
         return None
     header = tuple(c.strip().lower() for c in lines[0].split(",")) if lines else ()
     if header != CSV_HEADER:
-        got = repr(lines[0].strip()) if lines else "an empty file"
+        got = _quote(lines[0]) if lines else "an empty file"
         problems.append((key, f"{file} line 1: header must be x,y,ux,uy, got {got}"))
         return None
     rows, numbers, bad = [], [], []

@@ -18,6 +18,7 @@ from xfemslip.case_specs import FractureSpec
 from xfemslip.case_tables import (
     _NON_NEGATIVE,
     _POSITIVE,
+    MAX_COORDINATE,
     _check_number,
     _check_vector,
     _exact,
@@ -132,6 +133,13 @@ def _read_fracture(
     kn = table.number("kn", None, rule=_POSITIVE)
     kt = table.number("kt", None, rule=_POSITIVE)
     tip, radius = _read_tip(table)
+    if points is not None and np.abs(points).max() > MAX_COORDINATE:
+        table.error(
+            "points" if table.has("points") else "length",
+            f"a vertex lies beyond +-{MAX_COORDINATE:g} m (squared distances in "
+            f"the geometry would overflow), got {_exact(np.abs(points).max())}",
+        )
+        points = None
     if points is not None:
         _check_polyline(table, points, grid)
     if len(table.problems) > start:

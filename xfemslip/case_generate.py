@@ -18,6 +18,7 @@ from xfemslip.case_segments import MAX_NETWORK_FRACTURES
 from xfemslip.case_tables import (
     _NON_NEGATIVE,
     _POSITIVE,
+    MAX_COORDINATE,
     Range,
     _fmt,
     _show,
@@ -110,7 +111,8 @@ def _read_length(parent: _Table) -> dfn.LengthLaw | None:
         exponent = table.number("exponent", rule=Range(-10.0, 10.0))
         if len(table.problems) > start:
             return None
-        return dfn.LengthLaw(kind=kind, exponent=exponent, lmin=lmin, lmax=lmax)
+        law = dfn.LengthLaw(kind=kind, exponent=exponent, lmin=lmin, lmax=lmax)
+        return _drawable(table, law)
     median = table.number("median", rule=_POSITIVE)
     sigma = table.number("sigma", rule=Range(0.0, 10.0, lo_open=True))
     if len(table.problems) > start:
@@ -124,7 +126,49 @@ def _read_length(parent: _Table) -> dfn.LengthLaw | None:
             f"at least {MIN_LOGNORMAL_MASS:g} is needed",
         )
         return None
-    return law
+    return _drawable(table, law)
+
+
+def _drawable(table: _Table, law: dfn.LengthLaw) -> dfn.LengthLaw | None:
+    """The law, if its mean and (power law) its inverse CDF at 0 and 1 come
+    out finite and in [min, max]; values such as min = 1e-300 with exponent
+    2.5 overflow (min**(1 - exponent) = 1e450)."""
+    try:
+        with np.errstate(all="ignore"):  # an overflow is the answer, not a warning
+            mean = dfn.mean_length(law)
+            ends = (
+                dfn.power_law_ppf(
+                    np.array([0.0, 1.0]), law.exponent, law.lmin, law.lmax
+                )
+                if law.kind == "power_law"
+                else np.array([mean, mean])
+            )
+    except (OverflowError, ZeroDivisionError, ValueError):
+        mean, ends = math.nan, np.array([math.nan, math.nan])
+    lo = law.lmin if law.lmin is not None else 0.0
+    hi = law.lmax if law.lmax is not None else math.inf
+    slack = 1e-6 * (hi - lo) if math.isfinite(hi - lo) else 0.0
+    inside = np.all((ends >= lo - slack) & (ends <= hi + slack))
+    if math.isfinite(mean) and np.all(np.isfinite(ends)) and inside:
+        return law
+    values = ", ".join(
+        f"{name} = {getattr(law, attr)!r}"
+        for name, attr in (
+            ("exponent", "exponent"),
+            ("median", "median"),
+            ("sigma", "sigma"),
+            ("min", "lmin"),
+            ("max", "lmax"),
+        )
+        if table.has(name)
+    )
+    table.error(
+        None,
+        f"the {law.kind} law with {values} cannot be drawn in floating point "
+        "(its mean length or its inverse CDF overflows); use bounds closer "
+        "to the fracture lengths of the domain",
+    )
+    return None
 
 
 def _lognormal_mass(law: dfn.LengthLaw) -> float:
@@ -187,15 +231,17 @@ def _read_region(table: _Table) -> tuple[float, float, float, float] | None | bo
         isinstance(c, list)
         and len(c) == 2
         and all(
-            isinstance(v, int | float) and not isinstance(v, bool) and math.isfinite(v)
+            isinstance(v, int | float)
+            and not isinstance(v, bool)
+            and abs(v) <= MAX_COORDINATE  # False for NaN, inf, 1e400
             for v in c
         )
         for c in corners
     ):
         table.error(
             "region",
-            f"expected [[x0, y0], [x1, y1]] (lower-left and upper-right corners, m), "
-            f"got {_show(value)}",
+            "expected [[x0, y0], [x1, y1]] (lower-left and upper-right corners, "
+            f"m, within +-{MAX_COORDINATE:g}), got {_show(value)}",
         )
         return False
     (x0, y0), (x1, y1) = corners
@@ -253,16 +299,33 @@ def _read_generate(table: _Table) -> dfn.DfnParams | None:
     )
 
 
+def _expected_count(params: dfn.DfnParams, box) -> float:
+    """The count ``dfn.resolve_count`` rounds, as a float that may be inf or
+    NaN (p21 = 1e308), so that it is checked before it is converted."""
+    if params.count is not None:
+        return float(params.count)
+    x0, x1, y0, y1 = params.region or box
+    area = (x1 - x0) * (y1 - y0)
+    if params.p20 is not None:
+        return params.p20 * area
+    total = sum(s.weight for s in params.sets)
+    mean = sum(s.weight / total * dfn.mean_length(s.length) for s in params.sets)
+    return params.p21 * area / mean
+
+
 def _realize(
     table: _Table, params: dfn.DfnParams, grid: _Grid, existing: np.ndarray
 ) -> dfn.Network | None:
     """The network of ``params`` in the domain; a problem if it does not fit."""
     (x0, y0), (w, h) = grid.origin, grid.size
     box = (x0, x0 + w, y0, y0 + h)
-    wanted = dfn.resolve_count(params, box)
-    if wanted > MAX_NETWORK_FRACTURES:
+    expected = _expected_count(params, box)
+    if not expected <= MAX_NETWORK_FRACTURES + 0.5:  # NaN and inf too
+        key = next(k for k in ("count", "p20", "p21") if table.has(k))
         table.error(
-            None, f"asks for {wanted} fractures, more than {MAX_NETWORK_FRACTURES}"
+            key,
+            f"asks for {expected:.4g} fractures over the region, more than "
+            f"{MAX_NETWORK_FRACTURES}",
         )
         return None
     network = dfn.generate(params, box, existing)

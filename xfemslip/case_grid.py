@@ -15,6 +15,7 @@ from xfemslip.case_specs import MeshSpec
 from xfemslip.case_tables import (
     _POSITIVE,
     _REQUIRED,
+    MAX_COORDINATE,
     Range,
     _check_integer,
     _check_number,
@@ -42,16 +43,25 @@ class _Grid(NamedTuple):
     mesh: MeshSpec
 
 
+def _int_text(n: int) -> str:
+    """An integer of any size (TOML integers are unbounded, floats are not):
+    exact up to 15 digits, else like 1.23e+400."""
+    digits = str(n)
+    if len(digits) <= 15:
+        return digits
+    return f"{digits[0]}.{digits[1:3]}e+{len(digits) - 1}"
+
+
 def _check_element_count(nx: int, ny: int, key: str, problems: list) -> bool:
     """Memory guard on nx * ny (see MAX_ELEMENTS)."""
     count = nx * ny
     if count <= MAX_ELEMENTS:
         return True
-    gigabytes = count * BYTES_PER_ELEMENT / 1e9
+    gigabytes = count * BYTES_PER_ELEMENT // 10**9
     message = (
-        f"{nx} x {ny} = {count} elements exceeds the limit of {MAX_ELEMENTS} "
-        f"(would need at least ~{gigabytes:.3g} GB of memory, "
-        f"~{BYTES_PER_ELEMENT // 1024} kB per element)"
+        f"{_int_text(nx)} x {_int_text(ny)} = {_int_text(count)} elements exceeds "
+        f"the limit of {MAX_ELEMENTS} (would need at least ~{_int_text(gigabytes)} "
+        f"GB of memory, ~{BYTES_PER_ELEMENT // 1024} kB per element)"
     )
     problems.append((key, message))
     return False
@@ -91,13 +101,24 @@ def _read_axis(mesh: _Table, name: str) -> np.ndarray | None:
 
 @np.errstate(over="ignore")
 def _axis_resolves(coords: np.ndarray, key: str, problems: list) -> bool:
-    """Resolved node coordinates must stay finite and strictly increasing."""
+    """Resolved node coordinates must stay finite, strictly increasing and
+    within MAX_COORDINATE."""
     if (
         np.isfinite(coords).all()
         and np.isfinite(coords[-1] - coords[0])
         and (np.diff(coords) > 0.0).all()
     ):
-        return True
+        if np.abs(coords).max() <= MAX_COORDINATE:
+            return True
+        problems.append(
+            (
+                key,
+                f"node coordinates from {_exact(coords[0])} to {_exact(coords[-1])} "
+                f"reach beyond +-{MAX_COORDINATE:g} m (squared distances in the "
+                "geometry would overflow)",
+            )
+        )
+        return False
     message = (
         f"node coordinates from {_exact(coords[0])} to {_exact(coords[-1])} are not "
         "finite and strictly increasing in float64 (sizes too small relative to the "

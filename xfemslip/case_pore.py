@@ -13,6 +13,7 @@ import numpy as np
 
 from xfemslip.case_specs import PorePressureSpec, ReservoirSpec
 from xfemslip.case_tables import (
+    _COORDINATE,
     _POSITIVE,
     Range,
     _check_number,
@@ -66,7 +67,10 @@ def _check_box(value, key: str, problems: list) -> tuple | None:
             )
         )
         return None
-    items = [_check_number(v, f"{key}[{i}]", problems) for i, v in enumerate(value)]
+    items = [
+        _check_number(v, f"{key}[{i}]", problems, _COORDINATE)
+        for i, v in enumerate(value)
+    ]
     if any(v is None for v in items):
         return None
     x0, y0, x1, y1 = items
@@ -100,7 +104,7 @@ def _read_polygon(table: _Table) -> list | None:
             )
             return None
         xy = [
-            _check_number(c, f"{key}[{i}][{j}]", table.problems)
+            _check_number(c, f"{key}[{i}][{j}]", table.problems, _COORDINATE)
             for j, c in enumerate(v)
         ]
         if any(c is None for c in xy):

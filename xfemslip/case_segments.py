@@ -9,14 +9,22 @@ validated); import the public names from ``xfemslip.case``, not from here.
 from __future__ import annotations
 
 import math
+from collections import Counter
 from pathlib import Path
 
 import numpy as np
 
-from xfemslip.case_csv import CSV_TOLERANCE, _add_capped
+from xfemslip.case_csv import (
+    CSV_TOLERANCE,
+    MAX_CSV_PROBLEMS,
+    _add_capped,
+    _csv_lines,
+    _quote,
+)
 from xfemslip.case_grid import _Grid
 from xfemslip.case_polyline import _segment_meets_box, _self_intersection
 from xfemslip.case_tables import (
+    _COORDINATE,
     _NON_NEGATIVE,
     _POSITIVE,
     _exact,
@@ -38,19 +46,28 @@ MAX_NETWORK_FRACTURES = 5_000  # per source (file rows, generated count)
 
 
 def _csv_header(line: str | None, file: Path) -> tuple[list[str], list[str]]:
-    """(columns, problems) of the header line."""
+    """(columns, problems) of the header line; a suggestion for the first few
+    unknown columns only (a header of a million columns is answered at once)."""
     if line is None:
         return [], [f"{file} line 1: empty file, expected the header x0,y0,x1,y1"]
     columns = [c.strip().lower() for c in line.split(",")]
     allowed = SEGMENT_COLUMNS + OPTIONAL_COLUMNS
-    bad = [
-        f"{file} line 1: unknown column {c!r}{_suggest(c, allowed)}"
-        for c in columns
-        if c not in allowed
-    ]
+    unknown = [c for c in columns if c not in allowed]
+    if len(unknown) > MAX_CSV_PROBLEMS:
+        first = ", ".join(_quote(c) for c in unknown[:3])
+        bad = [
+            f"{file} line 1: {len(unknown)} unknown columns ({first}, ...); "
+            "allowed: " + ", ".join(allowed)
+        ]
+    else:
+        bad = [
+            f"{file} line 1: unknown column {_quote(c)}{_suggest(c, allowed)}"
+            for c in unknown
+        ]
+    counts = Counter(c for c in columns if c in allowed)
     bad += [
         f"{file} line 1: column {c!r} appears twice"
-        for c in sorted({c for c in columns if columns.count(c) > 1})
+        for c in sorted(c for c, n in counts.items() if n > 1)
     ]
     missing = [c for c in SEGMENT_COLUMNS if c not in columns]
     if missing:
@@ -73,10 +90,11 @@ def _csv_cell(name: str, text: str) -> tuple[object, str | None]:
     try:
         value = float(text)
     except ValueError:
-        return None, f"{name} is not a number: {text!r}"
+        return None, f"{name} is not a number: {_quote(text)}"
     if not math.isfinite(value):
-        return None, f"{name} must be finite, got {text!r}"
-    message = _range_problem(value, PROPERTY_RULES.get(name), name)
+        return None, f"{name} must be finite, got {_quote(text)}"
+    rule = _COORDINATE if name in SEGMENT_COLUMNS else PROPERTY_RULES.get(name)
+    message = _range_problem(value, rule, name)
     return value, (f"{name} {message}" if message else None)
 
 
@@ -90,7 +108,7 @@ def _csv_rows(lines: list[str], columns: list[str], file: Path):
         if len(fields) != len(columns):
             bad.append(
                 f"{file} line {number}: expected {len(columns)} values "
-                f"({','.join(columns)}), got {len(fields)}: {line.strip()!r}"
+                f"({','.join(columns)}), got {len(fields)}: {_quote(line)}"
             )
             continue
         row, problems = {}, []
@@ -110,6 +128,27 @@ def _csv_rows(lines: list[str], columns: list[str], file: Path):
     return rows, bad
 
 
+def _fracture_count(lines: list[str], columns: list[str]) -> int:
+    """Fractures of the file from its ``fracture`` column alone (a row without
+    an id is a fracture of its own), counted before any number is read."""
+    rows = (
+        line.split(",")
+        for line in lines[1:]
+        if line.strip() and not line.lstrip().startswith("#")
+    )
+    if "fracture" not in columns:
+        return sum(1 for _ in rows)
+    at = columns.index("fracture")
+    ids, single = set(), 0
+    for fields in rows:
+        fid = fields[at].strip() if at < len(fields) else ""
+        if fid:
+            ids.add(fid)
+        else:
+            single += 1
+    return len(ids) + single
+
+
 def _group_rows(rows: list) -> list[tuple[str, list]]:
     """Rows grouped by the ``fracture`` column in order of first appearance; a
     row without a fracture id is a fracture of its own."""
@@ -122,9 +161,12 @@ def _group_rows(rows: list) -> list[tuple[str, list]]:
     return [(k if isinstance(k, str) else None, g) for k, g in groups.items()]
 
 
-def _lines_text(group: list) -> str:
-    """``line 4`` or ``lines 4, 5, 9``."""
+def _lines_text(group: list, shown: int = 6) -> str:
+    """``line 4``, ``lines 4, 5, 9`` or ``lines 4, 5, 9, ..., 812 (40 rows)``."""
     numbers = [str(n) for n, _ in group]
+    if len(numbers) > shown:
+        head = ", ".join(numbers[: shown - 1])
+        return f"lines {head}, ..., {numbers[-1]} ({len(numbers)} rows)"
     return f"line{'s' if len(numbers) > 1 else ''} {', '.join(numbers)}"
 
 
@@ -137,7 +179,7 @@ def _chain(group: list, fid, file: Path, tol: float) -> tuple[np.ndarray | None,
         start = (row["x0"], row["y0"])
         if math.dist(start, points[-1]) > tol:
             bad.append(
-                f"{file} line {number}: fracture {fid!r} continues at "
+                f"{file} line {number}: fracture {_quote(fid)} continues at "
                 f"({_exact(start[0])}, {_exact(start[1])}) but its segment on line "
                 f"{prev} ends at ({_exact(points[-1][0])}, {_exact(points[-1][1])}); "
                 "the rows of a fracture must chain end to start"
@@ -156,7 +198,7 @@ def _group_properties(group: list, fid, file: Path, defaults: dict):
         if len(values) > 1:
             (n1, v1), (n2, v2) = given[0], next(g for g in given if g[1] != given[0][1])
             bad.append(
-                f"{file} lines {n1} and {n2}: fracture {fid!r} has {name} "
+                f"{file} lines {n1} and {n2}: fracture {_quote(fid)} has {name} "
                 f"{_fmt(v1)} and {_fmt(v2)}; its rows must agree"
             )
         props[name] = given[0][1] if given else defaults.get(name)
@@ -176,16 +218,18 @@ def _read_segments_file(
     if name is None:
         return None
     file, key = folder / name, table.key("file")
-    try:
-        lines = file.read_text(encoding="utf-8-sig").splitlines()
-    except (OSError, UnicodeDecodeError) as exc:
-        table.error(
-            "file", f"cannot read {file}: {getattr(exc, 'strerror', None) or exc}"
-        )
+    lines = _csv_lines(file, key, table.problems)
+    if lines is None:
         return None
     columns, bad = _csv_header(lines[0] if lines else None, file)
     if bad:
         _add_capped(table.problems, key, bad)
+        return None
+    count = _fracture_count(lines, columns)
+    if count > MAX_NETWORK_FRACTURES:  # before a number is read
+        table.error(
+            "file", f"{file}: {count} fractures, more than {MAX_NETWORK_FRACTURES}"
+        )
         return None
     rows, bad = _csv_rows(lines, columns, file)
     tol = CSV_TOLERANCE * max(grid.size) if grid is not None else 0.0
@@ -201,12 +245,10 @@ def _read_segments_file(
         if shape:
             bad.append(f"{where}: {shape}")
             continue
-        label = f"fracture {fid!r}, " if fid is not None else ""
+        label = f"fracture {_quote(fid)}, " if fid is not None else ""
         out.append((points, props, f"network.file {name}: {label}{_lines_text(group)}"))
     if not rows and not bad:
         bad.append(f"{file}: no segment rows after the header")
-    if len(out) > MAX_NETWORK_FRACTURES:
-        bad.append(f"{file}: {len(out)} fractures, more than {MAX_NETWORK_FRACTURES}")
     _add_capped(table.problems, key, bad)
     return None if bad else out
 

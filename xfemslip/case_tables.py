@@ -37,8 +37,14 @@ class Option(NamedTuple):
 
 
 _REQUIRED = object()  # sentinel default: the key must be given
+MAX_SUGGESTIONS = 20  # unknown keys of one table that get a 'did you mean'
+
 _POSITIVE = Range(0.0, lo_open=True)
 _NON_NEGATIVE = Range(0.0)
+# |x|, |y| of every point of a case [m]: the geometry squares distances, which
+# must stay finite (1e150**2 = 1e300); a kilometre-scale model is at 1e3.
+MAX_COORDINATE = 1e150
+_COORDINATE = Range(-MAX_COORDINATE, MAX_COORDINATE)
 
 
 # --------------------------------------------------------------------------- #
@@ -188,10 +194,12 @@ class _Table:
         self.problems = problems
         self.present = present  # False: an optional table the file leaves out
         where = f" in [{path}]" if path else ""
-        for name in data if allowed is not None else ():
-            if name not in allowed:
-                message = f"unknown key {name!r}{where}{_suggest(name, allowed)}"
-                self.error(name, message)
+        unknown = [n for n in data if allowed is not None and n not in allowed]
+        for k, name in enumerate(unknown):
+            # a suggestion for the first few; thousands of unknown keys are
+            # a wrong file, and difflib on each would take seconds
+            hint = _suggest(name, allowed) if k < MAX_SUGGESTIONS else ""
+            self.error(name, f"unknown key {name!r}{where}{hint}")
 
     def key(self, name: str | None) -> str:
         """Key path of ``name`` in this table (the table's own path for None)."""

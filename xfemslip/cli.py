@@ -24,6 +24,7 @@ from __future__ import annotations
 
 import contextlib
 import logging
+import math
 import platform
 import sys
 import traceback
@@ -33,6 +34,7 @@ from pathlib import Path
 import click
 
 from xfemslip import __version__
+from xfemslip.case_files import path_problem
 from xfemslip.errors import (
     CaseError,
     GeometryError,
@@ -130,25 +132,123 @@ def _reported_errors(debug: bool) -> Iterator[None]:
 
 def _load(case: Path):
     """Load and validate a case file (``CaseError`` on any problem)."""
+    from xfemslip.case import load_case
+
+    problem = path_problem(case)
+    if problem:
+        raise UsageError(f"{_shown_path(case)}: the path {problem}")
     if not case.exists():
         raise UsageError(f"{case}: no such file")
     if case.is_dir():
         raise UsageError(f"{case}: is a directory, expected a case file (.toml)")
-    from xfemslip.case import load_case
-
     return load_case(case)
+
+
+def _shown_path(path) -> str:
+    """A path for a message: NUL bytes escaped, cut to 80 characters."""
+    text = repr(str(path))[1:-1]
+    return text if len(text) <= 80 else text[:77] + "..."
+
+
+class _Path(click.Path):
+    """``click.Path`` that refuses a path no file system can hold (a NUL byte,
+    which click's own ``os.stat`` turns into a ValueError; a name over 255
+    bytes) and, with ``empty_ok=False``, an empty path (``-o ""`` would write
+    into the current folder)."""
+
+    def __init__(self, *args, empty_ok: bool = True, **kwargs):
+        super().__init__(*args, **kwargs)
+        self.empty_ok = empty_ok
+
+    def convert(self, value, param, ctx):
+        if isinstance(value, str):
+            if not value and not self.empty_ok:
+                self.fail("the path is empty", param, ctx)
+            problem = path_problem(value)
+            if problem:
+                self.fail(f"{_shown_path(value)}: {problem}", param, ctx)
+        return super().convert(value, param, ctx)
+
+
+class _FiniteFloat(click.FloatRange):
+    """``click.FloatRange`` without NaN and infinities (``float("nan")``
+    passes every range test)."""
+
+    def convert(self, value, param, ctx):
+        number = super().convert(value, param, ctx)
+        if not math.isfinite(number):
+            self.fail(f"{number!r} is not a finite number", param, ctx)
+        return number
+
+
+def _figure_path(ctx, param, value):
+    """A figure file whose suffix matplotlib can write (checked before any
+    work; matplotlib is imported only when a figure is asked for)."""
+    if value is None:
+        return value
+    from matplotlib.backend_bases import FigureCanvasBase
+
+    known = FigureCanvasBase.get_supported_filetypes()
+    if value.suffix.lstrip(".").lower() not in known:
+        raise click.BadParameter(
+            f"{_shown_path(value)}: the suffix must be one of "
+            + ", ".join(f".{k}" for k in sorted(known))
+        )
+    return value
+
+
+class _OneLineUsageError(click.UsageError):
+    """A click usage error shown as one line ``Error: ...`` (no usage block),
+    like every other refusal of the CLI."""
+
+    def show(self, file=None) -> None:
+        hint = f" (see '{self.ctx.command_path} --help')" if self.ctx else ""
+        message = " ".join(self.format_message().split())
+        click.echo(f"Error: {message}{hint}", err=True)
+
+
+@contextlib.contextmanager
+def _one_line_usage() -> Iterator[None]:
+    """Re-raise click's usage errors (bad options, arguments) as one line."""
+    try:
+        yield
+    except _OneLineUsageError:
+        raise
+    except getattr(click.exceptions, "NoArgsIsHelpError", ()):
+        raise  # `xfemslip` alone prints the help
+    except click.UsageError as err:
+        raise _OneLineUsageError(err.format_message(), err.ctx) from None
+
+
+class _Group(click.Group):
+    """The command group; its usage errors and its subcommands' are one line."""
+
+    def make_context(self, info_name, args, parent=None, **extra):
+        with _one_line_usage():
+            return super().make_context(info_name, args, parent, **extra)
+
+    def invoke(self, ctx):
+        with _one_line_usage():
+            return super().invoke(ctx)
 
 
 _debug_option = click.option(
     "--debug", is_flag=True, help="Show the traceback of a reported error."
 )
-_case_argument = click.argument("case", type=click.Path(path_type=Path))
+_case_argument = click.argument("case", type=_Path(path_type=Path))
 
 
-@click.group(context_settings={"help_option_names": ["-h", "--help"]})
+@click.group(cls=_Group, context_settings={"help_option_names": ["-h", "--help"]})
 @click.version_option(__version__, prog_name="xfemslip")
 def cli() -> None:
     """XFEM frictional contact on 2D fractures, driven by TOML case files."""
+    from xfemslip.cli_env import check_environment
+
+    try:  # not inside _reported_errors: the command installs the signal handlers
+        check_environment()
+    except UsageError as err:
+        click.echo(f"Error: {_one_line(err)}", err=True)
+        raise click.exceptions.Exit(EXIT_USAGE) from None
 
 
 def _solve_options(command):
@@ -160,7 +260,7 @@ def _solve_options(command):
                 "-o",
                 "--output",
                 "output",
-                type=click.Path(file_okay=False, path_type=Path),
+                type=_Path(file_okay=False, path_type=Path, empty_ok=False),
                 default=None,
                 help="Output directory [default: output.directory of the case, "
                 "else out/<name>].",
@@ -261,13 +361,13 @@ def info() -> None:
 )
 @click.option(
     "--plot",
-    type=click.Path(dir_okay=False, path_type=Path),
+    type=_Path(dir_okay=False, path_type=Path, empty_ok=False),
     help="Write error vs h and error vs wall time (.png or .pdf).",
 )
 @click.option(
     "--csv",
     "csv_path",
-    type=click.Path(dir_okay=False, path_type=Path),
+    type=_Path(dir_okay=False, path_type=Path, empty_ok=False),
     help="Write the table as CSV.",
 )
 @click.option(

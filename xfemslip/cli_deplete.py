@@ -5,13 +5,13 @@ Parses arguments and prints; the work is in :mod:`xfemslip.depletion`.
 
 from __future__ import annotations
 
-from pathlib import Path
-
 import click
 
 from xfemslip.cli import (
+    _case_argument,
     _configure_logging,
     _debug_option,
+    _FiniteFloat,
     _load,
     _reported_errors,
     _solve_options,
@@ -19,11 +19,11 @@ from xfemslip.cli import (
 
 
 @click.command()
-@click.argument("case", type=click.Path(path_type=Path))
+@_case_argument
 @_solve_options
 @click.option(
     "--tolerance",
-    type=click.FloatRange(min=0.0, min_open=True),
+    type=_FiniteFloat(min=0.0, min_open=True),
     default=None,
     help="Bisection tolerance on the critical pore-pressure change [Pa] "
     "[default: 0.1 % of |pore_pressure.change|; a value below |change| x "

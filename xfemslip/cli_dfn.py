@@ -12,7 +12,14 @@ from pathlib import Path
 
 import click
 
-from xfemslip.cli import _case_argument, _debug_option, _load, _reported_errors
+from xfemslip.cli import (
+    _case_argument,
+    _debug_option,
+    _figure_path,
+    _load,
+    _Path,
+    _reported_errors,
+)
 from xfemslip.errors import OutputError, UsageError
 
 
@@ -32,7 +39,7 @@ def _write_text(path: Path, text: str) -> None:
 @click.option(
     "--csv",
     "csv_path",
-    type=click.Path(dir_okay=False, path_type=Path),
+    type=_Path(dir_okay=False, path_type=Path, empty_ok=False),
     help="Write the fractures as a CSV of segments (the network.file format).",
 )
 @click.option(
@@ -43,17 +50,18 @@ def _write_text(path: Path, text: str) -> None:
 )
 @click.option(
     "--plot",
-    type=click.Path(dir_okay=False, path_type=Path),
+    type=_Path(dir_okay=False, path_type=Path, empty_ok=False),
+    callback=_figure_path,
     help="Draw the network (.png or .pdf).",
 )
 @click.option(
     "--result",
-    type=click.Path(dir_okay=False, exists=True, path_type=Path),
+    type=_Path(dir_okay=False, exists=True, path_type=Path),
     help="A result.h5 of this case: colour the figure by |slip|.",
 )
 @click.option(
     "--summary",
-    type=click.Path(dir_okay=False, exists=True, path_type=Path),
+    type=_Path(dir_okay=False, exists=True, path_type=Path),
     help="A sweep's summary.csv: add the histogram of slipping fractures.",
 )
 @_debug_option

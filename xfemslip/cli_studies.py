@@ -16,15 +16,24 @@ from pathlib import Path
 
 import click
 
+from xfemslip.case_files import path_problem
 from xfemslip.cli import (
     EXIT_FAILURE,
     _configure_logging,
     _debug_option,
+    _FiniteFloat,
     _load,
+    _Path,
     _reported_errors,
+    _shown_path,
 )
 from xfemslip.errors import UsageError
 
+# Each local worker holds its own interpreter, NumPy, SciPy and model
+# (~0.2-1 GB); more than a few per CPU only adds memory.
+MAX_JOBS = 4 * (os.cpu_count() or 1)
+# A figure of a few inches at this resolution is already ~100 megapixels.
+MAX_DPI = 2400.0
 KINDS = ("displacement", "principal_stress", "deformed_mesh", "slip", "mohr")
 
 
@@ -34,11 +43,11 @@ KINDS = ("displacement", "principal_stress", "deformed_mesh", "slip", "mohr")
 
 
 @click.command()
-@click.argument("sweep_file", metavar="SWEEP", type=click.Path(path_type=Path))
+@click.argument("sweep_file", metavar="SWEEP", type=_Path(path_type=Path))
 @click.option(
     "-o",
     "--output",
-    type=click.Path(file_okay=False, path_type=Path),
+    type=_Path(file_okay=False, path_type=Path, empty_ok=False),
     default=None,
     help="Sweep folder [default: output.directory of the sweep, else "
     "out/sweeps/<name>].",
@@ -46,10 +55,10 @@ KINDS = ("displacement", "principal_stress", "deformed_mesh", "slip", "mohr")
 @click.option(
     "-j",
     "--jobs",
-    type=click.IntRange(min=1),
+    type=click.IntRange(min=1, max=MAX_JOBS),
     default=None,
-    help="Local worker processes [default: the number of CPUs]; 1 runs the "
-    "cases in this process.",
+    help="Local worker processes [default: the number of CPUs, at most "
+    f"{MAX_JOBS} = 4 x CPUs]; 1 runs the cases in this process.",
 )
 @click.option(
     "--scheduler",
@@ -71,6 +80,9 @@ def sweep(sweep_file, output, jobs, scheduler, force, verbose, debug) -> None:
     """
     with _reported_errors(debug):
         _configure_logging(verbose, not verbose)
+        problem = path_problem(sweep_file)
+        if problem:
+            raise UsageError(f"{_shown_path(sweep_file)}: the path {problem}")
         if not sweep_file.is_file():
             raise UsageError(f"{sweep_file}: no such file")
         from xfemslip.sweep import load_sweep
@@ -136,11 +148,11 @@ def _default_figure_dir(results: list[Path]) -> Path:
 
 
 @click.command()
-@click.argument("results", nargs=-1, required=True, type=click.Path(path_type=Path))
+@click.argument("results", nargs=-1, required=True, type=_Path(path_type=Path))
 @click.option(
     "-o",
     "--output",
-    type=click.Path(file_okay=False, path_type=Path),
+    type=_Path(file_okay=False, path_type=Path, empty_ok=False),
     default=None,
     help="Folder for the figures [default: <result folder>/figures, or the "
     "results' common folder /figures].",
@@ -167,13 +179,13 @@ def _default_figure_dir(results: list[Path]) -> Path:
 )
 @click.option(
     "--scale",
-    type=click.FloatRange(min=0.0, min_open=True),
+    type=_FiniteFloat(min=0.0, min_open=True),
     default=None,
     help="Displacement magnification of the deformed mesh [default: auto].",
 )
 @click.option(
     "--dpi",
-    type=click.FloatRange(min=10.0),
+    type=_FiniteFloat(min=10.0, max=MAX_DPI),
     default=110.0,
     show_default=True,
     help="Resolution of the PNG files.",
@@ -213,11 +225,11 @@ def plot_run(out_dir: Path) -> None:
 
 
 @click.command()
-@click.argument("case", required=False, type=click.Path(path_type=Path))
+@click.argument("case", required=False, type=_Path(path_type=Path))
 @click.option(
     "--stress",
     nargs=3,
-    type=float,
+    type=_FiniteFloat(),
     default=None,
     metavar="XX YY XY",
     help="Total far-field stress [Pa], tension positive "
@@ -226,7 +238,7 @@ def plot_run(out_dir: Path) -> None:
 @click.option(
     "-p",
     "--pore-pressure",
-    type=float,
+    type=_FiniteFloat(),
     default=None,
     help="Pore pressure p [Pa]; effective stress = stress + p I "
     "[default: the final far-field pore pressure of CASE's [pore_pressure], "
@@ -234,13 +246,13 @@ def plot_run(out_dir: Path) -> None:
 )
 @click.option(
     "--friction",
-    type=click.FloatRange(min=0.0),
+    type=_FiniteFloat(min=0.0),
     default=None,
     help="Friction coefficient f [default: the first fracture's].",
 )
 @click.option(
     "--cohesion",
-    type=click.FloatRange(min=0.0),
+    type=_FiniteFloat(min=0.0),
     default=None,
     help="Cohesion c [Pa] [default: the first fracture's, else 0].",
 )
@@ -248,13 +260,13 @@ def plot_run(out_dir: Path) -> None:
     "--angle",
     "angles",
     multiple=True,
-    type=float,
+    type=_FiniteFloat(),
     help="A fracture angle to screen [deg, CCW from +x] (repeatable) "
     "[default: the fractures of CASE].",
 )
 @click.option(
     "--step",
-    type=click.FloatRange(min=0.1, max=90.0),
+    type=_FiniteFloat(min=0.1, max=90.0),
     default=5.0,
     show_default=True,
     help="Angle step of the orientation table [deg].",
@@ -262,14 +274,14 @@ def plot_run(out_dir: Path) -> None:
 @click.option(
     "--csv",
     "csv_path",
-    type=click.Path(dir_okay=False, path_type=Path),
+    type=_Path(dir_okay=False, path_type=Path, empty_ok=False),
     default=None,
     help="Also write the orientation table as CSV.",
 )
 @click.option(
     "--plot",
     "plot_dir",
-    type=click.Path(file_okay=False, path_type=Path),
+    type=_Path(file_okay=False, path_type=Path, empty_ok=False),
     default=None,
     help="Also draw the Mohr diagram into this folder.",
 )

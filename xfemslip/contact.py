@@ -10,6 +10,7 @@ iteration restarts the return map from the committed values.
 from __future__ import annotations
 
 import logging
+import math
 from dataclasses import dataclass, field
 from functools import cached_property
 
@@ -18,7 +19,7 @@ import numpy as np
 from xfemslip import kernels
 from xfemslip.assembly import coo_block, scatter_vector
 from xfemslip.case_specs import AUTO_PENALTY, CONTACT_PATCH_CELLS
-from xfemslip.enrichment import HEAVISIDE, _group_values
+from xfemslip.enrichment import HEAVISIDE, group_values
 from xfemslip.geometry import GEOMETRY_TOL
 
 logger = logging.getLogger(__name__)
@@ -232,10 +233,20 @@ def _cell_size(mesh, cells) -> np.ndarray:
     return np.sqrt((b[:, 1] - b[:, 0]) * (b[:, 3] - b[:, 2]))
 
 
-def _symmetric_groups(lengths, target):
+# A patch holds at most this many pieces (cells) per unit of its target
+# length, whatever their length.  On square-ish cells a patch of 1.5 cells
+# holds 2 to 5 pieces (5 next to junctions, where pieces are short); on cells
+# much longer across the fracture than along it (a strip of 100,000 x 1
+# cells), the sqrt(area) size would gather hundreds of pieces into one patch,
+# whose dense tangent block grows like their square.
+PATCH_PIECES_PER_CELL = 4
+
+
+def _symmetric_groups(lengths, target, max_items=None):
     """Consecutive items (lengths in cell units) in groups at least ``target``
-    long: greedy from both ends toward the middle, so the reversed list gets
-    the mirrored partition (and a rotated or reflected fracture the same one).
+    long (or of ``max_items`` items): greedy from both ends toward the
+    middle, so the reversed list gets the mirrored partition (and a rotated
+    or reflected fracture the same one).
 
     The two leftovers and an item centred exactly on the middle form a middle
     group; one shorter than target joins the shorter of its neighbours (on an
@@ -255,7 +266,7 @@ def _symmetric_groups(lengths, target):
         for i in items:
             members.append(i)
             acc += lengths[i]
-            if acc >= target:
+            if acc >= target or len(members) == max_items:
                 groups.append(members)
                 acc, members = 0.0, []
         return groups, members
@@ -318,7 +329,8 @@ def contact_patches(mesh, fractures, ip, length_cells: float) -> np.ndarray:
         for i in run:
             piece[ip.cell[i]].append(i)
         lengths = [ip.weight[piece[c]].sum() / size[piece[c][0]] for c in cells]
-        for g in _symmetric_groups(lengths, length_cells):
+        cap = PATCH_PIECES_PER_CELL * math.ceil(length_cells)
+        for g in _symmetric_groups(lengths, length_cells, cap):
             patch[[i for c in g for i in piece[cells[c]]]] = next_id
             next_id += 1
     return patch
@@ -397,7 +409,7 @@ def _jump_operators(mesh, fractures, ip, ec, cand, dofmap):
         vals = []
         for probe in (pts + off, pts - off):
             side = fr.side(probe)
-            vals.append(_group_values(fractures, fi, tip, pts, side, tol, probe)[0])
+            vals.append(group_values(fractures, fi, tip, pts, side, tol, probe)[0])
         k = Kc[rows, cols]
         j = np.where(cand.func[k] == HEAVISIDE, 0, cand.func[k] - 1)
         d = (vals[0] - vals[1])[np.arange(rows.size), j]

@@ -80,19 +80,34 @@ def _draw_plain(ax, spec) -> None:
 
 
 def read_slipping_counts(summary: Path) -> tuple[np.ndarray, np.ndarray]:
-    """(slipping_fractures, fractures) of the ok/skipped rows of a summary.csv."""
+    """(slipping_fractures, fractures) of the ok/skipped rows of a summary.csv
+    (read with the size cap of every CSV input; a bad row names its line)."""
+    from xfemslip.case_files import MAX_CSV_BYTES, UnreadableInput, read_input
+
     try:
-        with open(summary, newline="", encoding="utf-8") as fh:
-            rows = list(csv.DictReader(fh))
-    except OSError as exc:
-        raise UsageError(f"{summary}: cannot read: {exc.strerror or exc}") from None
-    if rows and "slipping_fractures" not in rows[0]:
-        raise UsageError(f"{summary}: no slipping_fractures column (an older sweep?)")
-    rows = [r for r in rows if r["status"] in ("ok", "skipped")]
-    return (
-        np.array([int(r["slipping_fractures"]) for r in rows]),
-        np.array([int(r["fractures"]) for r in rows]),
-    )
+        lines = read_input(summary, MAX_CSV_BYTES).splitlines()
+    except UnreadableInput as exc:
+        raise UsageError(f"{summary}: cannot read: {exc}") from None
+    rows = list(csv.DictReader(lines))
+    needed = ("status", "slipping_fractures", "fractures")
+    if rows and any(name not in rows[0] for name in needed):
+        raise UsageError(
+            f"{summary}: expected the columns {', '.join(needed)} of a sweep's "
+            "summary.csv (an older sweep?)"
+        )
+    counts, totals = [], []
+    for line, row in enumerate(rows, start=2):
+        if row["status"] not in ("ok", "skipped"):
+            continue
+        try:
+            counts.append(int(row["slipping_fractures"]))
+            totals.append(int(row["fractures"]))
+        except (TypeError, ValueError):
+            raise UsageError(
+                f"{summary} line {line}: slipping_fractures and fractures must be "
+                "integers"
+            ) from None
+    return np.array(counts, dtype=np.int64), np.array(totals, dtype=np.int64)
 
 
 def _draw_counts(ax, counts: np.ndarray, totals: np.ndarray) -> None:

@@ -140,14 +140,14 @@ def candidate_values(fractures, cand, k, pts, side, tol, probe=None):
 
     probe : (n, 2) points deciding the side of junction lines (default pts).
     """
-    F, grad = _group_values(
+    F, grad = group_values(
         fractures, cand.fracture[k], cand.tip[k], pts, side, tol, probe
     )
     j = 0 if cand.func[k] == HEAVISIDE else cand.func[k] - 1
     return F[:, j], grad[:, j]
 
 
-def _group_values(fractures, fi, tip, pts, side, tol, probe=None):
+def group_values(fractures, fi, tip, pts, side, tol, probe=None):
     """All functions of one (fracture, tip) group: (n, 1) Heaviside or (n, 4) branch.
 
     Heaviside of arm a (tip = -1 - a): F = J R with J the junction function of
@@ -209,7 +209,7 @@ def _candidate_node_values(fractures, mesh, cand, tol):
             rows = np.nonzero((cand.fracture == fi) & (cand.tip == tip))[0]
             pts = mesh.nodes[cand.node[rows]]
             side = np.where(fr.signed_distance(pts) >= -tol, 1.0, -1.0)
-            F = _group_values(fractures, fi, int(tip), pts, side, tol, pts)[0]
+            F = group_values(fractures, fi, int(tip), pts, side, tol, pts)[0]
             j = np.where(cand.func[rows] == HEAVISIDE, 0, cand.func[rows] - 1)
             out[rows] = F[np.arange(rows.size), j]
     return out
@@ -313,7 +313,7 @@ def build_enriched_cells(mesh, fractures, cand: Candidates) -> EnrichedCells:
         ti = _ranges(tri_off[cells], np.diff(tri_off)[cells])
         qi = _ranges(qp_off[cells], np.diff(qp_off)[cells])
         st = fractures[fi].side(centroids[ti])
-        Fq, gq = _group_values(
+        Fq, gq = group_values(
             fractures,
             fi,
             tip,
@@ -322,7 +322,7 @@ def build_enriched_cells(mesh, fractures, cand: Candidates) -> EnrichedCells:
             tol,
             np.repeat(centroids[ti], per_tri[ti], axis=0),
         )
-        Fvert = _group_values(
+        Fvert = group_values(
             fractures,
             fi,
             tip,

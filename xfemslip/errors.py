@@ -6,6 +6,10 @@ codes (``CaseError`` and ``UsageError`` -> exit 2, the others -> exit 1).
 
 from __future__ import annotations
 
+# Problems of a CaseError spelled out in its one-line message (all are kept
+# in ``problems``).
+MAX_SHOWN_PROBLEMS = 20
+
 
 class XfemslipError(Exception):
     """Base class of every error xfemslip reports to a user."""
@@ -23,10 +27,13 @@ class CaseError(XfemslipError):
         self.path = str(path)
         self.problems = [(str(k), str(m)) for k, m in problems]
         parts = [f"{k}: {m}" if k else m for k, m in self.problems]
+        if len(parts) > MAX_SHOWN_PROBLEMS:  # a file of 200,000 unknown keys
+            hidden = len(parts) - MAX_SHOWN_PROBLEMS
+            parts = [*parts[:MAX_SHOWN_PROBLEMS], f"and {hidden} more"]
         if len(parts) == 1:
             text = f"{self.path}: {parts[0]}"
         else:
-            text = f"{self.path}: {len(parts)} problems: " + "; ".join(parts)
+            text = f"{self.path}: {len(self.problems)} problems: " + "; ".join(parts)
         super().__init__(text.replace("\n", " "))
 
 

@@ -712,6 +712,8 @@ class NewtonSolver:
             return ""
         c = self.p.contact
         e_over_h = float(np.max(np.maximum(c.kn, c.kt))) / ratio  # [Pa/m]
+        if not e_over_h > 0.0:  # the ratio overflowed (e.g. E = 1e-300 Pa)
+            return "; the penalty kn*h/E is beyond the float range"
         kn, kt = (float(np.max(v)) / e_over_h for v in (c.kn, c.kt))
         top = PENALTY_RATIO_MEASURED
         return (

@@ -43,18 +43,19 @@ import copy
 import itertools
 import logging
 import re
-import tomllib
 from dataclasses import dataclass
 from pathlib import Path
 
 import tomli_w
 
-from xfemslip.case import loads_case, read_text
+from xfemslip.case import loads_case, parse_toml, path_problem, read_text
+from xfemslip.case_files import MAX_TOML_BYTES, UnreadableInput, read_input
 from xfemslip.case_tables import _show, _Table
 from xfemslip.errors import CaseError, GeometryError, MeshError
 from xfemslip.sweep_vary import (
     MAX_CASES,
     RANGE_KEYS,
+    case_count,
     expand_range,
     parse_key_path,
     read_vary,
@@ -77,6 +78,12 @@ __all__ = [
 SWEEP_KEYS = ("name", "base", "combine", "vary", "output")
 COMBINE = ("product", "zip")
 MAX_PROBLEMS = 20  # invalid generated cases listed in one message
+# Bytes of a case id (ASCII) and of the base name in a case's name: together
+# below the 255 bytes of a folder name.
+MAX_CASE_ID = 100
+# A generous bound on cases x base-case size: a 2 kB base allows far more
+# than MAX_CASES cases; a 1 MB base (thousands of inline fractures) 256.
+MAX_SWEEP_TEXT_BYTES = 256e6
 
 
 @dataclass(frozen=True)
@@ -128,13 +135,14 @@ def _slug(value) -> str:
 
 
 def case_id(index: int, n_cases: int, params) -> str:
-    """Folder name of a case: ``002_angle=45``: index, then each key's last name."""
+    """Folder name of a case: ``002_angle=45``: index, then each key's last
+    name, cut to MAX_CASE_ID characters (the index first keeps it unique)."""
     width = max(3, len(str(n_cases - 1)))
     parts = [f"{index:0{width}d}"]
     for key, value in params:
         name = re.sub(r"\[\d+\]", "", key.rsplit(".", 1)[-1])
         parts.append(f"{name}={_slug(value)}")
-    return "_".join(parts)
+    return "_".join(parts)[:MAX_CASE_ID].rstrip("_")
 
 
 def _combinations(vary: list, combine: str) -> list[tuple[tuple[str, object], ...]]:
@@ -157,7 +165,8 @@ def _build_case(base: dict, base_name: str, index: int, n: int, params, path: Pa
         message = set_key_path(document, parse_key_path(key), value)
         if message:
             problems.append((f'vary."{key}"', message))
-    document["name"] = f"{base_name}-{cid}"
+    short = str(base_name).encode("utf-8")[:MAX_CASE_ID].decode("utf-8", "ignore")
+    document["name"] = f"{short}-{cid}"
     output = document.get("output")
     if isinstance(output, dict):
         output.pop("directory", None)  # the sweep chooses the folder
@@ -208,14 +217,13 @@ def _read_base(root: _Table, path: Path) -> tuple[dict | None, Path, str | None]
         return None, path, None
     base_path = (path.parent / value) if not Path(value).is_absolute() else Path(value)
     try:
-        document = tomllib.loads(base_path.read_text(encoding="utf-8"))
-    except OSError as exc:
-        root.error(
-            "base", f"cannot read the base case {base_path}: {exc.strerror or exc}"
-        )
+        document = parse_toml(read_input(base_path, MAX_TOML_BYTES), base_path)
+    except UnreadableInput as exc:
+        root.error("base", f"cannot read the base case {base_path}: {exc}")
         return None, base_path, None
-    except (UnicodeDecodeError, tomllib.TOMLDecodeError) as exc:
-        root.error("base", f"the base case {base_path} is not valid TOML: {exc}")
+    except CaseError as err:
+        reasons = "; ".join(f"{k}: {m}" if k else m for k, m in err.problems)
+        root.error("base", f"the base case {base_path} is not valid TOML: {reasons}")
         return None, base_path, None
     return document, base_path, document.get("name", base_path.stem)
 
@@ -224,27 +232,25 @@ def loads_sweep(text: str, path: str | Path = "<string>") -> SweepSpec:
     """Validate sweep ``text`` (``path`` names it and anchors relative paths)
     and every case it generates; ``CaseError`` listing the problems."""
     path = Path(path)
-    try:
-        document = tomllib.loads(text)
-    except tomllib.TOMLDecodeError as exc:
-        raise CaseError(path, [("", f"TOML syntax error: {exc}")]) from None
+    document = parse_toml(text, path)
     problems: list[tuple[str, str]] = []
     root = _Table(document, "", problems, SWEEP_KEYS)
     name = root.string("name", path.stem)
     if isinstance(name, str) and any(c in "/\\" or ord(c) < 32 for c in name):
         root.error("name", f"must not contain a path separator, got {name!r}")
+    elif isinstance(name, str) and path_problem(name):
+        root.error("name", f"{path_problem(name)} (it names the sweep folder)")
     combine = root.choice("combine", COMBINE, "product")
     base, case_path, base_name = _read_base(root, path)
     vary = read_vary(root, combine)
     output = root.table("output", ("directory",))
     directory = output.string("directory", None) if output is not None else None
+    if directory is not None and path_problem(directory):
+        output.error("directory", path_problem(directory))
     if problems:
         raise CaseError(path, problems)
+    _check_volume(base, vary, combine, path)  # read_vary has bounded the count
     combos = _combinations(vary, combine)
-    if len(combos) > MAX_CASES:
-        raise CaseError(
-            path, [("vary", f"gives {len(combos)} cases, more than {MAX_CASES}")]
-        )
     cases = _generate(base, base_name, case_path, combos, problems)
     if not problems and all(case.refused for case in cases):  # nothing to run
         problems = [(case.label, case.refused) for case in cases]
@@ -262,6 +268,26 @@ def loads_sweep(text: str, path: str | Path = "<string>") -> SweepSpec:
         directory=Path(directory) if directory else Path("out") / "sweeps" / name,
         cases=tuple(cases),
     )
+
+
+def _check_volume(base: dict, vary: list, combine: str, path: Path) -> None:
+    """Refuse a sweep whose cases would hold more than MAX_SWEEP_TEXT_BYTES of
+    case text (each case is kept as text and as a spec until it has run)."""
+    n_cases = case_count(vary, combine)
+    size = len(tomli_w.dumps(base))
+    if n_cases * size > MAX_SWEEP_TEXT_BYTES:
+        raise CaseError(
+            path,
+            [
+                (
+                    "vary",
+                    f"gives {n_cases} cases of a {size / 1e6:.3g} MB base case, "
+                    f"{n_cases * size / 1e9:.3g} GB of case text, more than the "
+                    f"limit of {MAX_SWEEP_TEXT_BYTES / 1e9:.3g} GB; vary fewer "
+                    "values or make the base case smaller",
+                )
+            ],
+        )
 
 
 def _generate(base, base_name, case_path, combos, problems) -> list[SweepCase]:

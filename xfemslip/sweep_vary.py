@@ -9,7 +9,6 @@ with its key path.
 
 from __future__ import annotations
 
-import itertools
 import math
 import re
 
@@ -18,6 +17,7 @@ from xfemslip.case_tables import _show, _Table
 RANGE_KEYS = ("start", "stop", "step", "num")
 MAX_CASES = 10_000  # a typo in a range must not start a million runs
 RANGE_RTOL = 1e-9  # stop is on the grid when within this many steps of it
+MAX_SHOWN_KEYS = 6  # keys listed in a message about all of them
 
 _SEGMENT = re.compile(r"^([A-Za-z_][A-Za-z0-9_-]*)((?:\[\d+\])*)$")
 
@@ -93,14 +93,36 @@ def _flatten_vary(table: dict, prefix: str = "") -> list[tuple[str, object]]:
 
 
 def _number(value, key: str, problems: list) -> float | int | None:
-    """A finite TOML number (not a boolean)."""
+    """A finite TOML number (not a boolean) that a float can hold."""
     if isinstance(value, bool) or not isinstance(value, int | float):
         problems.append((key, f"expected a number, got {_show(value)}"))
         return None
-    if not math.isfinite(value):
-        problems.append((key, f"must be finite, got {value!r}"))
+    if not _fits_float(value):
+        problems.append((key, f"must be finite, got {_show(value)}"))
         return None
     return value
+
+
+def _fits_float(value) -> bool:
+    """A finite float, or an integer within the float range."""
+    try:
+        return math.isfinite(value)
+    except OverflowError:
+        return False
+
+
+def _count_text(count) -> str:
+    """A count for a message: exact up to 1e12, else like 1.23e+45."""
+    return str(count) if count <= 10**12 else f"{float(count):.3g}"
+
+
+def _step_count(start, stop, step) -> float:
+    """Number of values start, start + step, ... up to stop (inf when the
+    count itself overflows, e.g. step = 1e-310 over a span of 1)."""
+    try:
+        return math.floor((stop - start) / step + RANGE_RTOL) + 1
+    except OverflowError:
+        return math.inf
 
 
 def expand_range(spec: dict, key: str, problems: list) -> list | None:
@@ -128,6 +150,15 @@ def expand_range(spec: dict, key: str, problems: list) -> list | None:
     stop = _number(spec["stop"], f"{key}.stop", problems)
     if start is None or stop is None:
         return None
+    if not _fits_float(stop - start):
+        problems.append(
+            (
+                key,
+                f"stop - start = {stop!r} - {start!r} overflows the float range; "
+                "no range of values can span it",
+            )
+        )
+        return None
     if "num" in spec:
         num = spec["num"]
         if isinstance(num, bool) or not isinstance(num, int) or num < 1:
@@ -153,9 +184,11 @@ def expand_range(spec: dict, key: str, problems: list) -> list | None:
             )
         )
         return None
-    count = math.floor((stop - start) / step + RANGE_RTOL) + 1
+    count = _step_count(start, stop, step)
     if count > MAX_CASES:
-        problems.append((key, f"gives {count} values, more than {MAX_CASES}"))
+        problems.append(
+            (key, f"gives {_count_text(count)} values, more than {MAX_CASES}")
+        )
         return None
     as_int = all(isinstance(v, int) for v in (start, stop, step))
     return [
@@ -200,16 +233,54 @@ def read_vary(root: _Table, combine: str | None) -> list[tuple[str, list]]:
             out.append((key, values))
     _check_overlaps(out, root.problems)
     if combine == "zip" and len({len(v) for _, v in out}) > 1:
-        sizes = ", ".join(f"{k} has {len(v)}" for k, v in out)
-        root.problems.append(("combine", f'"zip" needs equal lengths: {sizes}'))
+        sizes = ", ".join(f"{k} has {len(v)}" for k, v in out[:MAX_SHOWN_KEYS])
+        more = ", ..." if len(out) > MAX_SHOWN_KEYS else ""
+        root.problems.append(("combine", f'"zip" needs equal lengths: {sizes}{more}'))
+    else:
+        _check_count(out, combine, root.problems)
     return out
+
+
+def case_count(vary: list[tuple[str, list]], combine: str | None) -> int:
+    """Number of cases of ``vary``, computed without expanding it."""
+    if not vary:
+        return 0
+    if combine == "zip":
+        return min(len(values) for _, values in vary)
+    return math.prod(len(values) for _, values in vary)
+
+
+def _check_count(vary: list, combine: str | None, problems: list) -> None:
+    """Refuse more than MAX_CASES cases before any is built."""
+    count = case_count(vary, combine)
+    if count <= MAX_CASES:
+        return
+    sizes = " x ".join(f"{len(v)} ({k})" for k, v in vary[:MAX_SHOWN_KEYS])
+    if len(vary) > MAX_SHOWN_KEYS:
+        sizes += f" x ... ({len(vary)} keys)"
+    problems.append(
+        (
+            "vary",
+            f"gives {_count_text(count)} cases ({sizes}), more than {MAX_CASES}",
+        )
+    )
 
 
 def _check_overlaps(vary: list, problems: list) -> None:
     """Two keys where one contains the other (``fractures[0]`` and
-    ``fractures[0].angle``) would depend on their order: refused."""
-    parsed = [(key, parse_key_path(key)) for key, _ in vary]
-    for (a, pa), (b, pb) in itertools.combinations(parsed, 2):
-        short, long_ = (pa, pb) if len(pa) <= len(pb) else (pb, pa)
-        if long_[: len(short)] == short:
-            problems.append((f'vary."{b}"', f'overlaps vary."{a}"'))
+    ``fractures[0].angle``, or the same key twice) would depend on their
+    order: refused.  Each key looks up its own prefixes among the keys before
+    and after it, so the check is linear in the number of keys."""
+    first: dict[tuple, str] = {}
+    for key, _ in vary:
+        parts = tuple(parse_key_path(key))
+        if parts in first:
+            problems.append((f'vary."{key}"', f'overlaps vary."{first[parts]}"'))
+        first.setdefault(parts, key)
+    for key, _ in vary:
+        parts = tuple(parse_key_path(key))
+        problems.extend(
+            (f'vary."{key}"', f'overlaps vary."{first[parts[:n]]}"')
+            for n in range(1, len(parts))
+            if parts[:n] in first
+        )

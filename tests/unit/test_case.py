@@ -953,3 +953,43 @@ def test_tip_errors(tmp_path, line, key, words):
     assert any(k == key and words in m for k, m in info.value.problems), (
         info.value.problems
     )
+
+
+# --------------------------------------------------------------------------- #
+# Sizes beyond the float range
+# --------------------------------------------------------------------------- #
+
+
+def test_an_element_count_of_401_digits_is_reported_without_overflow(tmp_path):
+    big = "1" + "0" * 400  # a TOML integer; no float holds it
+    text = tomli_w.dumps(base()).replace("elements = [\n    4,", f"elements = [{big},")
+    err = error_of(tmp_path, text)
+    assert messages(err, "mesh.elements") == (
+        "1.00e+400 x 2 = 2.00e+400 elements exceeds the limit of 25000000 (would "
+        "need at least ~4.09e+394 GB of memory, ~2 kB per element)"
+    )
+
+
+@pytest.mark.parametrize(
+    ("fracture", "key", "got"),
+    [
+        ({"points": [[1.5, -0.5], [1e308, -0.5]]}, "points", "1e+308"),
+        ({"points": [[1.5, -0.5], [2.5, 1e151]]}, "points", "1e+151"),
+        ({"center": [2.0, -0.5], "length": 4e150, "angle": 0.0}, "length", "2e+150"),
+    ],
+)
+def test_fracture_vertices_beyond_1e150_are_refused(tmp_path, fracture, key, got):
+    doc = base()
+    doc["fractures"][0] = {"friction": 0.6, **fracture}
+    err = error_of(tmp_path, doc)
+    assert messages(err, f"fractures[0].{key}") == (
+        "a vertex lies beyond +-1e+150 m (squared distances in the geometry would "
+        f"overflow), got {got}"
+    )
+
+
+def test_a_domain_reaching_beyond_1e150_is_refused(tmp_path):
+    err = error_of(tmp_path, base(domain={"size": [1e151, 1.0]}, fractures=None))
+    assert messages(err, "domain.size").startswith(
+        "node coordinates from 0.0 to 1e+151 reach beyond +-1e+150 m"
+    )

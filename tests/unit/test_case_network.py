@@ -392,3 +392,100 @@ def test_result_numbering_inline_then_file(tmp_path):
             np.testing.assert_allclose(cross / np.linalg.norm(t), 0.0, atol=1e-12)
             along = (p - a) @ t / (t @ t)
             assert along.min() >= 0.0 and along.max() <= 1.0
+
+
+# --------------------------------------------------------------------------- #
+# Derived sizes of [network.generate], checked before anything is drawn
+# --------------------------------------------------------------------------- #
+
+POWER = '{ distribution = "power_law", exponent = 2.5, min = 0.1, max = 0.4 }'
+
+
+def _power_law_mean(exponent, lo, hi, n=2_000_001) -> float:
+    """E[L] of pdf ~ l^-exponent on [lo, hi] by the trapezoidal rule."""
+    x = np.linspace(lo, hi, n)
+    pdf = x**-exponent
+    return float(np.trapezoid(x * pdf, x) / np.trapezoid(pdf, x))
+
+
+def test_p21_count_is_p21_times_area_over_the_mean_length(tmp_path):
+    """5005 fractures asked for through p21 (domain 2 m x 1 m): the refusal
+    gives the count the closed form of E[L] implies, before any draw."""
+    mean = _power_law_mean(2.5, 0.1, 0.4)
+    p21 = 5005 * mean / 2.0
+    text = GENERATE.replace("count = 5", f"p21 = {p21!r}").replace(
+        '{ distribution = "constant", value = 0.2 }', POWER
+    )
+    message = _problems(tmp_path, text)
+    assert (
+        "network.generate.p21: asks for 5005 fractures over the region, more than "
+        "5000" in message
+    ), message
+
+
+@pytest.mark.parametrize(
+    ("old", "new", "expected"),
+    [
+        ("count = 5", "p21 = 1e308", "network.generate.p21: asks for inf fractures"),
+        # 1e308 per m^2 over 2 m^2
+        ("count = 5", "p20 = 1e308", "network.generate.p20: asks for inf fractures"),
+        (
+            '{ distribution = "constant", value = 0.2 }',
+            POWER.replace("min = 0.1", "min = 1e-300"),
+            "network.generate.length: the power_law law with exponent = 2.5, "
+            "min = 1e-300, max = 0.4 cannot be drawn in floating point",
+        ),
+        (
+            '{ distribution = "constant", value = 0.2 }',
+            '{ distribution = "lognormal", median = 1e308, sigma = 10.0 }',
+            "network.generate.length: the lognormal law with median = 1e+308, "
+            "sigma = 10.0 cannot be drawn",
+        ),
+        (
+            "seed = 3",
+            "seed = 3\nregion = [[-1e308, 0.0], [1e308, 1.0]]",
+            "network.generate.region: expected [[x0, y0], [x1, y1]] (lower-left and "
+            "upper-right corners, m, within +-1e+150), got array of 2 items",
+        ),
+    ],
+    ids=["p21-1e308", "p20-1e308", "power-law-min-1e-300", "lognormal-1e308", "region"],
+)
+def test_generate_values_whose_derived_sizes_overflow(tmp_path, old, new, expected):
+    assert old in GENERATE
+    message = _problems(tmp_path, GENERATE.replace(old, new, 1))
+    assert expected in message, message
+    assert message.count(": ") >= 1 and "\n" not in message
+
+
+def test_a_steep_power_law_within_the_float_range_is_drawn(tmp_path):
+    """exponent 10 on [0.05, 0.4]: min**(1 - exponent) = 5e11, finite; the
+    drawn lengths follow the law's inverse CDF (all within [min, max]; whole
+    fractures, as outside = "reject" redraws those that leave the domain)."""
+    law = POWER.replace("exponent = 2.5", "exponent = 10.0").replace("0.1", "0.05")
+    text = GENERATE.replace('{ distribution = "constant", value = 0.2 }', law)
+    text = text.replace('"avoid"', '"allow"\noutside = "reject"')
+    spec = load_case(_case(tmp_path, text))
+    generated = [f for f in spec.fractures if f.source.startswith("network.generate")]
+    assert len(generated) == 5
+    lengths = [float(np.hypot(*(f.points[-1] - f.points[0]))) for f in generated]
+    assert all(0.05 - 1e-12 <= v <= 0.4 + 1e-12 for v in lengths), lengths
+
+
+def test_a_header_of_a_million_columns_is_one_problem(tmp_path):
+    header = ",".join(f"c{i}" for i in range(1_000_000))
+    message = _problems(tmp_path, FILE, csv=header + "\n0.1,0.1,0.2,0.2\n")
+    assert "line 1: 1000000 unknown columns ('c0', 'c1', 'c2', ...); allowed: x0" in (
+        message
+    )
+    assert "missing column(s) x0, y0, x1, y1" in message
+    assert len(message) < 2000
+
+
+def test_rows_are_quoted_short_and_the_fracture_count_comes_first(tmp_path):
+    wide = "a," + ",".join(["1"] * 100_000)
+    message = _problems(tmp_path, FILE, csv="fracture,x0,y0,x1,y1\n" + wide + "\n")
+    assert "line 2: expected 5 values (fracture,x0,y0,x1,y1), got 100001: " in message
+    assert "... (200001 characters)" in message and len(message) < 1000
+    rows = "".join(f"{i},0.1,{i * 1e-4!r},0.2,{i * 1e-4!r}\n" for i in range(5001))
+    message = _problems(tmp_path, FILE, csv="fracture,x0,y0,x1,y1\n" + rows)
+    assert message.endswith("seg.csv: 5001 fractures, more than 5000")

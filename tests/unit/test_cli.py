@@ -345,3 +345,138 @@ formats = {formats}
     )
     assert second.exit_code == 0, second.output
     assert sorted(p.name for p in out.iterdir()) == ["result.h5"]
+
+
+# ------------------------------------------------------------------- environment
+
+
+@pytest.mark.parametrize(
+    ("name", "value", "expected"),
+    [
+        ("NUMBA_NUM_THREADS", "0", "an integer >= 1"),
+        ("NUMBA_NUM_THREADS", "abc", "an integer >= 1"),
+        ("NUMBA_DISABLE_JIT", "yes", "an integer (0 or 1)"),
+        ("XFEMSLIP_KERNELS", "fortran", "numba, numpy or auto"),
+        ("XFEMSLIP_MEMORY_LIMIT", "10Q", "a number of bytes > 0"),
+        ("XFEMSLIP_MEMORY_LIMIT", "nan", "a number of bytes > 0"),
+    ],
+)
+@pytest.mark.parametrize("command", ["info", "check"])
+def test_bad_environment_is_one_line(runner, case_file, command, name, value, expected):
+    args = [command] + ([str(case_file)] if command == "check" else [])
+    result = runner.invoke(cli, args, env={name: value})
+    assert result.exit_code == 2
+    line = _assert_one_error_line(result)
+    assert line.startswith(f"Error: environment variable {name} = {value!r}: ")
+    assert f": expected {expected}" in line
+    assert not result.stdout
+
+
+@pytest.mark.parametrize(
+    ("name", "value"),
+    [
+        ("NUMBA_NUM_THREADS", "2"),
+        ("XFEMSLIP_KERNELS", " NumPy "),
+        ("XFEMSLIP_MEMORY_LIMIT", "1.5G"),
+        ("XFEMSLIP_MEMORY_LIMIT", ""),
+    ],
+)
+def test_good_environment_is_accepted(runner, case_file, name, value):
+    result = runner.invoke(cli, ["check", str(case_file)], env={name: value})
+    assert result.exit_code == 0, result.stderr
+
+
+def test_numba_threads_zero_in_a_fresh_interpreter(tmp_path):
+    """Numba reads NUMBA_NUM_THREADS when it is imported (ValueError at 0):
+    `info`, which imports it, must refuse before that, in one line."""
+    import os
+    import subprocess
+
+    env = dict(os.environ, NUMBA_NUM_THREADS="0")
+    proc = subprocess.run(
+        [sys.executable, "-m", "xfemslip", "info"],
+        env=env,
+        capture_output=True,
+        text=True,
+        timeout=120,
+        check=False,
+    )
+    assert proc.returncode == 2
+    assert proc.stderr.splitlines() == [
+        "Error: environment variable NUMBA_NUM_THREADS = '0': expected an integer "
+        ">= 1 (Numba's thread count)"
+    ]
+
+
+# ----------------------------------------------------------------------- options
+
+
+@pytest.mark.parametrize(
+    ("args", "words"),
+    [
+        (["run", "--bogus", "CASE"], "No such option '--bogus'"),
+        (["run"], "Missing argument 'CASE'"),
+        (["frobnicate"], "No such command 'frobnicate'"),
+        (["run", "CASE", "-o", "OUT/file.txt"], "Directory"),
+        (["run", "CASE", "-o", ""], "the path is empty"),
+        (["run", "CASE", "-o", "a\0b"], "contains a NUL byte"),
+        (["run", "CASE", "-o", "p" * 256], "has a part of 256 bytes"),
+        (["run", "ca\0se.toml"], "contains a NUL byte"),
+        (["screen", "--stress", "nan", "1", "0", "--friction", "0.5"], "nan"),
+        (["screen", "--stress", "-1", "-2", "0", "--friction", "inf"], "inf"),
+        (
+            [
+                "screen",
+                "--stress",
+                "-1",
+                "-2",
+                "0",
+                "--friction",
+                "0.5",
+                "--step",
+                "nan",
+            ],
+            "--step",
+        ),
+        (["plot", "CASE", "--dpi", "1e9"], "--dpi"),
+        (["dfn", "CASE", "--plot", "net.xyz"], "the suffix must be one of"),
+        (["deplete", "CASE", "--tolerance", "nan"], "--tolerance"),
+    ],
+    ids=lambda v: "-".join(v) if isinstance(v, list) else None,
+)
+def test_usage_errors_are_one_line_before_any_work(runner, case_file, args, words):
+    (case_file.parent / "file.txt").write_text("x")
+    args = [
+        a.replace("CASE", str(case_file)).replace("OUT", str(case_file.parent))
+        for a in args
+    ]
+    result = runner.invoke(cli, args)
+    assert result.exit_code == 2, result.output
+    line = _assert_one_error_line(result)
+    assert words in line, line
+    assert line.endswith("--help')")  # where to look for the usage
+    assert sorted(p.name for p in case_file.parent.iterdir()) == [
+        "file.txt",
+        "tiny.toml",
+    ]
+
+
+def test_group_without_command_still_prints_help(runner):
+    result = runner.invoke(cli, [])
+    assert "Commands:" in result.output
+
+
+def test_deplete_names_pore_pressure_change_zero(runner, tmp_path):
+    path = tmp_path / "dep.toml"
+    path.write_text(
+        VALID_CASE.replace('name = "tiny"\n', "")
+        + "\n[pore_pressure]\ninitial = 0.0\nchange = -0.0\n"
+        + "\n[[fractures]]\npoints = [[0.2, 0.3], [0.8, 0.7]]\nfriction = 0.5\n"
+    )
+    out = str(tmp_path / "out")
+    result = runner.invoke(cli, ["deplete", "-q", str(path), "-o", out])
+    assert result.exit_code == 2
+    line = _assert_one_error_line(result)
+    assert line.startswith(f"Error: {path}: pore_pressure.change")
+    assert "--tolerance" not in line
+    assert not (tmp_path / "out").exists()

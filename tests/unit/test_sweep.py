@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import csv
 import math
+import tomllib
 from pathlib import Path
 
 import h5py
@@ -13,6 +14,7 @@ import numpy as np
 import pytest
 from click.testing import CliRunner
 
+from xfemslip.case_tables import _Table
 from xfemslip.cli import cli
 from xfemslip.errors import CaseError
 from xfemslip.sweep import (
@@ -24,6 +26,7 @@ from xfemslip.sweep import (
     set_key_path,
 )
 from xfemslip.sweep_run import arc_extent, run_sweep, slipping_length
+from xfemslip.sweep_vary import _check_overlaps, case_count, read_vary
 
 # A small, fast case: 10 x 10 cells, a 45-degree fracture that slips (f = 0.1).
 BASE = """\
@@ -462,3 +465,125 @@ def test_cli_sweep_two_processes(tmp_path, base, runner, monkeypatch):
     assert float(summary[1]["slip_share"]) == 1.0
     # the printed table lists the parameters and the metrics
     assert "fractures[0].angle" in result.stdout and "max_abs_slip_m" in result.stdout
+
+
+# --------------------------------------------------------------------------- #
+# Sizes counted before anything is expanded
+# --------------------------------------------------------------------------- #
+
+
+def test_a_product_of_1e12_cases_is_refused_from_the_list_lengths(tmp_path, base):
+    """Six ranges of 100 values: 100**6 = 1e12 cases, refused without building
+    one (itertools.product into a list would need terabytes)."""
+    keys = ["friction", "cohesion", "kn", "kt", "angle", "length"]
+    body = 'base = "base.toml"\n[vary]\n' + "".join(
+        f'"fractures[0].{k}" = {{ start = 1.0, stop = 100.0, num = 100 }}\n'
+        for k in keys
+    )
+    with pytest.raises(CaseError) as excinfo:
+        loads_sweep(body, tmp_path / "big.toml")
+    assert excinfo.value.problems == [
+        (
+            "vary",
+            "gives 1000000000000 cases (100 (fractures[0].friction) x 100 "
+            "(fractures[0].cohesion) x 100 (fractures[0].kn) x 100 (fractures[0].kt) "
+            "x 100 (fractures[0].angle) x 100 (fractures[0].length)), more than 10000",
+        )
+    ]
+
+
+@pytest.mark.parametrize(
+    ("values", "count"),
+    [([[1, 2, 3], [4, 5]], 6), ([list(range(100))] * 2, 10_000), ([[1]] * 50, 1)],
+)
+def test_case_count_is_the_product_of_the_lengths(values, count):
+    vary = [(f"k{i}", v) for i, v in enumerate(values)]
+    assert case_count(vary, "product") == count
+    assert case_count(vary[:1], "zip") == len(values[0])
+
+
+@pytest.mark.parametrize(
+    ("range_", "key", "message"),
+    [
+        (
+            "{ start = 0.0, stop = 1.0, step = 1e-300 }",
+            'vary."material.nu"',
+            "gives 1e+300 values, more than 10000",
+        ),
+        (
+            "{ start = 0.0, stop = 1.0, step = 5e-324 }",  # 1 / step overflows
+            'vary."material.nu"',
+            "gives inf values, more than 10000",
+        ),
+        (
+            "{ start = -1e308, stop = 1e308, step = 1e307 }",
+            'vary."material.nu"',
+            "stop - start = 1e+308 - -1e+308 overflows the float range",
+        ),
+        (
+            "{ start = -1e308, stop = 1e308, num = 3 }",
+            'vary."material.nu"',
+            "stop - start = 1e+308 - -1e+308 overflows the float range",
+        ),
+        (
+            "{ start = 0, stop = 1" + "0" * 400 + ", step = 1 }",
+            'vary."material.nu".stop',
+            "must be finite, got integer 1" + "0" * 400,
+        ),
+        (
+            "{ start = 0, stop = 100000, step = 3 }",  # 33334 values, exactly
+            'vary."material.nu"',
+            "gives 33334 values, more than 10000",
+        ),
+    ],
+)
+def test_ranges_whose_size_overflows_are_refused_at_their_key(range_, key, message):
+    problems = []
+    document = tomllib.loads(f'[vary]\n"material.nu" = {range_}\n')
+    read_vary(_Table(document, "", problems), "product")
+    assert len(problems) == 1
+    assert problems[0][0] == key
+    assert problems[0][1].startswith(message[:60]), problems[0][1]
+
+
+def test_overlap_check_is_linear_and_finds_repeated_keys(tmp_path, base):
+    """20,000 distinct keys: a pairwise check would make 2e8 comparisons."""
+    vary = [(f"material.k{i}", [1]) for i in range(20_000)]
+    vary += [("material.k7.x", [1]), ("material.k3", [2])]
+    problems = []
+    _check_overlaps(vary, problems)
+    assert sorted(problems) == [
+        ('vary."material.k3"', 'overlaps vary."material.k3"'),
+        ('vary."material.k7.x"', 'overlaps vary."material.k7"'),
+    ]
+
+
+def test_case_ids_and_names_stay_folder_names(tmp_path, base):
+    """26 varied keys would make a 300-character folder name: the id is cut
+    after the index, and the member's name stays under 255 bytes."""
+    params = [(f"solver.key{i}", 1.5) for i in range(26)]
+    cid = case_id(7, 10, params)
+    assert len(cid) == 100 and cid.startswith("007_key0=1.5_key1=1.5")
+    long_name = "\u00e9" * 200  # 400 bytes
+    base.write_text(BASE.replace('name = "tiny"', f'name = "{long_name}"'))
+    body = 'base = "base.toml"\n[vary]\n"fractures[0].friction" = [0.1, 0.2]\n'
+    spec = loads_sweep(body, tmp_path / "s.toml")
+    for case in spec.cases:
+        assert len(case.spec.name.encode()) <= 255
+        assert case.spec.name.endswith(case.case_id)
+
+
+def test_a_sweep_of_too_much_case_text_is_refused(tmp_path, base):
+    """A base of 6,000 inline fractures (~0.9 MB of TOML) times 10,000 cases."""
+    fracture = BASE[BASE.index("[[fractures]]") : BASE.index("[loading]")]
+    base.write_text(BASE.replace("[loading]", fracture * 6000 + "[loading]"))
+    body = (
+        'base = "base.toml"\n[vary]\n'
+        '"material.nu" = { start = 0.0, stop = 0.4, num = 10000 }\n'
+    )
+    with pytest.raises(CaseError) as excinfo:
+        loads_sweep(body, tmp_path / "s.toml")
+    ((key, message),) = excinfo.value.problems
+    assert key == "vary"
+    assert message.startswith("gives 10000 cases of a ")
+    assert "more than the limit of 0.256 GB" in message
