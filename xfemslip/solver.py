@@ -417,6 +417,7 @@ class NewtonSolver:
             if guess is not None:  # first solve with the predicted set
                 log.predicted = 1
                 du = self._solve(guess[0], guess[1], k, it, eta)
+                guess = None  # its tangent blocks are not needed any more
             else:
                 du = self._solve(res, r, k, it, eta)
                 flipped, stubborn = self._reversals(
@@ -559,8 +560,11 @@ class NewtonSolver:
         stick = _frozen_law(law, mask).evaluate(
             u, self.mode, law.pt_committed, law.gt_committed
         )
-        blocks = res.blocks.copy()
-        blocks[mask] = stick.blocks[mask]
+        # the tangent of res with the cluster's blocks in stick, formed in
+        # the stick evaluation's array (not a copy of res.blocks: one array
+        # of the padded blocks less, memory.NEWTON_BLOCKS)
+        blocks = stick.blocks
+        np.copyto(blocks, res.blocks, where=~mask[:, None, None])
         K = self.K_ff + coo_block(self.c_dofs, blocks, self.free.size)
         branches = local_branches.search(c, self.c_dofs, K, u[self.free], res, r, idx)
         if branches is None:
