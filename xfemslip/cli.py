@@ -419,7 +419,10 @@ cli.add_command(dfn)
 
 def main() -> None:
     """Console-script entry point (``xfemslip``)."""
-    from xfemslip import interrupt
+    from xfemslip import interrupt, memory
 
+    # freed memory goes back to the system between Newton iterations, so the
+    # peak is what memory.py estimates (see configure_allocator)
+    memory.configure_allocator()
     interrupt.for_process()
     cli(prog_name="xfemslip")
