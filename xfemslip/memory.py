@@ -13,20 +13,39 @@ The peak resident memory of a run is modelled from the sizes that set it
 - ``assembly``, while the stiffness is assembled: the padded element
   matrices of the enriched cells, (8 + 2 S)^2 doubles each, the COO
   triplets of every cell's entries with their conversion to CSR
-  (TRIPLET_BYTES per entry) and, on the NumPy kernels, the shape-function
-  gradients of all quadrature points at once (NUMPY_QP_FUNCTION_BYTES per
-  point and function, 4 + S functions);
-- ``solver``: the stiffness (12 B per non-zero) and its sparse LU factors,
-  whose fill grows like nnz * log2(n_dofs) with a fill-reducing ordering
-  (LU_BYTES per non-zero and per factor log2);
+  (TRIPLET_BYTES per entry, ENRICHED_TRIPLET_BYTES more per entry of an
+  enriched cell, whose own triplets are still held while all are joined)
+  and, on the NumPy kernels, the shape-function gradients of all quadrature
+  points at once (NUMPY_QP_FUNCTION_BYTES per point and function, 4 + S
+  functions);
+- ``solver``: the stiffness, its free-dof part, the Newton matrix and its
+  CSC copy (MATRIX_BYTES per non-zero) and, with SuperLU, LU_FACTORS sparse
+  LU factorizations (the kept one while the next is built), whose fill grows
+  like nnz * log2(n_dofs) with a fill-reducing ordering (LU_BYTES per
+  non-zero and per log2); with AMG (linsolve.choose), its hierarchy and set-up
+  (AMG_BYTES per non-zero) and the GMRES basis (AMG_RESTART + 1 vectors).
+  A run whose AMG solve fails over to SuperLU may need more than estimated;
+- ``contact tangents``, during the Newton iterations: the contact tangent
+  blocks of every patch, padded to the widest (8 B per entry), NEWTON_BLOCKS
+  arrays of them at once (the iterate's, the next one's -- a line-search
+  trial or a local branch search's -- and the scratch one of the
+  evaluations whose tangent is not used; one more on the NumPy kernels,
+  which form the product before copying it in place), and the COO triplets
+  of their non-empty entries (TRIPLET_BYTES each).  Before the interface
+  points exist the widest block is taken as 2 S (measured 0.65 to 1.2 times
+  the real one on generated networks);
 - ``steps``: every converged load step is kept until the output is written:
   the displacement, the contact force and the displacement of the last
-  contact evaluation (3 x 8 B per dof), the contact tangent blocks of every
-  patch (padded to the widest, 8 B per entry), and the written fields (per
-  node 16 B, per cell 48 B, 80 B more with pore pressure, per contact point
-  80 B).
+  contact evaluation (3 x 8 B per dof), per contact patch its jumps,
+  tractions and state (48 B), and the written fields (per node 16 B, per
+  cell 48 B, 80 B more with pore pressure, per contact point 80 B).
 
-peak = base + enriched + max(assembly, solver + steps x per_step).
+peak = base + enriched + max(assembly, solver + contact tangents + steps).
+
+The resident memory is what is in use only if freed memory goes back to
+the system: the command line fixes glibc's allocator thresholds for that
+(configure_allocator; with glibc's defaults a crowded network whose Newton
+solve ran long peaked at 1.7 times this estimate).
 
 It is evaluated three times, each before what it guards: from the case alone
 (``check_memory(spec)``, before the mesh: a lower estimate of the enrichment),
@@ -35,9 +54,10 @@ the enriched cells are built: the slots per cell exactly, their quadrature
 points estimated), and from the built model (``model_footprint``, before the
 first solve: everything but the LU fill exact).  Measured against the peak
 resident memory (ru_maxrss) of whole runs by benchmarks/memory_estimate.py
-(table in the README, *Memory*): the last two estimates lie between 0.94
-and 1.26 times the measured peak on shipped cases, crowded networks, long
-runs and large meshes.
+(table in docs/robustness.md, *Memory*): the last two estimates lie
+between 0.90 and 1.34 times the measured peak on shipped cases, crowded
+networks (failing after a long Newton solve, or converging), long runs and
+large meshes.
 
 The limit is the machine's physical memory (``SC_PHYS_PAGES * SC_PAGE_SIZE``),
 or the environment variable ``XFEMSLIP_MEMORY_LIMIT`` in bytes (suffixes k, M,
@@ -46,6 +66,7 @@ G, T allowed, e.g. ``500M``), which tests and shared machines use.
 
 from __future__ import annotations
 
+import ctypes
 import logging
 import math
 import os
@@ -58,15 +79,24 @@ from xfemslip.errors import MeshError, UsageError
 logger = logging.getLogger(__name__)
 
 ENV_LIMIT = "XFEMSLIP_MEMORY_LIMIT"
-BASE_NUMPY = 90e6  # measured 85 MB: a 10 x 10 case on the NumPy kernels [B]
-BASE_NUMBA = 200e6  # measured 191 MB: the same case on the Numba kernels [B]
+BASE_NUMPY = 92e6  # measured 92 MB: a 10 x 10 case on the NumPy kernels [B]
+BASE_NUMBA = 202e6  # measured 201 MB: the same case on the Numba kernels [B]
 QP_BYTES = 48.0  # per enriched-cell quadrature point: xy, w, triangle share [B]
 QP_SLOT_BYTES = 28.0  # per point and slot: F, grad F (24 B), vertex values [B]
 TRIPLET_BYTES = 48.0  # per COO entry: rows, cols, values and the CSR copy [B]
+# per COO entry of an enriched cell: its own rows, cols and values, held
+# while all cells' triplets are joined (assembly.assemble_bulk) [B]
+ENRICHED_TRIPLET_BYTES = 24.0
 # per enriched-cell quadrature point and shape function, NumPy kernels only:
 # gradients, weighted gradients and their gathered cell data [B]
 NUMPY_QP_FUNCTION_BYTES = 56.0
-LU_BYTES = 7.0  # per stiffness non-zero and per factor log2(n_dofs) [B]
+# per stiffness non-zero: K, K_ff, K_ff + K_contact and its CSC copy, 12 B
+# each (8 B value, 4 B index) [B]
+MATRIX_BYTES = 48.0
+LU_BYTES = 5.0  # per stiffness non-zero and per log2(n_dofs), one factor [B]
+LU_FACTORS = 2  # factorizations held at once
+AMG_BYTES = 40.0  # per stiffness non-zero: hierarchy and its set-up [B]
+NEWTON_BLOCKS = 3  # contact tangent-block arrays held at once (+1 on NumPy)
 NNZ_PER_ENTRY = 0.56  # CSR non-zeros per COO entry (shared nodes summed)
 # Enriched-cell quadrature points, estimated before the cells are cut: a
 # cell crossed by p fracture pieces has about QP_CELL + QP_PIECE p +
@@ -96,10 +126,13 @@ class Footprint:
     enriched_cells: int = 0
     slots: int = 0  # enrichment slots of the widest enriched cell (padding)
     entries: float = 0.0  # COO entries of all cells, sum of (8 + 2 s)^2
+    enriched_entries: float = 0.0  # of them, those of the enriched cells
     qp: float = 0.0  # enriched-cell quadrature points
     patches: float = 0.0  # contact patches
     block: float = 0.0  # dofs of the widest patch's tangent block (2 J)
+    contact_entries: float = 0.0  # non-empty entries of the tangent blocks
     points: float = 0.0  # contact integration points
+    amg: bool = False  # the linear solver is AMG-preconditioned GMRES
 
 
 def estimate_terms(fp: Footprint) -> dict[str, float]:
@@ -107,24 +140,36 @@ def estimate_terms(fp: Footprint) -> dict[str, float]:
     base = BASE_NUMBA if fp.numba else BASE_NUMPY
     enriched = fp.qp * (QP_BYTES + QP_SLOT_BYTES * fp.slots)
     gradients = 0.0 if fp.numba else NUMPY_QP_FUNCTION_BYTES * fp.qp * (4 + fp.slots)
+    triplets = TRIPLET_BYTES * fp.entries + ENRICHED_TRIPLET_BYTES * fp.enriched_entries
     assembly = fp.enriched_cells * (8 + 2 * fp.slots) ** 2 * 8.0
-    assembly += max(gradients, TRIPLET_BYTES * fp.entries)  # one after the other
-    solver = fp.nnz * (12.0 + LU_BYTES * math.log2(max(fp.n_dofs, 2)))
+    assembly += max(gradients, triplets)  # one after the other
+    if fp.amg:
+        from xfemslip.solve.linear import AMG_RESTART
+
+        solver = fp.nnz * (MATRIX_BYTES + AMG_BYTES)
+        solver += (AMG_RESTART + 1) * 8.0 * fp.n_dofs
+    else:
+        log_n = math.log2(max(fp.n_dofs, 2))
+        solver = fp.nnz * (MATRIX_BYTES + LU_FACTORS * LU_BYTES * log_n)
+    arrays = NEWTON_BLOCKS + (0 if fp.numba else 1)
+    tangents = arrays * 8.0 * fp.patches * fp.block**2
+    tangents += TRIPLET_BYTES * fp.contact_entries
     per_step = (
         24.0 * fp.n_dofs
-        + 8.0 * fp.patches * (fp.block**2 + 8)
+        + 48.0 * fp.patches
         + 16.0 * fp.n_nodes
         + (128.0 if fp.pore else 48.0) * fp.n_cells
         + 80.0 * fp.points
     )
     steps = fp.steps * per_step
-    total = base + enriched + max(assembly, solver + steps)
+    total = base + enriched + max(assembly, solver + tangents + steps)
     return {
         "total": total,
         "base": base,
         "enriched cells": enriched,
         "assembly": assembly,
         "solver": solver,
+        "contact tangents": tangents,
         "steps": steps,
     }
 
@@ -155,16 +200,20 @@ def case_footprint(spec) -> Footprint:
     )
     pieces = min(1.5 * length / h, float(n_cells))
     entries = 64.0 * n_cells  # the enriched cells' wider blocks are not known yet
+    patches = _patches(spec, length, h, 4 * pieces)
     return Footprint(
         n_nodes=n_nodes,
         n_cells=n_cells,
         n_dofs=n_dofs,
+        # the band of the enriched dofs is not known yet: AMG if large enough
+        amg=_amg(spec, spec.mesh.x, spec.mesh.y, n_dofs, 0.0),
         nnz=NNZ_PER_ENTRY * entries + 20.0 * (n_dofs - 2 * n_nodes),
         steps=spec.loading.steps,
         entries=entries,
         pore=spec.pore_pressure is not None,
-        patches=_patches(spec, length, h, 4 * pieces),
+        patches=patches,
         block=16.0,
+        contact_entries=256.0 * patches,
         points=4 * pieces,
     )
 
@@ -202,25 +251,34 @@ def enriched_footprint(spec, mesh, fractures, cand) -> Footprint:
         np.sum(QP_CELL + QP_PIECE * p + QP_PIECE2 * p * p + QP_BRANCH * branch[enr])
     )
     S = int(slots.max(initial=0))
-    entries = 64.0 * (mesh.n_cells - enr.sum()) + float(
-        np.sum((8.0 + 2.0 * slots[enr]) ** 2)
-    )
+    enriched_entries = float(np.sum((8.0 + 2.0 * slots[enr]) ** 2))
+    entries = 64.0 * (mesh.n_cells - enr.sum()) + enriched_entries
     n_points = 4.0 * sum(fr.piece_cell.size for fr in fractures)
     length = sum(float(fr.length.sum()) for fr in fractures)
+    patches = _patches(spec, length, mesh.h_min, n_points)
+    n_dofs = 2 * mesh.n_nodes + 2 * cand.node.size
     return Footprint(
         n_nodes=mesh.n_nodes,
         n_cells=mesh.n_cells,
-        n_dofs=2 * mesh.n_nodes + 2 * cand.node.size,
+        n_dofs=n_dofs,
+        amg=_amg(spec, mesh.x, mesh.y, n_dofs, _band_share(mesh, cand, n_dofs)),
         nnz=NNZ_PER_ENTRY * entries,
         steps=spec.loading.steps,
-        numba=choose(spec.solver.kernels, qp * (8 + 2 * S) ** 2) == "numba",
+        # the points are estimated up to 20 % low (QP_CELL ...): near the
+        # crossover, the larger base of the Numba kernels
+        numba=choose(spec.solver.kernels, 1.25 * qp * (8 + 2 * S) ** 2) == "numba",
         pore=spec.pore_pressure is not None,
         enriched_cells=int(enr.sum()),
         slots=S,
         entries=entries,
+        enriched_entries=enriched_entries,
         qp=qp,
-        patches=_patches(spec, length, mesh.h_min, n_points),
+        patches=patches,
         block=2.0 * S,
+        # a patch's block holds the slots of about one cut cell
+        contact_entries=patches * float(np.mean((2.0 * slots[enr]) ** 2))
+        if enr.any()
+        else 0.0,
         points=n_points,
     )
 
@@ -231,12 +289,15 @@ def model_footprint(model) -> Footprint:
     ec, contact = model.ec, model.contact
     S = ec.slot_node.shape[1]
     used = np.count_nonzero(ec.slot_cand >= 0, axis=1)
-    entries = 64.0 * (model.mesh.n_cells - ec.cells.size)
-    entries += float(np.sum((8.0 + 2.0 * used) ** 2))
+    enriched_entries = float(np.sum((8.0 + 2.0 * used) ** 2))
+    entries = 64.0 * (model.mesh.n_cells - ec.cells.size) + enriched_entries
+    dofs = np.count_nonzero(contact.dofs >= 0, axis=1)
+    p = model.problem
     return Footprint(
         n_nodes=model.mesh.n_nodes,
         n_cells=model.mesh.n_cells,
-        n_dofs=model.problem.n_dofs,
+        n_dofs=p.n_dofs,
+        amg=_amg(model.spec, model.mesh.x, model.mesh.y, p.n_dofs, p),
         nnz=float(model.problem.K.nnz),
         steps=model.spec.loading.steps,
         numba=contact.kernels == "numba",
@@ -244,11 +305,106 @@ def model_footprint(model) -> Footprint:
         enriched_cells=int(ec.cells.size),
         slots=S,
         entries=entries,
+        enriched_entries=enriched_entries,
         qp=float(ec.qp_w.size),
         patches=float(contact.dofs.shape[0]),
         block=float(contact.dofs.shape[1]),
+        contact_entries=float(np.sum(dofs.astype(float) ** 2)),
         points=float(model.ip.n),
     )
+
+
+# glibc's malloc (mallopt(3)): a block of at least M_MMAP_THRESHOLD bytes is
+# mapped on its own and unmapped when freed; a smaller one comes from the
+# heap, whose free space is given back only at its top, beyond
+# M_TRIM_THRESHOLD.  By default glibc raises the threshold to the size of
+# every mapped block freed, up to 32 MiB, so after the first large free the
+# tangent blocks, the linear-system work arrays and SuperLU's factor arrays
+# (4 of 30 x nnz entries per factorization, mostly unused) all land in the
+# heap, where freed space stays resident between Newton iterations: a
+# crowded network peaked at 0.63 GB with 0.35 GB in use.  Fixed thresholds
+# keep the resident memory at what is in use (configure_allocator).  4 MiB:
+# NumPy asks for transparent huge pages from 4 MiB on, so a mapped array
+# costs few page faults; a free heap top of up to 8 MiB (twice that, glibc's
+# own ratio) is kept for the smaller temporaries of an iteration (32 MiB
+# raised the peak of the shipped cases by 10 MB).
+M_TRIM_THRESHOLD, M_MMAP_THRESHOLD = -1, -3  # malloc.h
+MMAP_THRESHOLD = 4 << 20  # [B]
+TRIM_THRESHOLD = 8 << 20  # [B]
+_MALLOC_ENV = {
+    "MALLOC_MMAP_THRESHOLD_": MMAP_THRESHOLD,
+    "MALLOC_TRIM_THRESHOLD_": TRIM_THRESHOLD,
+}
+
+
+def configure_allocator() -> bool:
+    """Fix glibc's mmap and trim thresholds (MMAP_THRESHOLD, TRIM_THRESHOLD)
+    in this process and, through the environment variables glibc reads at
+    start, in the processes it starts (sweep workers).  The command line
+    does this first; a program using the library may call it too.
+
+    Returns whether it did: not on another C library, nor when the
+    environment already sets a MALLOC_*_ threshold or a glibc.malloc
+    tunable (the user's choice stands).
+    """
+    if any(name in os.environ for name in _MALLOC_ENV):
+        return False
+    if "glibc.malloc." in os.environ.get("GLIBC_TUNABLES", ""):
+        return False
+    try:
+        if not os.confstr("CS_GNU_LIBC_VERSION").startswith("glibc"):
+            return False
+        mallopt = ctypes.CDLL(None).mallopt
+    except (ValueError, OSError, AttributeError):  # not glibc
+        return False
+    mallopt.argtypes, mallopt.restype = [ctypes.c_int, ctypes.c_int], ctypes.c_int
+    if mallopt(M_MMAP_THRESHOLD, MMAP_THRESHOLD) != 1:
+        return False
+    if mallopt(M_TRIM_THRESHOLD, TRIM_THRESHOLD) != 1:
+        return False
+    for name, value in _MALLOC_ENV.items():
+        os.environ[name] = str(value)
+    return True
+
+
+def _amg(spec, x, y, n_dofs, band) -> bool:
+    """Whether the linear solver will be AMG (linsolve.choose) for a mesh
+    with grid lines x, y and about n_dofs free dofs; band: the share of them
+    in the AMG band, or the Problem to take it from (only computed where
+    the other conditions hold)."""
+    from xfemslip.solve import linear as linsolve
+
+    method = spec.solver.linear_solver
+    if method != "auto" or n_dofs < linsolve.AUTO_AMG_MIN_DOFS:
+        return method == "amg"
+    # the grid lines as node coordinates (cell_aspect_ratio reads those)
+    lines = np.zeros((x.size + y.size, 2))
+    lines[: x.size, 0], lines[x.size :, 1] = x, y
+    lines[: x.size, 1], lines[x.size :, 0] = y[0], x[0]
+    if not isinstance(band, float):  # the Problem: its band as "auto" forms it
+        enr = np.arange(band.n_dofs) >= 2 * band.node_xy.shape[0]
+        mask = linsolve.band_mask(band.K, enr, linsolve.AMG_BAND_LAYERS)
+        band = float(mask.sum()) / band.n_dofs
+    return linsolve.choose(method, n_dofs, lines, band) == "amg"
+
+
+def _band_share(mesh, cand, n_dofs) -> float:
+    """Share of the dofs in the AMG band (linsolve.system_facts) before the
+    stiffness exists: the enriched dofs and the standard ones of the nodes
+    within AMG_BAND_LAYERS node rings of an enriched node (an enriched dof
+    couples to the nodes of its support, each layer adds a ring)."""
+    from xfemslip.solve.linear import AMG_BAND_LAYERS
+
+    grid = np.zeros((mesh.ny + 1, mesh.nx + 1), bool)
+    grid.flat[np.unique(cand.node)] = True
+    for _ in range(AMG_BAND_LAYERS):
+        ring = grid.copy()
+        ring[1:] |= grid[:-1]
+        ring[:-1] |= grid[1:]
+        ring[:, 1:] |= ring[:, :-1].copy()
+        ring[:, :-1] |= ring[:, 1:].copy()
+        grid = ring
+    return (2.0 * grid.sum() + 2.0 * cand.node.size) / max(n_dofs, 1)
 
 
 def available_bytes() -> tuple[float, str]:
@@ -305,10 +461,12 @@ def check_memory(spec, footprint: Footprint | None = None) -> None:
     if need <= limit:
         return
     nx, ny = spec.mesh.x.size - 1, spec.mesh.y.size - 1
-    if terms["assembly"] < terms["solver"] + terms["steps"]:
+    solve = ("solver", "contact tangents", "steps")
+    if terms["assembly"] < sum(terms[k] for k in solve):
         del terms["assembly"]
     else:
-        del terms["solver"], terms["steps"]
+        for k in solve:
+            del terms[k]
     largest = [kv for kv in sorted(terms.items(), key=lambda kv: -kv[1]) if kv[1]]
     largest = largest[:3]
     parts = ", ".join(
@@ -330,6 +488,7 @@ __all__ = [
     "available_bytes",
     "case_footprint",
     "check_memory",
+    "configure_allocator",
     "enriched_footprint",
     "estimate_dofs",
     "estimate_terms",

@@ -41,5 +41,12 @@ for _command in (run, check, info, verify, sweep, plot, screen, deplete, dfn):
 
 def main() -> None:
     """Console-script entry point (``xfemslip``)."""
+    # here, not at the top: memory imports NumPy, which --help and the
+    # argument errors do not pay
+    from xfemslip import memory
+
+    # freed memory goes back to the system between Newton iterations, so the
+    # peak is what memory.py estimates (see configure_allocator)
+    memory.configure_allocator()
     interrupt.for_process()
     cli(prog_name="xfemslip")

@@ -178,11 +178,20 @@ class NewtonSolver:
         self.linear = LinearSolver(self.K_ff, linear_solver, self.free, problem.node_xy)
         c = problem.contact
         self.c_dofs = np.where(c.dofs >= 0, self.reduced[np.maximum(c.dofs, 0)], -1)
-        zero = c.evaluate(np.zeros(n), self.mode, c.pt_committed, c.gt_committed)
+        # tangent blocks of the contact evaluations whose tangent is never
+        # used (_scratch_blocks)
+        self._scratch = None
+        zero = c.evaluate(
+            np.zeros(n),
+            self.mode,
+            c.pt_committed,
+            c.gt_committed,
+            scratch=self._scratch_blocks(),
+        )
         self.f_c0 = c.in_situ_force(zero)
         # the contact law at zero jump: what it admits of the in-situ traction
         # (kept for the log and deplete; its tangent blocks are not needed)
-        self.in_situ = dataclasses.replace(zero, blocks=None)
+        self.in_situ = zero
         # the in-situ excess over the contact law (ContactSet.in_situ_force),
         # released from the first load step on: a load like lam F_ext, so it
         # is stacked into the reference of eta (None: nothing to release)
@@ -291,7 +300,9 @@ class NewtonSolver:
                 k,
                 lam1,
                 u.copy(),
-                res,
+                # kept until the output is written; its tangent blocks (the
+                # largest part on crowded networks) are never read again
+                dataclasses.replace(res, blocks=None),
                 iterations,
                 log.residuals,
                 log.switches,
@@ -414,6 +425,7 @@ class NewtonSolver:
             if guess is not None:  # first solve with the predicted set
                 log.predicted = 1
                 du = self._solve(guess[0], guess[1], k, it, eta)
+                guess = None  # its tangent blocks are not needed any more
             else:
                 du = self._solve(res, r, k, it, eta)
                 flipped, stubborn = self._reversals(
@@ -529,7 +541,9 @@ class NewtonSolver:
             return None, None
         trial = u.copy()
         trial[self.free] -= du
-        res = law.evaluate(trial, self.mode, pt_prev, gt_prev)
+        res = law.evaluate(
+            trial, self.mode, pt_prev, gt_prev, scratch=self._scratch_blocks()
+        )
         new = _regime(res.state, res.pt)
         mask = ((regime == SLIP) & (new == SLIP_BACKWARD)) | (
             (regime == SLIP_BACKWARD) & (new == SLIP)
@@ -554,8 +568,11 @@ class NewtonSolver:
         stick = _frozen_law(law, mask).evaluate(
             u, self.mode, law.pt_committed, law.gt_committed
         )
-        blocks = res.blocks.copy()
-        blocks[mask] = stick.blocks[mask]
+        # the tangent of res with the cluster's blocks in stick, formed in
+        # the stick evaluation's array (not a copy of res.blocks: one array
+        # of the padded blocks less, memory.NEWTON_BLOCKS)
+        blocks = stick.blocks
+        np.copyto(blocks, res.blocks, where=~mask[:, None, None])
         K = self.K_ff + coo_block(self.c_dofs, blocks, self.free.size)
         branches = local_branches.search(c, self.c_dofs, K, u[self.free], res, r, idx)
         if branches is None:
@@ -591,18 +608,40 @@ class NewtonSolver:
         for _ in range(LINE_SEARCH_CUTS + 1):
             trial = u.copy()
             trial[self.free] -= alpha * du
-            res = c.evaluate(trial, self.mode, pt_prev, gt_prev)
+            # Only the kept trial's tangent is used: the full step (the one
+            # kept near the solution) gets its own blocks, a shorter one is
+            # evaluated into the scratch blocks and, if kept, once more
+            # below (same result, bit for bit).  A fresh tangent per trial
+            # (up to 6 more per iteration of a stalling Newton solve) is an
+            # array of 8 m (2J)^2 bytes, 10.7 MB on a crowded network.
+            scratch = None if alpha == 1.0 else self._scratch_blocks()
+            res = c.evaluate(trial, self.mode, pt_prev, gt_prev, scratch=scratch)
             r, eta = self._residual(trial, lam, res)
             if best is None or eta < best[3]:
                 best = (trial, res, r, eta)
             if eta <= (1.0 - 1.0e-4 * alpha) * eta0:
                 break
             alpha *= 0.5
+        if best[1].blocks is None:  # the same evaluation, with its tangent
+            best = (
+                best[0],
+                c.evaluate(best[0], self.mode, pt_prev, gt_prev),
+                *best[2:],
+            )
         if alpha < 1.0:
             logger.info(
                 "line search: step length %.3g (eta %.3e -> %.3e)", alpha, eta0, best[3]
             )
         return best
+
+    def _scratch_blocks(self) -> np.ndarray:
+        """The (m, 2J, 2J) array that contact evaluations whose tangent is
+        not used write their tangent blocks into (ContactSet.evaluate), one
+        per solver."""
+        if self._scratch is None:
+            c = self.p.contact
+            self._scratch = np.empty((c.n, c.dofs.shape[1], c.dofs.shape[1]))
+        return self._scratch
 
     def _no_convergence_reason(self, switches):
         """Why Newton stopped, and what to change."""
