@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Why the slip error on the OpenGeoSys peer problem stopped converging (issue 7).
+"""Why the slip error on the OpenGeoSys peer problem stopped converging.
 
 Usage (from the project root)::
 

@@ -1,4 +1,4 @@
-"""The numerical stress matrix of issue 4: every case, both tangents.
+"""The numerical stress matrix: every case, both tangents.
 
 Writes a table (case, converged, Newton iterations, stick/slip switches,
 load-step cuts / ping-pong freezes, max |slip|, result vs reference) into its
@@ -316,7 +316,7 @@ def main() -> int:
         else:
             doc = (
                 doc.rstrip("\n")
-                + "\n\n## Numerical stability matrix (issue 4)\n\n"
+                + "\n\n## Numerical stability matrix\n\n"
                 + text
                 + "\n"
             )

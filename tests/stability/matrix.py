@@ -1,4 +1,4 @@
-"""The numerical stress matrix of issue 4: case builders, one runner, references.
+"""The numerical stress matrix: case builders, one runner, references.
 
 Shared by the tests in this folder (a fast subset) and ``benchmarks/stability.py``
 (the whole matrix, written to ``benchmarks/RESULTS.md``).  Every case either

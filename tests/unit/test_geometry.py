@@ -324,7 +324,7 @@ def test_clip_segment_against_hand_computed_parameters():
 
 
 # ------------------------------------------------------------- intersecting fractures
-# Networks are built since issue 6 (junctions: tests/unit/test_junction.py);
+# Networks are built (junctions: tests/unit/test_junction.py);
 # only truly degenerate input is refused: fractures overlapping on one line.
 
 

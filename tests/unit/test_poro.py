@@ -1,5 +1,5 @@
 """[pore_pressure] / [reservoir]: case keys, per-cell material, loads, output,
-and the ``xfemslip deplete`` command (issue 6, depletion)."""
+and the ``xfemslip deplete`` command (depletion)."""
 
 from __future__ import annotations
 

@@ -5,8 +5,8 @@ triangle of about one cell there; with its neighbours slipping, patch 170
 and back; stick exceeds the bound), and Newton failed after 5 load-step cuts
 (which cannot help: without cohesion or initial stress the first sub-step is
 the same problem scaled).  The local branch search (xfemslip.contact.branches)
-puts a neighbour in stick and the step converges.  benchmarks/RESULTS.md,
-"Refined DFN realizations (session 4)"."""
+puts a neighbour in stick and the step converges.  docs/performance.md,
+"Fracture networks", refined meshes."""
 
 from __future__ import annotations
 

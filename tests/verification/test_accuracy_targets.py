@@ -1,4 +1,4 @@
-"""The accuracy targets of issue 3 on the frictional inclined crack.
+"""The accuracy targets on the frictional inclined crack.
 
 The problem (xfemslip.verify.problems): a straight crack of half-length a = 0.5 m at
 30 deg in a 2 m box whose edges carry the exact displacements of the cracked

@@ -1,4 +1,4 @@
-"""Depletion verification (issue 6): poroelastic loading against closed forms.
+"""Depletion verification: poroelastic loading against closed forms.
 
 1. Uniaxial strain (``closed_form_depletion.uniaxial_strain_change``): a box
    with rollers on its sides, u_y = 0 at the bottom and a constant overburden

@@ -170,7 +170,7 @@ def test_slip_matches_closed_form_more(tmp_path, psi, friction, cohesion, plane)
 
 @pytest.mark.slow
 def test_slip_error_converges(tmp_path):
-    """Observed order of the L2 slip error over n = 32, 64, 128 is >= 1 (issue 3).
+    """Observed order of the L2 slip error over n = 32, 64, 128 is >= 1.
 
     The order is the least-squares slope of log(error) against log(h) over the
     three meshes: measured 1.20, errors 0.99 %, 0.59 %, 0.19 %.  It was 0.84

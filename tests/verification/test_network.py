@@ -1,4 +1,4 @@
-"""Fracture networks: X crossings and T junctions (issue 6, items 4 and 6).
+"""Fracture networks: X crossings and T junctions.
 
 - Order independence: the same network listed in another order, with some
   fractures' points reversed, gives the same per-fracture fields to round-off

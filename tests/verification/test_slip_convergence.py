@@ -1,5 +1,5 @@
 """Slip of a frictional crack on a graded far-field mesh (the OpenGeoSys peer
-problem of issue 7) against the closed form of the infinite plane.
+problem) against the closed form of the infinite plane.
 
 Setup (xfemslip.reference.peer, as benchmarks/ogs_compare.py): a crack of half-length
 a = 1 m at 45 degrees through the centre of a square box of half-width 200 m

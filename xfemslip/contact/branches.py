@@ -23,14 +23,16 @@ tangent is not symmetric) a patch near junctions can have no consistent branch
 while its neighbours keep theirs: the tangents of the branches then differ in
 the sign of their determinant, the full Newton step from slip forward lands in
 slip backward and back, and no line search or load-step cut helps
-(benchmarks/RESULTS.md, "Refined DFN realizations (session 4)").  The cure is
+(docs/performance.md, "Fracture networks", refined meshes).  The cure is
 a neighbour changing branch, which this search finds.  Only the branches of
 the first solve are taken from it: Newton then goes on under the true law.
 """
 
 from __future__ import annotations
 
+import dataclasses
 import itertools
+import math
 
 import numpy as np
 import scipy.sparse as sp
@@ -166,3 +168,41 @@ def _solve_or_nan(L, b):
 def current_branches(res, idx) -> np.ndarray:
     """Branches (0 stick or open, +-1 slip) of the patches idx in res."""
     return np.where(res.state[idx] == SLIP, np.sign(res.pt[idx]), 0).astype(np.int64)
+
+
+def force_branches(c, *, open_at=None, stick_at=None, slip_at=None, sign=None):
+    """The contact set ``c`` whose return map lands on a chosen branch at the
+    selected patches (boolean masks or index arrays); the others as in ``c``.
+
+    The one way the solver forces a branch (the predictor's first guess, the
+    ping-pong and reversal holds, the branches of a local search).  Same
+    kernel, same affine expressions; only the parameters that select a
+    branch differ:
+
+    - ``open_at``: k_N = 0 and p_N0 > 0, so zero traction and tangent;
+    - ``stick_at``: an infinite cohesion, so the trial traction is always
+      inside the bound; the normal law stays free (a patch may still open);
+    - ``slip_at``: a committed plastic slip of -sign * inf (``sign`` +-1 per
+      selected patch), so the trial traction is infinite with that sign and
+      is returned onto sign * (c - f p_N); the plastic slip g_T - p_T / k_T
+      it reports does not depend on it.
+
+    A closed branch whose normal jump is open at the evaluation point stays
+    open (the normal test comes first).  Never committed: the true law is
+    restored and checked before a step is accepted.
+    """
+    changes = {}
+    if open_at is not None:
+        kn, pn0 = c.kn.copy(), c.pn0.copy()
+        kn[open_at] = 0.0
+        pn0[open_at] = 1.0
+        changes |= {"kn": kn, "pn0": pn0}
+    if stick_at is not None:
+        cohesion = c.cohesion.copy()
+        cohesion[stick_at] = math.inf
+        changes["cohesion"] = cohesion
+    if slip_at is not None:
+        committed = c.slip_committed.copy()
+        committed[slip_at] = -np.asarray(sign) * math.inf
+        changes["slip_committed"] = committed
+    return dataclasses.replace(c, **changes)

@@ -26,11 +26,9 @@ true law to the Newton tolerance as without the guess.
 
 from __future__ import annotations
 
-import dataclasses
-import math
-
 import numpy as np
 
+from xfemslip.contact.branches import force_branches
 from xfemslip.contact.interface import ContactSet
 from xfemslip.conventions import OPEN, SLIP, STICK
 
@@ -80,27 +78,17 @@ def predict_state(c: ContactSet, pn_committed, stress, d_lambda):
 
 
 def predicted_law(c: ContactSet, state, sign) -> ContactSet:
-    """The contact set whose return map gives the predicted branch.
-
-    Same kernel, same affine expressions; only the parameters that select a
-    branch differ (as in solver._frozen_law): an open patch gets k_N = 0 and
-    p_N0 > 0 (zero traction and tangent); a stuck one an infinite cohesion
-    (its trial traction is always inside the bound); a slipping one a
-    committed plastic slip of -sign * inf (its trial traction is infinite
-    with the predicted sign, so it is returned onto sign * (c - f p_N), and
-    the plastic slip g_T - p_T / k_T it reports does not depend on it).  A
-    closed branch whose normal jump is open at the evaluation point stays
-    open (the normal test comes first): that patch is simply not predicted.
-    Never committed.
+    """The contact set whose return map gives the predicted branch
+    (:func:`xfemslip.contact.branches.force_branches`): open, stick or slip
+    with ``sign`` as ``state`` says.  A closed branch whose normal jump is
+    open at the evaluation point stays open: that patch is simply not
+    predicted.  Never committed.
     """
-    kn, pn0 = c.kn.copy(), c.pn0.copy()
-    cohesion, slip = c.cohesion.copy(), c.slip_committed.copy()
-    is_open = state == OPEN
-    kn[is_open] = 0.0
-    pn0[is_open] = 1.0
-    cohesion[state == STICK] = math.inf
     is_slip = state == SLIP
-    slip[is_slip] = -sign[is_slip] * math.inf
-    return dataclasses.replace(
-        c, kn=kn, pn0=pn0, cohesion=cohesion, slip_committed=slip
+    return force_branches(
+        c,
+        open_at=state == OPEN,
+        stick_at=state == STICK,
+        slip_at=is_slip,
+        sign=sign[is_slip],
     )

@@ -33,6 +33,7 @@ import scipy.sparse as sp
 
 from xfemslip.case.specs import AUTO_PENALTY
 from xfemslip.contact import branches as local_branches
+from xfemslip.contact.branches import force_branches
 from xfemslip.contact.interface import ContactResult, ContactSet
 from xfemslip.contact.predictor import predict_state, predicted_law
 from xfemslip.conventions import (
@@ -63,7 +64,7 @@ PENALTY_RATIO_MEASURED = 1.0e6
 LINE_SEARCH_CUTS = 6
 # Ping-pong remedy: a contact point whose branch of the law (stick, slip +t,
 # slip -t) alternates A, B, A, B, A, B over six successive iterates is
-# cycling.  It is then frozen in STICK (see _frozen_law) until Newton
+# cycling.  It is then frozen in STICK (force_branches) until Newton
 # converges; the true law is then restored and Newton continues from there,
 # so an accepted step always satisfies the true law.  At most
 # PINGPONG_MAX_FREEZES freezes per attempt; after that the attempt fails and
@@ -81,7 +82,7 @@ REVERSAL_HOLDS = 2
 # Local branch searches (xfemslip.contact.branches) per Newton solve: a patch
 # that reverses its slip again after REVERSAL_HOLDS holds has no consistent
 # branch while its neighbours keep theirs (refined DFN realizations:
-# benchmarks/RESULTS.md, "Refined DFN realizations (session 4)"); the
+# docs/performance.md, "Fracture networks", refined meshes); the
 # stick/slip set of it and its neighbours is then searched.
 LOCAL_SEARCHES = 2
 # Load-step bisection: a load step that does not converge is cut in halves, at
@@ -405,7 +406,7 @@ class NewtonSolver:
             cycling = _cycling(history)
             if cycling is not None and log.freezes < PINGPONG_MAX_FREEZES:
                 frozen = cycling if frozen is None else (frozen | cycling)
-                law = _frozen_law(c, frozen)
+                law = force_branches(c, stick_at=frozen)
                 log.freezes += 1
                 logger.info(
                     "step %d/%d iteration %d: %d contact point(s) ping-pong "
@@ -459,7 +460,7 @@ class NewtonSolver:
                 if flipped is not None:
                     held += flipped
                     frozen = flipped if frozen is None else (frozen | flipped)
-                    law = _frozen_law(c, frozen)
+                    law = force_branches(c, stick_at=frozen)
                     log.reversals += 1
                     logger.info(
                         "step %d/%d iteration %d: the Newton step reverses the "
@@ -528,7 +529,7 @@ class NewtonSolver:
         so nothing in the linearization holds the patch), and the line search
         then only shortens steps that keep cycling.  The continuous path
         between the two slip branches passes through stick: those patches are
-        held in stick (_frozen_law) until Newton converges, then the true law
+        held in stick (force_branches) until Newton converges, then the true law
         is restored and checked, as for ping-pong.  A patch is held at most
         REVERSAL_HOLDS times per Newton solve (``held``, counts).  Returns
         (patches to hold, or None; patches that reverse again after their
@@ -565,7 +566,7 @@ class NewtonSolver:
         idx = np.concatenate([first, rest])[: local_branches.MAX_CLUSTER]
         mask = np.zeros(c.n, bool)
         mask[idx] = True
-        stick = _frozen_law(law, mask).evaluate(
+        stick = force_branches(law, stick_at=mask).evaluate(
             u, self.mode, law.pt_committed, law.gt_committed
         )
         # the tangent of res with the cluster's blocks in stick, formed in
@@ -586,12 +587,16 @@ class NewtonSolver:
             idx.size,
             int(np.count_nonzero(branches != now)),
         )
-        # a patch of the cluster held in stick by _frozen_law gets its own
+        # a patch of the cluster held in stick by a hold gets its own
         # cohesion back (a forced slip needs the finite bound)
         base = dataclasses.replace(
             law, cohesion=np.where(mask, c.cohesion, law.cohesion)
         )
-        return _forced_law(base, idx, branches)
+        branches = np.asarray(branches)
+        moving = branches != 0
+        return force_branches(
+            base, stick_at=idx[~moving], slip_at=idx[moving], sign=branches[moving]
+        )
 
     def _line_search(self, u, du, lam, eta0, pt_prev, gt_prev, law=None):
         """Backtracking on eta along the Newton direction (Armijo on the norm).
@@ -792,34 +797,3 @@ def _cycling(history):
     for i, regime in enumerate(last):
         mask &= regime == (a if i % 2 == 0 else b)
     return mask if mask.any() else None
-
-
-def _frozen_law(c: ContactSet, frozen) -> ContactSet:
-    """The contact set with the frozen points held in STICK.
-
-    A cycling point alternates between two branches of the law (stick and
-    slip, or slip forward and backward); holding it in stick (an infinite
-    cohesion, so the trial traction is always within the bound) is the
-    branch that adds stiffness.  The normal law stays free (a point may still
-    open).  The kernel is unchanged: only the cohesion of the frozen points
-    differs, and the result is never committed: the true law is restored and
-    checked before a step is accepted.
-    """
-    cohesion = c.cohesion.copy()
-    cohesion[frozen] = math.inf
-    return dataclasses.replace(c, cohesion=cohesion)
-
-
-def _forced_law(c: ContactSet, idx, branches) -> ContactSet:
-    """The contact set with the patches idx held on the branches ``branches``
-    (0 stick, +-1 slip forward / backward), as predictor.predicted_law does:
-    stick by an infinite cohesion, slip by a committed plastic slip of
-    -s * inf.  Never committed: the true law is restored and checked before a
-    step is accepted."""
-    cohesion, slip = c.cohesion.copy(), c.slip_committed.copy()
-    branches = np.asarray(branches)
-    st = idx[branches == 0]
-    sl = idx[branches != 0]
-    cohesion[st] = math.inf
-    slip[sl] = -branches[branches != 0] * math.inf
-    return dataclasses.replace(c, cohesion=cohesion, slip_committed=slip)

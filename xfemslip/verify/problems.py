@@ -19,7 +19,7 @@ Measured per run: dofs, relative L2 slip error, K_II error (interaction
 integral, worst tip), K_I (should be 0), normal-traction oscillation
 max |p_N - mean| / |mean| over the inner 90 % of the crack, the observed
 order of the slip error between consecutive meshes, and the wall time
-(build + solve, in-process).  Targets (issue 3): slip L2 <= 1 % at h = a/20,
+(build + solve, in-process).  Targets: slip L2 <= 1 % at h = a/20,
 observed order >= 1, K_II within 2 % at h = a/20, no misclassified
 orientation farther than 2 degrees from the window's edges.
 """
@@ -52,7 +52,7 @@ STRESS = (-20.0e6, -40.0e6, 0.0)  # remote stress [Pa], the paper's state
 E, NU = 5.0e9, 0.3
 PENALTY = 100.0  # kn = kt = PENALTY * E / h, as in check_inclined_crack.py
 
-# Targets of issue 3
+# Accuracy targets
 SLIP_TARGET = 0.01  # relative L2 slip error at h = a/20
 KII_TARGET = 0.02  # relative K_II error at h = a/20
 ORDER_TARGET = 1.0  # observed order of the slip error
