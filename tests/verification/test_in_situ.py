@@ -29,12 +29,12 @@ from __future__ import annotations
 import math
 from pathlib import Path
 
-import h5py
 import numpy as np
 import pytest
 import tomli_w
 from click.testing import CliRunner
 
+import xfemslip
 from xfemslip.case import load_case
 from xfemslip.cli import cli
 from xfemslip.conventions import OPEN, SLIP, STICK
@@ -105,18 +105,14 @@ def _write(tmp_path, name, doc):
 
 
 def _steps(out):
-    """[(s, slip, opening, state)] of every step of a result.h5."""
-    with h5py.File(out / "result.h5") as f:
-        keys = sorted(f["steps"]) if "steps" in f else [None]
-        rows = []
-        for k in keys:
-            g = f if k is None else f[f"steps/{k}"]
-            fr = g["fractures/0"]
-            rows.append(
-                tuple(fr[n][()] for n in ("s", "slip", "opening"))
-                + (f["fractures/0/state"][()],)
-            )
-        return rows
+    """[(s, slip, opening, state of the final step)] of every step of a
+    result.h5."""
+    result = xfemslip.read_result(out / "result.h5")
+    final = result.fractures[0].state
+    return [
+        (step.fractures[0].s, step.fractures[0].slip, step.fractures[0].opening, final)
+        for step in result.steps
+    ]
 
 
 def _error(s, slip, stress, angle=45.0):
