@@ -29,7 +29,7 @@ tables and checks, instead of the installed one.
 Networks:
 
 - ``test table``: the network of
-  ``tests/unit/test_case_network.py::test_allow_network_that_crosses_is_built
+  ``tests/unit/case/test_case_network.py::test_allow_network_that_crosses_is_built
   _with_a_junction_per_crossing``: 40 fractures of 0.2 m, uniform
   orientation, ``intersections = "allow"``, in a 2 x 1 m domain of 20 x 10
   cells (h = 0.1 m);

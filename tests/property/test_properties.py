@@ -233,7 +233,7 @@ grid = st.integers(0, 1024).map(lambda k: k / 1024.0)  # exact binary fractions
 # the Duffy rule is not exact for B1..B4 and the rotated cells are fanned from
 # other corners, so the answers differ by the quadrature error (~0.5 % of sigma on
 # 1 m cells).  The radius stays below the shortest fracture (2 m): see the
-# default-radius xfail in tests/unit/test_enrichment.py.
+# default-radius xfail in tests/unit/fem/test_enrichment.py.
 TIPS = {"ramp": ('"ramp"', 1e-6), "branch": ('{ kind = "branch", radius = 1.5 }', 2e-2)}
 
 

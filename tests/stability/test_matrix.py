@@ -13,7 +13,8 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from matrix import (
+
+from tests.support.matrix import (
     OPEN,
     RESERVOIR,
     SHEAR_STRESS,
@@ -29,7 +30,6 @@ from matrix import (
     solve,
     window_reference,
 )
-
 from xfemslip.case import loads_case
 from xfemslip.errors import GeometryError
 from xfemslip.reference import closed_form as cf

@@ -20,7 +20,9 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from matrix import (
+
+import xfemslip.solve.newton as solver_module
+from tests.support.matrix import (
     RESERVOIR,
     SLIP,
     STICK,
@@ -29,8 +31,6 @@ from matrix import (
     reservoir_text,
     solve,
 )
-
-import xfemslip.solve.newton as solver_module
 from xfemslip.contact.branches import force_branches
 from xfemslip.errors import ConvergenceError
 from xfemslip.solve.newton import _cycling

@@ -28,8 +28,8 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from depletion_cases import offset_fault_case
 
+from tests.support.depletion_cases import offset_fault_case
 from xfemslip.case import loads_case
 from xfemslip.fem.poro import fluid_pressure
 from xfemslip.post.fields import step_fields

@@ -45,8 +45,8 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from harness import SLIP, STICK, read_result
 
+from tests.support.harness import SLIP, STICK, read_result
 from xfemslip.case import load_case
 from xfemslip.reference import closed_form as cf
 from xfemslip.simulation import run_case

@@ -22,9 +22,9 @@ from pathlib import Path
 import numpy as np
 import pytest
 import tomli_w
-from harness import SLIP, STICK, read_result
 
 import xfemslip
+from tests.support.harness import SLIP, STICK, read_result
 from xfemslip.case import load_case
 from xfemslip.simulation import run_case
 

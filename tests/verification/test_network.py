@@ -27,7 +27,7 @@ import math
 import numpy as np
 import pytest
 
-from tests.verification.harness import case_text
+from tests.support.harness import case_text
 from xfemslip.case import loads_case
 from xfemslip.conventions import SLIP, STICK
 from xfemslip.simulation import build_model, newton_solver

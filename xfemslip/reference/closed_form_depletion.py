@@ -53,9 +53,9 @@ plane strain, homogeneous isotropic elasticity (shear modulus mu, Poisson nu).
    .../faultMechanics/slippedVerticalFault/generate_analytical.py; Frigo,
    Castelletto, Cusini et al., J. Comput. Phys. 2026, Sec. 5.1.2, eqs.
    48-51, for equal thickness b - a = d - c): tested in
-   tests/unit/test_closed_form_depletion.py.
+   tests/unit/reference/test_closed_form_depletion.py.
    The released elastic energy -1/2 int sigma_xy delta dy is positive
-   (checked in tests/unit/test_closed_form_depletion.py with a numerical
+   (checked in tests/unit/reference/test_closed_form_depletion.py with a numerical
    Cauchy principal value of the slip's stress).  The fault must stay closed
    (compressive effective normal stress), which the in-situ stress provides.
 """

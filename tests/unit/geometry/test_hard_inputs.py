@@ -12,9 +12,9 @@ import sys
 
 import numpy as np
 import pytest
-from casegen import fracture_spec
-from hardcases import arc, depletion, measure, polygon, zigzag
 
+from tests.support.casegen import fracture_spec
+from tests.support.hardcases import arc, depletion, measure, polygon, zigzag
 from xfemslip.case import loads_case
 from xfemslip.errors import GeometryError, UsageError
 from xfemslip.fem.mesh import build_mesh

@@ -10,15 +10,15 @@ import numpy as np
 import pytest
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
-from casegen import sweep_member
 
+from tests.support.casegen import sweep_member
 from xfemslip.case import loads_case
 from xfemslip.simulation import build_model, run_case
 from xfemslip.solve import linear as linsolve
 from xfemslip.solve.linear import LinearSolver, choose, system_facts
 from xfemslip.solve.newton import NewtonSolver
 
-ROOT = Path(__file__).resolve().parents[2]
+ROOT = Path(__file__).resolve().parents[3]
 CASE = ROOT / "cases" / "reservoir_depletion.toml"
 pytest.importorskip("pyamg")
 

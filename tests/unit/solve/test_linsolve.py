@@ -19,7 +19,7 @@ from xfemslip.solve import linear as linsolve
 from xfemslip.solve.linear import LinearSolver, choose, rigid_body_modes
 from xfemslip.solve.newton import NewtonSolver
 
-CASE = Path(__file__).resolve().parents[2] / "cases" / "reservoir_depletion.toml"
+CASE = Path(__file__).resolve().parents[3] / "cases" / "reservoir_depletion.toml"
 pytest.importorskip("pyamg")
 
 

@@ -13,8 +13,8 @@ import h5py
 import numpy as np
 import pytest
 from click.testing import CliRunner
-from test_sweep import BASE
 
+from tests.support.casegen import SWEEP_BASE as BASE
 from xfemslip.cli import cli
 from xfemslip.errors import UsageError
 from xfemslip.plot.data import FractureData, _piece_outlines, figure_data
@@ -23,7 +23,7 @@ from xfemslip.plot.mohr import _circle_point
 from xfemslip.reference.closed_form import angle_to_sigma1, principal
 from xfemslip.reference.screen import plane_stresses
 
-ROOT = Path(__file__).resolve().parents[2]
+ROOT = Path(__file__).resolve().parents[3]
 PNG = b"\x89PNG\r\n\x1a\n"
 
 

@@ -11,8 +11,8 @@ import math
 
 import numpy as np
 import pytest
-from casegen import fracture_spec
 
+from tests.support.casegen import fracture_spec
 from xfemslip.errors import GeometryError
 from xfemslip.fem.mesh import build_mesh
 from xfemslip.geometry.fracture import build_fracture, build_fractures, clip_segment
@@ -324,7 +324,7 @@ def test_clip_segment_against_hand_computed_parameters():
 
 
 # ------------------------------------------------------------- intersecting fractures
-# Networks are built (junctions: tests/unit/test_junction.py);
+# Networks are built (junctions: tests/unit/geometry/test_junction.py);
 # only truly degenerate input is refused: fractures overlapping on one line.
 
 

@@ -17,8 +17,8 @@ import numpy as np
 import pytest
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
-from casegen import fracture_case
 
+from tests.support.casegen import fracture_case
 from xfemslip import conventions
 from xfemslip.case import loads_case
 from xfemslip.fem.assembly import _enriched_matrices

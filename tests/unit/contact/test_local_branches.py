@@ -17,7 +17,7 @@ from xfemslip.fem.assembly import coo_block
 from xfemslip.simulation import build_model
 from xfemslip.solve.newton import NewtonSolver
 
-CASE = Path(__file__).resolve().parents[2] / "cases" / "reservoir_depletion.toml"
+CASE = Path(__file__).resolve().parents[3] / "cases" / "reservoir_depletion.toml"
 
 
 def _setup(friction):

@@ -17,8 +17,8 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from casegen import fracture_case
 
+from tests.support.casegen import fracture_case
 from xfemslip import conventions
 from xfemslip.case import loads_case
 from xfemslip.contact.predictor import predict_state, predicted_law, stress_increment
@@ -27,7 +27,7 @@ from xfemslip.reference.closed_form import slip_window
 from xfemslip.simulation import build_model
 from xfemslip.solve.newton import NewtonSolver
 
-ROOT = Path(__file__).resolve().parents[2]
+ROOT = Path(__file__).resolve().parents[3]
 RESERVOIR = ROOT / "cases" / "reservoir_depletion.toml"
 PLATE = ROOT / "cases" / "liu_borja_plate.toml"
 

@@ -1,8 +1,7 @@
 """Inputs whose cost must follow the mesh, not their number of vertices, a
 child process measured for its peak memory, and a case's memory estimates:
-shared by tests/unit/test_hard_inputs.py, tests/unit/test_memory.py and
-benchmarks/hard_inputs.py, benchmarks/memory_estimate.py (imported by
-basename)."""
+shared by tests/unit/geometry/test_hard_inputs.py, tests/unit/test_memory.py
+and benchmarks/hard_inputs.py, benchmarks/memory_estimate.py."""
 
 from __future__ import annotations
 

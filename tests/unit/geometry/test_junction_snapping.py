@@ -31,10 +31,10 @@ from pathlib import Path
 import numpy as np
 import pytest
 import tomli_w
-from casegen import SHIPPED_DFN, fracture_spec
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
+from tests.support.casegen import SHIPPED_DFN, fracture_spec
 from xfemslip.case import loads_case
 from xfemslip.errors import GeometryError
 from xfemslip.fem.mesh import build_mesh
@@ -432,7 +432,7 @@ def test_stuck_fractures_carry_the_uniform_traction(name):
     all stick, so the body is nearly uncracked and each contact patch carries
     sigma . n of the far field (within 2.5 % of |sigma_yy|: the ramp tips
     perturb it by up to 0.8 MPa), with the penalty jump p_T / k_T; no NaN."""
-    from tests.verification.harness import case_text
+    from tests.support.harness import case_text
     from xfemslip.conventions import STICK
     from xfemslip.simulation import build_model, newton_solver
 

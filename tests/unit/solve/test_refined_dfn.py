@@ -13,8 +13,8 @@ from __future__ import annotations
 from pathlib import Path
 
 import numpy as np
-from casegen import sweep_member
 
+from tests.support.casegen import sweep_member
 from xfemslip.case import loads_case
 from xfemslip.conventions import OPEN, SLIP
 from xfemslip.simulation import build_model, newton_solver

@@ -13,7 +13,7 @@ from xfemslip.errors import ConvergenceError
 from xfemslip.simulation import build_model
 from xfemslip.solve.newton import NewtonSolver
 
-CASE = Path(__file__).resolve().parents[2] / "cases" / "reservoir_depletion.toml"
+CASE = Path(__file__).resolve().parents[3] / "cases" / "reservoir_depletion.toml"
 
 
 def _solve(tangent, steps=1, n=20, friction=0.1):
@@ -23,7 +23,7 @@ def _solve(tangent, steps=1, n=20, friction=0.1):
     model = build_model(loads_case(text, CASE))
     # without the stick/slip predictor: these tests watch Newton's own
     # iterates settle (the predictor's first solve lands on the final set
-    # directly; tests/unit/test_predictor.py)
+    # directly; tests/unit/contact/test_predictor.py)
     solver = NewtonSolver(model.problem, 1e-10, 60, tangent, predictor=False)
     return solver.run(steps)
 

@@ -14,6 +14,7 @@ import numpy as np
 import pytest
 from click.testing import CliRunner
 
+from tests.support.casegen import SWEEP_BASE as BASE
 from xfemslip.case.tables import Table
 from xfemslip.cli import cli
 from xfemslip.errors import CaseError
@@ -28,41 +29,6 @@ from xfemslip.studies.sweep import (
     set_key_path,
 )
 from xfemslip.studies.vary import _check_overlaps, case_count, read_vary
-
-# A small, fast case: 10 x 10 cells, a 45-degree fracture that slips (f = 0.1).
-BASE = """\
-name = "tiny"
-
-[domain]
-size = [1.0, 1.0]
-
-[mesh]
-elements = [10, 10]
-
-[material]
-E = 5.0e9
-nu = 0.3
-
-[[fractures]]
-center = [0.5, 0.5]
-length = 0.6
-angle = 45.0
-friction = 0.1
-kn = 5.0e12
-kt = 5.0e12
-
-[loading]
-stress = { xx = -20.0e6, yy = -40.0e6, xy = 0.0 }
-
-[boundary]
-bottom = { uy = 0.0 }
-top = "traction"
-left = "traction"
-right = "traction"
-
-[output]
-formats = ["h5"]
-"""
 
 
 @pytest.fixture
@@ -333,7 +299,7 @@ def test_cli_bad_sweep_is_exit_2_one_line_and_writes_nothing(tmp_path, base, run
 
 
 def test_paper_sweep_files_are_valid():
-    root = Path(__file__).resolve().parents[2] / "cases" / "sweeps"
+    root = Path(__file__).resolve().parents[3] / "cases" / "sweeps"
     found = {p.stem: load_sweep(p) for p in sorted(root.glob("*.toml"))}
     assert set(found) == {
         "young_modulus",
@@ -453,7 +419,7 @@ def test_rerun_after_editing_the_base_runs_again(tmp_path, base):
 @pytest.mark.slow  # two spawned interpreters load numba: ~7 s
 def test_cli_sweep_two_processes(tmp_path, base, runner, monkeypatch):
     # spawned workers import xfemslip from the same tree as this process
-    monkeypatch.setenv("PYTHONPATH", str(Path(__file__).resolve().parents[2]))
+    monkeypatch.setenv("PYTHONPATH", str(Path(__file__).resolve().parents[3]))
     path = _sweep(
         tmp_path, 'base = "base.toml"\n[vary]\n"fractures[0].angle" = [0.0, 45.0]\n'
     )

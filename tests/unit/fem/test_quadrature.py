@@ -13,9 +13,9 @@ from itertools import product
 
 import numpy as np
 import pytest
-from casegen import fracture_spec
 from scipy import integrate
 
+from tests.support.casegen import fracture_spec
 from xfemslip.fem.mesh import build_mesh
 from xfemslip.fem.quadrature import (
     cell_subtriangles,

@@ -16,8 +16,8 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from casegen import sweep_member
 
+from tests.support.casegen import sweep_member
 from xfemslip import kernels
 from xfemslip.case import load_case, loads_case
 from xfemslip.conventions import OPEN, SLIP, STICK, TANGENT_CONSISTENT, TANGENT_SECANT
@@ -28,7 +28,7 @@ from xfemslip.kernels import vectorized
 from xfemslip.simulation import _geometry, build_model, kernel_work
 from xfemslip.solve.newton import NewtonSolver
 
-ROOT = Path(__file__).resolve().parents[2]
+ROOT = Path(__file__).resolve().parents[3]
 NUMBA = kernels.backend("numba")
 
 

@@ -4,8 +4,8 @@ cell-by-cell evaluation of every slot with the public candidate_values."""
 from __future__ import annotations
 
 import numpy as np
-from casegen import fracture_spec
 
+from tests.support.casegen import fracture_spec
 from xfemslip.fem.enrichment import (
     build_enriched_cells,
     candidate_values,

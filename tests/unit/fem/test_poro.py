@@ -426,8 +426,7 @@ def test_enriched_stiffness_takes_the_material_of_each_quadrature_point():
     left of the fracture and of the host right of it, against the point-by-
     point NumPy reference of test_kernels_bulk (not the D-difference form of
     assembly._enriched_matrices)."""
-    from test_kernels_bulk import enriched_reference
-
+    from tests.support.bulk_reference import enriched_reference
     from xfemslip.fem.assembly import _enriched_matrices
 
     model = build_model(loads_case(SPLIT.format(E=5.0e9), "split.toml"))

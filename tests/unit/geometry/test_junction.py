@@ -13,8 +13,8 @@ import math
 
 import numpy as np
 import pytest
-from casegen import fracture_spec
 
+from tests.support.casegen import fracture_spec
 from xfemslip.errors import GeometryError
 from xfemslip.fem.enrichment import HEAVISIDE, build_enriched_cells, find_candidates
 from xfemslip.fem.mesh import build_mesh

@@ -1,4 +1,4 @@
-"""A small one-fracture case shared by the unit tests (imported by basename)."""
+"""Small cases shared by the unit tests and the benchmarks (tests.support)."""
 
 from __future__ import annotations
 
@@ -69,3 +69,39 @@ def sweep_member(path=SHIPPED_DFN, index=0, **keys) -> str:
         message = set_key_path(document, parse_key_path(key), value)
         assert message is None, message
     return tomli_w.dumps(document)
+
+
+# A small, fast case: 10 x 10 cells, a 45-degree fracture that slips (f = 0.1).
+SWEEP_BASE = """\
+name = "tiny"
+
+[domain]
+size = [1.0, 1.0]
+
+[mesh]
+elements = [10, 10]
+
+[material]
+E = 5.0e9
+nu = 0.3
+
+[[fractures]]
+center = [0.5, 0.5]
+length = 0.6
+angle = 45.0
+friction = 0.1
+kn = 5.0e12
+kt = 5.0e12
+
+[loading]
+stress = { xx = -20.0e6, yy = -40.0e6, xy = 0.0 }
+
+[boundary]
+bottom = { uy = 0.0 }
+top = "traction"
+left = "traction"
+right = "traction"
+
+[output]
+formats = ["h5"]
+"""
