@@ -47,9 +47,9 @@ import h5py
 import numpy as np
 from xfem_process import timed_run
 
-from xfemslip import closed_form as cf
-from xfemslip import verify as V
-from xfemslip.case_fractures import TIP_KINDS
+from xfemslip.reference import closed_form as cf
+from xfemslip.verify import problems as V
+from xfemslip.case.fractures import TIP_KINDS
 from xfemslip.errors import XfemslipError
 
 AOH = (4, 8, 16, 32, 64)

@@ -22,13 +22,13 @@ import logging
 import statistics
 import time
 
-from xfemslip.peer import case_text as xfem_case
+from xfemslip.reference.peer import case_text as xfem_case
 
 
 def one(spec, method: str, stall_stop: bool) -> dict:
-    from xfemslip import linsolve
+    from xfemslip.solve import linear as linsolve
     from xfemslip.simulation import build_model
-    from xfemslip.solver import NewtonSolver
+    from xfemslip.solve.newton import NewtonSolver
 
     linsolve.AMG_STALL_STOP = stall_stop
     model = build_model(spec)

@@ -64,7 +64,7 @@ def case_text(mesh: int, count: int, tip: str, steps: int, source="dfn") -> str:
 
 def record(text: str, max_systems: int):
     """Build, run with SuperLU; the Newton systems (Kc, r) and model facts."""
-    from xfemslip import linsolve
+    from xfemslip.solve import linear as linsolve
     from xfemslip.case import loads_case
     from xfemslip.errors import ConvergenceError
     from xfemslip.simulation import build_model, newton_solver
@@ -111,7 +111,7 @@ def record(text: str, max_systems: int):
 
 
 def replay(ns, systems, method: str) -> dict:
-    from xfemslip.linsolve import LinearSolver
+    from xfemslip.solve.linear import LinearSolver
 
     t0 = time.process_time()
     ls = LinearSolver(ns.K_ff, method, ns.free, ns.p.node_xy)

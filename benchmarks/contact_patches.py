@@ -8,7 +8,7 @@ The problem is that of ``check_inclined_crack.py`` and ``xfemslip verify``:
 a crack of half-length a = 0.5 m through (0.0123, -0.0077) in a 2 m box,
 remote stress (-20, -40, 0) MPa, E = 5 GPa, nu = 0.3, plane strain, with the
 exact Westergaard displacements of the cracked infinite plane on every edge
-(``xfemslip.closed_form``).  Printed as markdown tables:
+(``xfemslip.reference.closed_form``).  Printed as markdown tables:
 
 1. contact patch length (``[solver] contact_patch``) x mesh: relative L2 slip
    error and normal-traction oscillation max |p_N - mean| / |mean| over the
@@ -29,10 +29,8 @@ from pathlib import Path
 
 import numpy as np
 
-from xfemslip import closed_form as cf
-from xfemslip import verify as V
-
-
+from xfemslip.reference import closed_form as cf
+from xfemslip.verify import problems as V
 def run(folder: Path, n, psi=30.0, friction=0.1, penalty=100.0, patch=None):
     """Solve; return (relative L2 slip error or max|slip|, oscillation, iterations).
 

@@ -19,8 +19,8 @@ import tempfile
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
-sys.path.insert(0, str(ROOT / "tests" / "unit"))
-from hardcases import arc, depletion, measure, polygon, zigzag  # noqa: E402
+sys.path.insert(0, str(ROOT))  # tests.support
+from tests.support.hardcases import arc, depletion, measure, polygon, zigzag  # noqa: E402
 
 INPUTS = {
     "zigzag": (zigzag, ["run"]),

@@ -63,7 +63,7 @@ def with_backend(text: str, backend: str) -> str:
 
 def work_of(case: Path) -> float:
     from xfemslip.case import load_case
-    from xfemslip.enrichment import build_enriched_cells, find_candidates
+    from xfemslip.fem.enrichment import build_enriched_cells, find_candidates
     from xfemslip.simulation import _geometry, kernel_work
 
     spec = load_case(case)

@@ -22,10 +22,9 @@ import tempfile
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
-sys.path.insert(0, str(ROOT / "tests" / "unit"))
-from casegen import sweep_member  # noqa: E402
-from hardcases import estimates, measure  # noqa: E402
-
+sys.path.insert(0, str(ROOT))  # tests.support
+from tests.support.casegen import sweep_member  # noqa: E402
+from tests.support.hardcases import estimates, measure  # noqa: E402
 from xfemslip import memory  # noqa: E402
 
 CASES = ROOT / "cases"

@@ -29,7 +29,7 @@ tables and checks, instead of the installed one.
 Networks:
 
 - ``test table``: the network of
-  ``tests/unit/test_case_network.py::test_allow_network_that_crosses_is_built
+  ``tests/unit/case/test_case_network.py::test_allow_network_that_crosses_is_built
   _with_a_junction_per_crossing``: 40 fractures of 0.2 m, uniform
   orientation, ``intersections = "allow"``, in a 2 x 1 m domain of 20 x 10
   cells (h = 0.1 m);
@@ -64,11 +64,11 @@ _source_first(sys.argv)
 import numpy as np  # noqa: E402
 import tomli_w  # noqa: E402
 
-from xfemslip import geometry  # noqa: E402
+from xfemslip.geometry import fracture as geometry  # noqa: E402
 from xfemslip.case import loads_case  # noqa: E402
-from xfemslip.dfn import intersecting_pairs  # noqa: E402
+from xfemslip.geometry.dfn import intersecting_pairs  # noqa: E402
 from xfemslip.errors import CaseError, GeometryError  # noqa: E402
-from xfemslip.mesh import build_mesh  # noqa: E402
+from xfemslip.fem.mesh import build_mesh  # noqa: E402
 from xfemslip.simulation import check_geometry  # noqa: E402
 
 ROOT = Path(__file__).resolve().parents[1]

@@ -7,7 +7,7 @@ box, a crack of length 2a = 2 m at 45 degrees through the centre, far-field
 stress sxx = -20 MPa, syy = -40 MPa applied as edge tractions, f = 0.1,
 c = 0, kn = kt = 5e12 Pa/m, E = 5 GPa, nu = 0.3, plane strain, one load step.
 Error: relative L2 norm of slip - exact slip along the crack (Phan et al.,
-xfemslip.closed_form.slip_profile).
+xfemslip.reference.closed_form.slip_profile).
 
 xfemslip: a graded mesh, cells of size h over [-0.8, 0.8]^2 (the crack and a
 margin) growing by 1.3 per cell to the edges; the bottom edge has u_y = 0 (the
@@ -40,7 +40,7 @@ from pathlib import Path
 
 from xfem_process import timed_run
 
-from xfemslip import peer
+from xfemslip.reference import peer
 
 ROOT = Path(__file__).resolve().parents[1]
 OGS_PY = ROOT.parent / "ogs-venv/bin/python"
@@ -48,7 +48,7 @@ OGS_SCRIPT = ROOT.parent / "shared/peers/ogs/ogs_lie_slip.py"
 
 
 def xfem_prepare(h, folder: Path, **box) -> dict:
-    """Write the case (xfemslip.peer.case_text; ``box``: half, growth,
+    """Write the case (xfemslip.reference.peer.case_text; ``box``: half, growth,
     radius) and warm the caches; returns the state of its runs."""
     case = folder / f"case_{h:g}.toml"
     case.write_text(peer.case_text(h, **box))

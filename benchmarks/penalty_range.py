@@ -23,8 +23,8 @@ import numpy as np
 import tomli_w
 
 ROOT = Path(__file__).resolve().parents[1]
-sys.path.insert(0, str(ROOT / "tests" / "unit"))
-from hardcases import measure  # noqa: E402
+sys.path.insert(0, str(ROOT))  # tests.support
+from tests.support.hardcases import measure  # noqa: E402
 
 CASES = [
     "reservoir_depletion",

@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Cost of the per-quadrature-point reservoir in enriched cells (xfemslip.poro):
+"""Cost of the per-quadrature-point reservoir in enriched cells (xfemslip.fem.poro):
 bulk assembly of the same model with one material (the default path), with a
 reservoir by cell only (qp_material=None) and with the per-QP split, and the
 Biot body load; median of several calls after a warm-up, ratios from the
@@ -15,7 +15,7 @@ import argparse
 import statistics
 import time
 
-from xfemslip.assembly import assemble_bulk
+from xfemslip.fem.assembly import assemble_bulk
 from xfemslip.case import load_case
 from xfemslip.simulation import build_model
 
@@ -37,7 +37,7 @@ def former_vs_current(model, runs: int) -> None:
     import numpy as np
 
     from xfemslip import kernels
-    from xfemslip.assembly import _enriched_matrices
+    from xfemslip.fem.assembly import _enriched_matrices
 
     mesh, ec, D = model.mesh, model.ec, model.D
 
@@ -83,8 +83,8 @@ def main() -> int:
     )
     args = parser.parse_args()
     model = build_model(load_case(args.case))
-    from xfemslip.enrichment import find_candidates
-    from xfemslip.poro import body_load
+    from xfemslip.fem.enrichment import find_candidates
+    from xfemslip.fem.poro import body_load
 
     mesh, ec, ip, mats = model.mesh, model.ec, model.ip, model.materials
     cand = find_candidates(mesh, model.fractures)

@@ -1,5 +1,5 @@
-"""Refined DFN failure (benchmarks/RESULTS.md, "Refined DFN realizations
-(session 4)"): at the first Newton step that the line search can only make
+"""Refined DFN failure (docs/performance.md, "Fracture networks", refined
+meshes): at the first Newton step that the line search can only make
 worse, the 2x2 compliance (g_N, g_T) of the rest of the model seen by the
 patch that the full step reverses (a Schur complement through one sparse LU),
 and the determinant of the patch's stick / slip-forward / slip-backward
@@ -20,10 +20,10 @@ import sys
 import numpy as np
 import scipy.sparse.linalg as spla
 
-from xfemslip import solver as S
-from xfemslip.assembly import coo_block
+from xfemslip.solve import newton as S
+from xfemslip.fem.assembly import coo_block
 from xfemslip.case import load_case
-from xfemslip.contact import SLIP
+from xfemslip.conventions import SLIP
 from xfemslip.simulation import build_model, newton_solver
 
 spec = load_case(sys.argv[1])

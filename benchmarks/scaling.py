@@ -9,7 +9,7 @@ system on the same mesh, measured in the same run.
     python benchmarks/scaling.py --merge a.json b.json --plot benchmarks/scaling.png
 
 A solver name with the suffix "/nopred" (e.g. superlu/nopred) runs Newton
-without the stick/slip predictor (xfemslip/predictor.py), against the same
+without the stick/slip predictor (xfemslip/contact/predictor.py), against the same
 floor as the plain solver.
 
 Every measurement runs in its own subprocess so that the peak memory
@@ -55,7 +55,7 @@ def one(n: int, solver: str, cracked: bool) -> dict:
 
     from xfemslip.case import loads_case
     from xfemslip.simulation import build_model
-    from xfemslip.solver import NewtonSolver
+    from xfemslip.solve.newton import NewtonSolver
 
     solver, _, flag = solver.partition("/")
     spec = loads_case(case_text(n, cracked), CASE)

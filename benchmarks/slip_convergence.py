@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Why the slip error on the OpenGeoSys peer problem stopped converging (issue 7).
+"""Why the slip error on the OpenGeoSys peer problem stopped converging.
 
 Usage (from the project root)::
 
@@ -9,7 +9,7 @@ Usage (from the project root)::
     python benchmarks/slip_convergence.py exact --aoh 10 20 40
     python benchmarks/slip_convergence.py box --h 0.1 0.05 0.025 0.0125 [--element q4]
 
-The problem is that of ``benchmarks/ogs_compare.py`` (``xfemslip.peer``): a
+The problem is that of ``benchmarks/ogs_compare.py`` (``xfemslip.reference.peer``): a
 crack of half-length a = 1 m at 45 degrees through the centre of a square box,
 remote stress (-20, -40, 0) MPa as edge tractions (bottom edge a roller),
 f = 0.1, c = 0, kn = kt = 5e12 Pa/m, E = 5 GPa, nu = 0.3, plane strain, one
@@ -47,11 +47,11 @@ from pathlib import Path
 import numpy as np
 
 from xfemslip import kernels
-from xfemslip import peer as oc
-from xfemslip import quadrature as Q
+from xfemslip.reference import peer as oc
+from xfemslip.fem import quadrature as Q
 from xfemslip.case import loads_case
-from xfemslip.closed_form import relative_l2, slip_profile
-from xfemslip.post import fracture_fields
+from xfemslip.reference.closed_form import relative_l2, slip_profile
+from xfemslip.post.fields import fracture_fields
 from xfemslip.simulation import build_model, newton_solver
 
 HALF = 200.0  # [m] half-width of the box
@@ -69,7 +69,7 @@ def case_text(
     patch=None,
     aligned=False,
 ):
-    """xfemslip.peer.case_text on the mesh graded(h, fine, half, growth), with
+    """xfemslip.reference.peer.case_text on the mesh graded(h, fine, half, growth), with
     one option changed.  aligned: the crack at 0 degrees (off the mesh lines by
     (0.3 h, 0.37 h)) under the stress that gives it the same normal and shear
     traction as the 45-degree crack: (-30, -30, 10) MPa."""
@@ -226,8 +226,7 @@ def study_box(hs, element, half):
 
 
 def study_exact(aohs):
-    from xfemslip import verify as V
-
+    from xfemslip.verify import problems as V
     prob = next(p for p in V.PROBLEMS if p.name == "inclined-30")
     print("| radius | " + " | ".join(f"a/{n}" for n in aohs) + " |")
     print("| --- | " + " | ".join("---" for _ in aohs) + " |")

@@ -1,9 +1,9 @@
-"""The numerical stress matrix of issue 4: every case, both tangents.
+"""The numerical stress matrix: every case, both tangents.
 
 Writes a table (case, converged, Newton iterations, stick/slip switches,
 load-step cuts / ping-pong freezes, max |slip|, result vs reference) into its
 own section of benchmarks/RESULTS.md (between the stability markers) and
-prints it.  The case builders and references are tests/stability/matrix.py.
+prints it.  The case builders and references are tests/support/matrix.py.
 
 Usage (from the project root):  python benchmarks/stability.py [--quick]
 --quick skips the 1-degree angle sweep and the 1000-step runs.
@@ -21,9 +21,9 @@ from pathlib import Path
 import numpy as np
 
 ROOT = Path(__file__).resolve().parents[1]
-sys.path.insert(0, str(ROOT / "tests" / "stability"))
+sys.path.insert(0, str(ROOT))  # tests.support
 
-from matrix import (  # noqa: E402
+from tests.support.matrix import (  # noqa: E402
     H32_N,
     RESERVOIR,
     SHEAR_STRESS,
@@ -316,7 +316,7 @@ def main() -> int:
         else:
             doc = (
                 doc.rstrip("\n")
-                + "\n\n## Numerical stability matrix (issue 4)\n\n"
+                + "\n\n## Numerical stability matrix\n\n"
                 + text
                 + "\n"
             )

@@ -75,7 +75,7 @@ def main() -> None:
             for _ in range(opts.runs):  # interleaved: load changes hit all modes
                 for name, extra in modes.items():
                     times[name].append(_time([str(sweep), *extra], tmp / "out"))
-        from xfemslip.sweep import load_sweep
+        from xfemslip.studies.sweep import load_sweep
 
         n_cases = len(load_sweep(sweep).cases)
     load = ", ".join(f"{v:.1f}" for v in os.getloadavg())

@@ -2,6 +2,9 @@
 
 from __future__ import annotations
 
+import contextlib
+import logging
+
 import pytest
 
 
@@ -23,3 +26,32 @@ def pytest_collection_modifyitems(
     for item in items:
         if "slow" in item.keywords:
             item.add_marker(skip_slow)
+
+
+@contextlib.contextmanager
+def _package_logging_kept():
+    """Put back the level and the handlers of the ``xfemslip`` logger: a
+    command run in-process (CliRunner) sets the level and adds its stderr
+    handler, which later tests would otherwise see."""
+    logger = logging.getLogger("xfemslip")
+    level, handlers = logger.level, list(logger.handlers)
+    try:
+        yield
+    finally:
+        logger.setLevel(level)
+        for handler in list(logger.handlers):
+            if handler not in handlers:
+                logger.removeHandler(handler)
+
+
+@pytest.fixture(autouse=True, scope="module")
+def _package_logging_per_module():
+    """(module-scoped fixtures run commands too)"""
+    with _package_logging_kept():
+        yield
+
+
+@pytest.fixture(autouse=True)
+def _package_logging_per_test():
+    with _package_logging_kept():
+        yield

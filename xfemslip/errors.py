@@ -1,7 +1,7 @@
 """Exceptions of xfemslip.
 
-Library code raises these; only ``cli.py`` turns them into messages and exit
-codes (``CaseError`` and ``UsageError`` -> exit 2, the others -> exit 1).
+Library code raises these; only :mod:`xfemslip.cli` turns them into messages
+and exit codes (``CaseError`` and ``UsageError`` -> exit 2, the others -> exit 1).
 """
 
 from __future__ import annotations
@@ -52,19 +52,36 @@ class GeometryError(XfemslipError):
 class ConvergenceError(XfemslipError):
     """Newton did not converge in a load step.
 
-    Attributes: ``step`` (1-based), ``iteration``, ``residual`` (eta),
+    Fields: ``step`` (1-based), ``iteration``, ``residual`` (eta),
     ``increment`` (relative increment norm), ``flips`` (stick/slip switches in
-    the last iteration).
+    the last iteration), ``reason`` (why, without the step and residual
+    figures of the message), ``retryable`` (False when a smaller load step
+    cannot help, so the step is not bisected) and ``result`` (the
+    :class:`~xfemslip.post.result.Result` of the steps that converged before,
+    set by ``run_case``; None elsewhere).
     """
 
     def __init__(
-        self, message, *, step, iteration, residual, increment=float("nan"), flips=0
+        self,
+        message,
+        *,
+        step,
+        iteration,
+        residual,
+        increment=float("nan"),
+        flips=0,
+        reason="",
+        retryable=True,
+        result=None,
     ):
         self.step = step
         self.iteration = iteration
         self.residual = residual
         self.increment = increment
         self.flips = flips
+        self.reason = reason
+        self.retryable = retryable
+        self.result = result
         super().__init__(message)
 
 

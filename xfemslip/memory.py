@@ -144,7 +144,7 @@ def estimate_terms(fp: Footprint) -> dict[str, float]:
     assembly = fp.enriched_cells * (8 + 2 * fp.slots) ** 2 * 8.0
     assembly += max(gradients, triplets)  # one after the other
     if fp.amg:
-        from xfemslip.linsolve import AMG_RESTART
+        from xfemslip.solve.linear import AMG_RESTART
 
         solver = fp.nnz * (MATRIX_BYTES + AMG_BYTES)
         solver += (AMG_RESTART + 1) * 8.0 * fp.n_dofs
@@ -230,7 +230,7 @@ def enriched_footprint(spec, mesh, fractures, cand) -> Footprint:
     their slots exactly (the cells around each enriched node, as
     enrichment.build_enriched_cells takes them), the quadrature points from
     the fracture pieces per cell (QP_CELL ...)."""
-    from xfemslip.enrichment import HEAVISIDE
+    from xfemslip.fem.enrichment import HEAVISIDE
     from xfemslip.kernels import choose
 
     nx = mesh.nx
@@ -372,7 +372,7 @@ def _amg(spec, x, y, n_dofs, band) -> bool:
     with grid lines x, y and about n_dofs free dofs; band: the share of them
     in the AMG band, or the Problem to take it from (only computed where
     the other conditions hold)."""
-    from xfemslip import linsolve
+    from xfemslip.solve import linear as linsolve
 
     method = spec.solver.linear_solver
     if method != "auto" or n_dofs < linsolve.AUTO_AMG_MIN_DOFS:
@@ -393,7 +393,7 @@ def _band_share(mesh, cand, n_dofs) -> float:
     stiffness exists: the enriched dofs and the standard ones of the nodes
     within AMG_BAND_LAYERS node rings of an enriched node (an enriched dof
     couples to the nodes of its support, each layer adds a ring)."""
-    from xfemslip.linsolve import AMG_BAND_LAYERS
+    from xfemslip.solve.linear import AMG_BAND_LAYERS
 
     grid = np.zeros((mesh.ny + 1, mesh.nx + 1), bool)
     grid.flat[np.unique(cand.node)] = True
@@ -411,7 +411,7 @@ def available_bytes() -> tuple[float, str]:
     """The memory limit [B] and where it comes from."""
     text = os.environ.get(ENV_LIMIT, "").strip()
     if text:
-        value = _parse_bytes(text)
+        value = parse_bytes(text)
         if value is None:
             raise UsageError(
                 f"environment variable {ENV_LIMIT} = {text!r}: expected a number of "
@@ -427,7 +427,7 @@ def available_bytes() -> tuple[float, str]:
         return math.inf, "unknown"
 
 
-def _parse_bytes(text: str) -> float | None:
+def parse_bytes(text: str) -> float | None:
     number, suffix = text, ""
     if text[-1:].lower() in "kmgt" and text[-1:].isalpha():
         number, suffix = text[:-1], text[-1].lower()

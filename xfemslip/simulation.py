@@ -3,7 +3,7 @@
 Testable without the CLI.  Output files follow ``output-format.md``; when a
 load step fails, the steps already converged are written (``converged =
 False``) before the ConvergenceError is passed on.  The files of a run are one
-set, swapped into the output folder whole (:mod:`xfemslip.writers.folder`).
+set, swapped into the output folder whole (:mod:`xfemslip.io.folder`).
 """
 
 from __future__ import annotations
@@ -17,34 +17,33 @@ from pathlib import Path
 import numpy as np
 
 from xfemslip import __version__, interrupt, kernels
-from xfemslip.assembly import BulkSystem, assemble_bulk
-from xfemslip.boundary import dirichlet, hold_enriched, traction_load
-from xfemslip.contact import OPEN, SLIP, STICK, ContactSet, build_contact
-from xfemslip.enrichment import EnrichedCells, build_enriched_cells, find_candidates
+from xfemslip.contact.interface import ContactSet, build_contact
+from xfemslip.contact.predictor import stress_increment
+from xfemslip.conventions import OPEN, SLIP, STATE_CODES, STICK
 from xfemslip.errors import ConvergenceError, GeometryError
-from xfemslip.geometry import build_fractures
-from xfemslip.material import elasticity_matrix
-from xfemslip.memory import check_memory, enriched_footprint, model_footprint
-from xfemslip.mesh import Mesh, build_mesh
-from xfemslip.poro import (
+from xfemslip.fem.assembly import BulkSystem, assemble_bulk
+from xfemslip.fem.boundary import dirichlet, hold_enriched, traction_load
+from xfemslip.fem.enrichment import EnrichedCells, build_enriched_cells, find_candidates
+from xfemslip.fem.material import elasticity_matrix
+from xfemslip.fem.mesh import Mesh, build_mesh
+from xfemslip.fem.poro import (
     Materials,
     PorePressure,
     body_load,
     build_materials,
     build_pore_pressure,
-    fluid_pressure,
     fracture_load,
     make_contact_effective,
 )
-from xfemslip.post import STATE_CODES, bulk_fields, fracture_fields, vis_mesh
-from xfemslip.predictor import stress_increment
-from xfemslip.quadrature import InterfacePoints, interface_points
-from xfemslip.solver import NewtonSolver, Problem, StepResult
-from xfemslip.writers import StepFields
+from xfemslip.fem.quadrature import InterfacePoints, interface_points
+from xfemslip.geometry.fracture import build_fractures
+from xfemslip.io.results import run_folder, write_results
+from xfemslip.memory import check_memory, enriched_footprint, model_footprint
+from xfemslip.post.fields import first_non_finite, step_fields, vis_mesh
+from xfemslip.post.result import Result, run_id
+from xfemslip.solve.newton import NewtonSolver, Problem
 
 logger = logging.getLogger(__name__)
-
-OUTPUT_FILES = ("result.h5", "result.vtu", "fractures.vtu", "result.pvd")
 
 
 @dataclass
@@ -62,17 +61,6 @@ class Model:
     problem: Problem
     materials: Materials | None = None  # per-cell constants ([reservoir])
     pore: PorePressure | None = None  # [pore_pressure]
-
-
-@dataclass
-class RunSummary:
-    out_dir: Path
-    converged: bool
-    load_steps: int
-    newton_iterations: int
-    iterations_per_step: list
-    wall_time_s: float
-    n_dofs: int
 
 
 @contextlib.contextmanager
@@ -146,7 +134,7 @@ def build_model(spec) -> Model:
     F = traction_load(
         mesh, spec.boundary, spec.loading, ec, cand, bulk.dofmap, fractures
     )
-    if pore is not None:  # Biot body load and fracture fluid load (xfemslip.poro)
+    if pore is not None:  # Biot body load and fracture fluid load (xfemslip.fem.poro)
         make_contact_effective(contact, pore)
         F = F + body_load(mesh, bulk, pore, ec) + fracture_load(contact, ip, pore)
     problem = Problem(
@@ -257,98 +245,69 @@ def floating_parts(mesh, fractures, contact, bc):
     return out
 
 
-def step_fields(model: Model, r: StepResult) -> StepFields:
-    spec = model.spec
-    mats, pore = model.materials, model.pore
-    hetero = spec.reservoir is not None
-    biot_p = None
-    if pore is not None:
-        p = pore.cell_pressure(r.load_factor)
-        biot_p = (pore.biot * pore.initial, pore.biot * p)
-    stress, szz, principal = bulk_fields(
-        model.mesh,
-        model.bulk,
-        mats.D if hetero else model.D,
-        r.u,
-        spec.loading.initial_stress,
-        mats.nu if hetero else spec.material.nu,
-        spec.material.model,
-        cell_material=mats.cell if hetero else None,
-        biot_p=biot_p,
-    )
-    extra = {}
-    fluid = None
-    if pore is not None:
-        extra = {
-            "effective_stress": stress + biot_p[1][:, None] * [1.0, 1.0, 0.0],
-            "pore_pressure": p,
-        }
-        fluid = fluid_pressure(model.ip, pore, r.load_factor)
-    n_std = 2 * model.mesh.n_nodes
-    return StepFields(
-        step=r.step,
-        load_factor=r.load_factor,
-        newton_iterations=r.iterations,
-        displacement=r.u[:n_std].reshape(-1, 2).copy(),
-        stress=stress,
-        stress_zz=szz,
-        principal_stress=principal,
-        fractures=fracture_fields(model.ip, r.contact, len(model.fractures), fluid),
-        **extra,
-    )
+def run_case(spec, out_dir: Path | str | None = None, *, overwrite: bool = False):
+    """Solve a case; returns its :class:`~xfemslip.post.result.Result`.
 
+    Parameters
+    ----------
+    spec : CaseSpec
+        A validated case (:func:`xfemslip.load_case`).
+    out_dir : folder, optional
+        Where to write the output set (``result.h5``, and the VTU/PVD files
+        the case's ``output.formats`` call for), swapped in whole; None writes
+        nothing (the command line passes ``-o`` or ``output.directory``).
+    overwrite : bool
+        Replace the results of an earlier run in ``out_dir``.
 
-def run_case(
-    spec, out_dir: Path | None = None, *, overwrite: bool = False
-) -> RunSummary:
-    """Solve a case and write its output; returns a summary.
+    Returns
+    -------
+    Result : the mesh, the fields of every load step and the run's attributes
+    (those of ``result.h5``); ``out_dir`` is the folder written, or None.
 
-    Raises ConvergenceError (after writing the converged steps) when a load
-    step fails, UsageError when the output exists and overwrite is False.
+    Raises
+    ------
+    ConvergenceError when a load step fails, after writing the converged
+    steps (``converged = false``); its ``result`` holds them.  UsageError when
+    ``out_dir`` holds results and ``overwrite`` is False.
     """
-    start = time.perf_counter()
     done = solve_and_write(
         spec, out_dir, overwrite, lambda solver, _: solver.run(spec.loading.steps)
     )
     if done.failure is not None:
+        done.failure.result = done.result  # the steps that converged
         raise done.failure
-    iters = [r.iterations for r in done.results]
-    logger.info("Newton iterations per load step: %s", iters)
-    return RunSummary(
-        out_dir=done.out_dir,
-        converged=True,
-        load_steps=spec.loading.steps,
-        newton_iterations=int(sum(iters)),
-        iterations_per_step=iters,
-        wall_time_s=time.perf_counter() - start,
-        n_dofs=done.model.problem.n_dofs,
-    )
+    logger.info("Newton iterations per load step: %s", done.result.iterations_per_step)
+    return done.result
 
 
 @dataclass
 class Written:
     """What solve_and_write built, solved and wrote."""
 
-    out_dir: Path
+    out_dir: Path | None  # the output folder (None: nothing written)
     model: Model
     results: list  # the converged StepResults (solver.completed)
     value: object  # what ``drive`` returned (None after a failure)
     failure: ConvergenceError | None
+    result: Result  # the fields of the results (those written)
 
 
 def solve_and_write(spec, out_dir, overwrite, drive, finish=None) -> Written:
     """The frame of every command that solves a case: take the output folder
-    (:func:`xfemslip.writers.folder.output_folder`: locked, refused when it
-    holds results and not ``overwrite``), build the model and its Newton
-    solver, run ``drive(solver, model)``, and write the converged steps (also
-    after a ConvergenceError, which is returned, not raised, with converged =
-    False in result.h5).  ``finish(written, folder)`` may add files of its own
-    to the set in ``folder``; the set replaces the folder's content whole."""
-    from xfemslip.writers.folder import output_folder
-
+    (:func:`xfemslip.io.results.run_folder`: locked, refused when it holds
+    results and not ``overwrite``; ``out_dir`` None: no folder, nothing
+    written), build the model and its Newton solver, run ``drive(solver,
+    model)``, and write the converged steps (also after a ConvergenceError,
+    which is returned, not raised, with converged = False in result.h5).
+    ``finish(written, folder)`` may add files of its own to the set in
+    ``folder``; the set replaces the folder's content whole."""
     start = time.perf_counter()
-    out_dir = Path(out_dir) if out_dir is not None else Path(spec.output.directory)
-    with output_folder(out_dir, overwrite=overwrite, results=OUTPUT_FILES) as stage:
+    folder = (
+        run_folder(out_dir, overwrite)
+        if out_dir is not None
+        else contextlib.nullcontext()
+    )
+    with folder as stage:
         model = build_model(spec)
         solver = newton_solver(model)
         value = failure = None
@@ -359,37 +318,48 @@ def solve_and_write(spec, out_dir, overwrite, drive, finish=None) -> Written:
         interrupt.checkpoint()  # a signal swallowed while solving ends it here
         results = solver.completed
         with interrupt.deferred():
-            failure = (
-                write_output(
-                    model,
-                    results,
-                    stage.path,
-                    converged=failure is None,
-                    wall=time.perf_counter() - start,
-                    iterations=[r.iterations for r in results],
-                )
-                or failure
+            result, bad = collect_result(
+                model,
+                results,
+                converged=failure is None,
+                wall=time.perf_counter() - start,
             )
-            done = Written(out_dir, model, results, value, failure)
+            failure = bad or failure
+            if stage is None:
+                return Written(None, model, results, value, failure, result)
+            write_results(
+                stage.path,
+                result,
+                formats=spec.output.formats,
+                vis_mesh=lambda i: vis_mesh(
+                    model.mesh, model.ec, model.bulk, results[i].u
+                ),
+                fracture_ids=[fr.index for fr in model.fractures],
+            )
+            result.out_dir = Path(out_dir)
+            done = Written(result.out_dir, model, results, value, failure, result)
             if finish is not None:
                 finish(done, stage.path)
     return done
 
 
-def write_output(model: Model, results, out_dir: Path, *, converged, wall, iterations):
-    """Write result.h5 (+ VTU/PVD) of the converged steps into ``out_dir``
-    (the staging folder of the set).  Returns a ConvergenceError when a step
-    holds NaN or inf: the finite steps before it are written, converged =
-    False."""
-    from xfemslip.writers import hdf5, run_id
-
+def collect_result(model: Model, results, *, converged, wall):
+    """The Result of the converged steps ``results`` and, when a step holds
+    NaN or inf, the ConvergenceError that says so (the finite steps before it
+    are kept, converged = False), else None."""
     spec = model.spec
     fields = [step_fields(model, r) for r in results]
-    bad = _first_non_finite(fields)
+    iterations = [r.iterations for r in results]
+    cuts = [r.cuts for r in results]
+    bad = first_non_finite(fields)
     if bad is not None:  # never write NaN/inf: keep the finite steps only
-        index, name = bad
-        fields, results = fields[:index], results[:index]
-        iterations, converged = list(iterations[:index]), False
+        index = bad[0]
+        fields, iterations, cuts, converged = (
+            fields[:index],
+            iterations[:index],
+            cuts[:index],
+            False,
+        )
     attrs = {
         "format_version": 1,
         "xfemslip_version": __version__,
@@ -398,8 +368,8 @@ def write_output(model: Model, results, out_dir: Path, *, converged, wall, itera
         "load_steps": int(spec.loading.steps),
         "newton_iterations": int(sum(iterations)),
         "newton_iterations_per_step": np.array(iterations, dtype=np.int64),
-        # load-step bisections per written step (issue 4; 0 = not cut)
-        "load_step_cuts_per_step": np.array([r.cuts for r in results], dtype=np.int64),
+        # load-step bisections per written step (0 = not cut)
+        "load_step_cuts_per_step": np.array(cuts, dtype=np.int64),
         "wall_time_s": float(wall),
         "tangent": spec.solver.tangent,
         "contact_patch_cells": float(spec.solver.contact_patch),
@@ -408,22 +378,11 @@ def write_output(model: Model, results, out_dir: Path, *, converged, wall, itera
         "status_codes": STATE_CODES,
     }
     attrs["run_id"] = run_id(attrs, model.mesh.nodes, model.mesh.cells, fields)
-    hdf5.write_result(
-        out_dir / "result.h5",
-        points=model.mesh.nodes,
-        cells=model.mesh.cells,
-        steps=fields,
-        attrs=attrs,
-        load_steps=spec.loading.steps,
-    )
-    if "vtu" in spec.output.formats and fields:
-        _write_vtu(
-            model, results, fields, out_dir, spec.loading.steps > 1, attrs["run_id"]
-        )
+    result = Result(attrs, model.mesh.nodes, model.mesh.cells, fields)
     if bad is None:
-        return None
+        return result, None
     step = bad[0] + 1
-    return ConvergenceError(
+    error = ConvergenceError(
         f"load step {step} gave a non-finite {bad[1]} (NaN or inf), which is "
         f"not written; {len(fields)} finite step(s) kept. Lower the penalty "
         "stiffnesses kn/kt or use more load steps",
@@ -431,54 +390,4 @@ def write_output(model: Model, results, out_dir: Path, *, converged, wall, itera
         iteration=0,
         residual=float("nan"),
     )
-
-
-def _first_non_finite(fields):
-    """(index, field name) of the first step holding NaN or inf, or None."""
-    for index, f in enumerate(fields):
-        arrays = {
-            "displacement": f.displacement,
-            "stress": f.stress,
-            "stress_zz": f.stress_zz,
-            "principal_stress": f.principal_stress,
-        }
-        for i, fr in enumerate(f.fractures):
-            for name in ("slip", "opening", "normal_traction", "shear_traction"):
-                arrays[f"fractures[{i}].{name}"] = getattr(fr, name)
-        for name, value in arrays.items():
-            if not np.all(np.isfinite(value)):
-                return index, name
-    return None
-
-
-def _write_vtu(model, results, fields, out_dir, series, set_id) -> None:
-    """Write the VTU (and PVD) files of the converged steps into ``out_dir``,
-    each stamped with the set's ``run_id``."""
-    from xfemslip.writers import vtu
-
-    entries = []
-    for r, f in zip(results, fields, strict=True):
-        interrupt.checkpoint()  # between files: a deferred signal stops here
-        vis = vis_mesh(model.mesh, model.ec, model.bulk, r.u)
-        cell_data = {
-            "stress": f.stress,
-            "stress_zz": f.stress_zz,
-            "principal_stress": f.principal_stress,
-        }
-        if f.effective_stress is not None:
-            cell_data["effective_stress"] = f.effective_stress
-            cell_data["pore_pressure"] = f.pore_pressure
-        fr = [(model.fractures[i].index, ff) for i, ff in enumerate(f.fractures)]
-        names = []
-        if series:
-            (out_dir / "steps").mkdir(exist_ok=True)
-            names.append(f"steps/%s_{r.step:04d}.vtu")
-            entries.append((r.load_factor, f"steps/result_{r.step:04d}.vtu"))
-        if r is results[-1]:
-            names.append("%s.vtu")
-        for name in names:
-            vtu.write_bulk(out_dir / (name % "result"), vis, cell_data, run_id=set_id)
-            if fr:
-                vtu.write_fractures(out_dir / (name % "fractures"), fr, run_id=set_id)
-    if series:
-        vtu.write_pvd(out_dir / "result.pvd", entries, run_id=set_id)
+    return result, error

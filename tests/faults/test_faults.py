@@ -23,7 +23,7 @@ from click.testing import CliRunner
 import xfemslip.simulation as simulation
 from xfemslip.cli import cli
 from xfemslip.errors import OutputError
-from xfemslip.writers import hdf5
+from xfemslip.io import hdf5
 
 ROOT = Path(__file__).resolve().parents[2]
 RESERVOIR = ROOT / "cases" / "reservoir_depletion.toml"

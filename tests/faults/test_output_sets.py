@@ -2,7 +2,7 @@
 
 Real processes are killed (SIGKILL, SIGTERM, SIGINT) while they write, at
 points chosen by the writer's test hook (``XFEMSLIP_TEST_PAUSE``, see
-``xfemslip.writers.folder``: the process stops exactly between two renames
+``xfemslip.io.folder``: the process stops exactly between two renames
 until the signal arrives) and at a sweep of delays over the write phase; two
 runs race into one folder; disks fill; folders are read-only.  After each
 fault the folder is compared, file by file, with the complete earlier and the
@@ -25,9 +25,9 @@ from click.testing import CliRunner
 
 from tests.faults import harness
 from xfemslip.cli import cli
-from xfemslip.writers import folder as folder_module
-from xfemslip.writers.fileset import replace_files
-from xfemslip.writers.lock import folder_lock
+from xfemslip.io import folder as folder_module
+from xfemslip.io.fileset import replace_files
+from xfemslip.io.lock import folder_lock
 
 
 @pytest.fixture(scope="module")
@@ -436,8 +436,8 @@ def test_sweep_reruns_a_member_whose_set_is_not_whole(tmp_path):
     """The done-test needs the whole set: a member with a converged result.h5
     but no result.vtu (a disk that filled before this rule) runs again; a
     whole member is skipped."""
-    from xfemslip.sweep import load_sweep
-    from xfemslip.sweep_run import is_done, run_sweep
+    from xfemslip.studies.run import is_done, run_sweep
+    from xfemslip.studies.sweep import load_sweep
 
     base = harness.write_case(tmp_path, "base.toml", 8, 2)
     sweep_file = tmp_path / "sweep.toml"
@@ -486,7 +486,7 @@ def test_deplete_interrupted_while_writing_tables_keeps_the_earlier_set(
 ):
     """deplete's CSVs are part of its set: Ctrl-C while they are written
     leaves the earlier folder as it was (exit 130)."""
-    import xfemslip.depletion as depletion
+    import xfemslip.studies.depletion as depletion
 
     root = harness.ROOT / "cases" / "depleting_reservoir.toml"
     text = root.read_text()

@@ -3,7 +3,7 @@ run from the shipped sweep files ``cases/sweeps/*.toml`` (base case
 ``cases/reservoir_depletion.toml``: sigma_1 = 40 MPa vertical, sigma_3 = 20 MPa,
 a 0.6 m fracture, E = 5 GPa, f = 0.1).
 
-The closed-form references (``xfemslip.closed_form``) are the Mohr-Coulomb
+The closed-form references (``xfemslip.reference.closed_form``) are the Mohr-Coulomb
 slip window and the excess shear Delta tau = |tau| - f |sigma_n| that drives
 the slip of a crack in an infinite plane (slip proportional to Delta tau / E').
 The model is a 1 m box, not an infinite plane, so magnitudes are compared as
@@ -17,15 +17,15 @@ from pathlib import Path
 
 import pytest
 
-from xfemslip.closed_form import (
+from xfemslip.reference.closed_form import (
     angle_to_sigma1,
     crack_tractions,
     driving_shear,
     principal,
     slip_window,
 )
-from xfemslip.sweep import load_sweep
-from xfemslip.sweep_run import run_sweep
+from xfemslip.studies.run import run_sweep
+from xfemslip.studies.sweep import load_sweep
 
 ROOT = Path(__file__).resolve().parents[2]
 STRESS = (-20.0e6, -40.0e6, 0.0)  # the base case's loading.stress [Pa]

@@ -18,11 +18,12 @@ from hypothesis import assume, given, settings
 from hypothesis import strategies as st
 
 from xfemslip.case import loads_case
-from xfemslip.kernels.contact import OPEN, SLIP, STICK, coulomb_return_map
+from xfemslip.conventions import OPEN, SLIP, STICK
+from xfemslip.fem.quadrature import cell_subtriangles, polygon_area, split_polygon
+from xfemslip.kernels.contact import coulomb_return_map
 from xfemslip.kernels.shape import q4_shape
-from xfemslip.quadrature import cell_subtriangles, polygon_area, split_polygon
 from xfemslip.simulation import build_model
-from xfemslip.solver import NewtonSolver
+from xfemslip.solve.newton import NewtonSolver
 
 TOL = 1e-10
 unit = st.floats(0.0, 1.0, allow_nan=False)
@@ -232,7 +233,7 @@ grid = st.integers(0, 1024).map(lambda k: k / 1024.0)  # exact binary fractions
 # the Duffy rule is not exact for B1..B4 and the rotated cells are fanned from
 # other corners, so the answers differ by the quadrature error (~0.5 % of sigma on
 # 1 m cells).  The radius stays below the shortest fracture (2 m): see the
-# default-radius xfail in tests/unit/test_enrichment.py.
+# default-radius xfail in tests/unit/fem/test_enrichment.py.
 TIPS = {"ramp": ('"ramp"', 1e-6), "branch": ('{ kind = "branch", radius = 1.5 }', 2e-2)}
 
 

@@ -1,7 +1,7 @@
 """Key scalars of a run, shared by ``test_cases.py`` and ``regen.py``.
 
-Everything is read from the documented ``result.h5`` (output-format.md) plus
-the ``RunSummary`` of ``run_case``; nothing from xfemslip's internals.
+Everything is read from the documented ``result.h5`` (output-format.md,
+through ``xfemslip.read_result``); nothing from xfemslip's internals.
 """
 
 from __future__ import annotations
@@ -9,17 +9,16 @@ from __future__ import annotations
 import json
 from pathlib import Path
 
-import h5py
 import numpy as np
 
+from xfemslip import read_result
 from xfemslip.case import load_case
+from xfemslip.conventions import SLIP
 from xfemslip.simulation import run_case
 
 ROOT = Path(__file__).resolve().parents[2]
 CASES_DIR = ROOT / "cases"
 GOLDEN_DIR = Path(__file__).resolve().parent / "golden"
-
-SLIP_CODE = 2  # output-format.md: 0 open, 1 stick, 2 slip
 
 
 def case_files() -> list[Path]:
@@ -31,22 +30,17 @@ def golden_path(case: Path) -> Path:
 
 
 def run(case: Path, out_dir: Path):
-    """``xfemslip run CASE -o OUT_DIR`` in-process; returns the RunSummary."""
+    """``xfemslip run CASE -o OUT_DIR`` in-process; returns its Result."""
     return run_case(load_case(case), out_dir)
 
 
-def key_scalars(out_dir: Path, summary) -> dict:
-    """The pinned scalars of one run (floats, ints and a list of ints)."""
-    with h5py.File(out_dir / "result.h5", "r") as f:
-        points = f["mesh/points"][()]
-        u = f["fields/displacement"][()]
-        stress = f["fields/stress"][()]
-        slips, states = [], []
-        i = 0
-        while f"fractures/{i}" in f:
-            slips.append(f[f"fractures/{i}/slip"][()])
-            states.append(f[f"fractures/{i}/state"][()])
-            i += 1
+def key_scalars(out_dir: Path) -> dict:
+    """The pinned scalars of the run written to ``out_dir`` (floats, ints and
+    a list of ints)."""
+    result = read_result(out_dir / "result.h5")
+    points, u, stress = result.points, result.displacement, result.stress
+    slips = [f.slip for f in result.fractures]
+    states = [f.state for f in result.fractures]
     slip = np.concatenate(slips) if slips else np.zeros(0)
     state = np.concatenate(states) if states else np.zeros(0, np.int8)
     x_mid = 0.5 * (points[:, 0].min() + points[:, 0].max())
@@ -56,8 +50,8 @@ def key_scalars(out_dir: Path, summary) -> dict:
         "max_abs_slip": float(np.max(np.abs(slip))) if slip.size else 0.0,
         "min_slip": float(np.min(slip)) if slip.size else 0.0,
         "n_contact_points": int(slip.size),
-        "n_slip_points": int(np.sum(state == SLIP_CODE)),
-        "iterations_per_step": [int(k) for k in summary.iterations_per_step],
+        "n_slip_points": int(np.sum(state == SLIP)),
+        "iterations_per_step": result.iterations_per_step,
         # the reaction is not in the output; the mean vertical stress stands in
         "mean_stress_yy": float(np.mean(stress[:, 1])),
         "top_centre_point": [float(v) for v in points[top_centre]],

@@ -26,7 +26,8 @@ def main(argv: list[str]) -> int:
     with tempfile.TemporaryDirectory() as tmp:
         for case in cases:
             out = Path(tmp) / case.stem
-            scalars = key_scalars(out, run(case, out))
+            run(case, out)
+            scalars = key_scalars(out)
             print(f"{write_golden(case, scalars)}: {scalars}")
     return 0
 

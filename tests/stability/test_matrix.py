@@ -1,4 +1,4 @@
-"""The numerical stress matrix of issue 4, fast subset (the whole matrix is
+"""The numerical stress matrix, fast subset (the whole matrix is
 ``benchmarks/stability.py``; its table is in ``benchmarks/RESULTS.md``).
 
 Every case converges and matches its independent reference, or fails with a
@@ -13,7 +13,8 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from matrix import (
+
+from tests.support.matrix import (
     OPEN,
     RESERVOIR,
     SHEAR_STRESS,
@@ -29,10 +30,9 @@ from matrix import (
     solve,
     window_reference,
 )
-
-from xfemslip import closed_form as cf
 from xfemslip.case import loads_case
 from xfemslip.errors import GeometryError
+from xfemslip.reference import closed_form as cf
 from xfemslip.simulation import build_model
 
 pytestmark = pytest.mark.verification
@@ -205,7 +205,7 @@ kt = 5.0e12
 
 
 def test_overlapping_fractures_are_refused():
-    # crossing fractures are a network since issue 6; one on top of the other
+    # crossing fractures make a network; one on top of the other
     # (collinear overlap) is still refused
     pts = [[0.4, 0.4], [0.9, 0.9]]
     text = reservoir_text(n=20) + _extra_fracture(pts)

@@ -1,4 +1,4 @@
-"""Newton control of issue 4: load-step bisection and the ping-pong remedy.
+"""Newton control: load-step bisection and the ping-pong remedy.
 
 - Bisection: a load step that fails is retried from the last committed state
   in halves.  The friction history must be exactly that of a run that takes
@@ -20,7 +20,9 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from matrix import (
+
+import xfemslip.solve.newton as solver_module
+from tests.support.matrix import (
     RESERVOIR,
     SLIP,
     STICK,
@@ -29,10 +31,9 @@ from matrix import (
     reservoir_text,
     solve,
 )
-
-import xfemslip.solver as solver_module
+from xfemslip.contact.branches import force_branches
 from xfemslip.errors import ConvergenceError
-from xfemslip.solver import _cycling, _frozen_law
+from xfemslip.solve.newton import _cycling
 
 pytestmark = pytest.mark.verification
 
@@ -58,11 +59,11 @@ def test_bisection_keeps_the_friction_history_exact(monkeypatch):
 
     The failures are forced: every Newton attempt runs in full (so it mutates
     whatever it mutates) and is then declared failed when it spans more than
-    MAX_INCREMENT of the load.  (Until session 3 this test relied on the
-    secant tangent stalling on this stiff-penalty case, kn h / E = 1e8; the
-    stall turned out to be the round-off floor of eta, 1.3e-8 to 1.9e-8
-    against the tolerance 1e-8, which moved with every change of summation
-    order: with eta = 5e-8 the full step converges uncut.)"""
+    MAX_INCREMENT of the load.  A natural failure will not do: the secant
+    tangent's stall on this stiff-penalty case (kn h / E = 1e8) is the
+    round-off floor of eta, 1.3e-8 to 1.9e-8 against the tolerance 1e-8,
+    which moves with every change of summation order (with eta = 5e-8 the
+    full step converges uncut)."""
     text = stiff_cohesive_case()
     real = solver_module.NewtonSolver._newton
 
@@ -138,7 +139,7 @@ def test_frozen_points_stick_but_may_open():
     assert np.mean(res.state == SLIP) > 0.8  # premise
     frozen = np.zeros(c.n, bool)
     frozen[::2] = True
-    law = _frozen_law(c, frozen)
+    law = force_branches(c, stick_at=frozen)
     # committed history is now the step's; from the previous one (zeros) the
     # same u evaluates stick at the frozen points, slip elsewhere
     zero = np.zeros(c.n)

@@ -10,14 +10,14 @@ from dataclasses import replace
 from pathlib import Path
 
 import pytest
-from casegen import sweep_member
 from click.testing import CliRunner
-from hardcases import estimates, measure
 
+from tests.support.casegen import sweep_member
+from tests.support.hardcases import estimates, measure
 from xfemslip.case import load_case, loads_case
 from xfemslip.cli import cli
-from xfemslip.enrichment import find_candidates
 from xfemslip.errors import MeshError, UsageError
+from xfemslip.fem.enrichment import find_candidates
 from xfemslip.memory import (
     ENV_LIMIT,
     LU_BYTES,

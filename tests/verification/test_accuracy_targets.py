@@ -1,6 +1,6 @@
-"""The accuracy targets of issue 3 on the frictional inclined crack.
+"""The accuracy targets on the frictional inclined crack.
 
-The problem (xfemslip.verify): a straight crack of half-length a = 0.5 m at
+The problem (xfemslip.verify.problems): a straight crack of half-length a = 0.5 m at
 30 deg in a 2 m box whose edges carry the exact displacements of the cracked
 infinite plane (closed_form.displacement), far field xx = -20 MPa,
 yy = -40 MPa, f = 0.1, default tip treatment, kn = kt = 100 E / h.  With the
@@ -19,9 +19,9 @@ import math
 import numpy as np
 import pytest
 
-from xfemslip import closed_form as cf
-from xfemslip import verify as V
-from xfemslip.jintegral import stress_intensity_factors
+from xfemslip.post.jintegral import stress_intensity_factors
+from xfemslip.reference import closed_form as cf
+from xfemslip.verify import problems as V
 
 pytestmark = pytest.mark.verification
 

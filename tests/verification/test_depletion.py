@@ -1,4 +1,4 @@
-"""Depletion verification (issue 6): poroelastic loading against closed forms.
+"""Depletion verification: poroelastic loading against closed forms.
 
 1. Uniaxial strain (``closed_form_depletion.uniaxial_strain_change``): a box
    with rollers on its sides, u_y = 0 at the bottom and a constant overburden
@@ -8,10 +8,10 @@
    and layered (reservoir layer spanning the width, host with other E, nu).
 2. A fluid-filled stuck fracture in a uniformly depleting body (alpha = 1)
    does not perturb it: the Biot body load and the fracture fluid load cancel
-   on the fracture (xfemslip.poro, eqs. 1-2), so the stress stays the closed
+   on the fracture (xfemslip.fem.poro, eqs. 1-2), so the stress stays the closed
    form to round-off and the jump stays the penalty's elastic part.
 3. Critical depletion of a fracture inside a reservoir layer (bisection of
-   ``xfemslip.depletion``) against Coulomb on the rotated effective stress of
+   ``xfemslip.studies.depletion``) against Coulomb on the rotated effective stress of
    the uniaxial path (``critical_change_uniaxial``).  Measured (fracture of
    length L = 30 m at 60 degrees, f = 0.5): relative error 1.28e-3 at h = 5 m
    (L/6 cells), 1.23e-4 at h = 2.5 m; the same 1.28e-3 with kn = kt = 1e14
@@ -28,18 +28,19 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from depletion_cases import offset_fault_case
 
+from tests.support.depletion_cases import offset_fault_case
 from xfemslip.case import loads_case
-from xfemslip.closed_form_depletion import (
+from xfemslip.fem.poro import fluid_pressure
+from xfemslip.post.fields import step_fields
+from xfemslip.reference.closed_form_depletion import (
     critical_change_uniaxial,
     offset_fault_slip,
     rectangles_shear,
     uniaxial_strain_change,
 )
-from xfemslip.depletion import critical_depletion
-from xfemslip.poro import fluid_pressure
-from xfemslip.simulation import build_model, newton_solver, step_fields
+from xfemslip.simulation import build_model, newton_solver
+from xfemslip.studies.depletion import critical_depletion
 
 pytestmark = pytest.mark.verification
 
@@ -278,7 +279,7 @@ def test_offset_fault_stuck_shear_traction():
     Reservoir 100 m thick, throw 30 m, E = 10 GPa, nu = 0.25, dp = -10 MPa,
     rollers at +-3 km (graded mesh, uniform h near the fault).  The fault is
     ON the pressure boundary x = 0, mid-cell (the cut cells are split per
-    quadrature point, xfemslip.poro), so the four reservoir corners, where
+    quadrature point, xfemslip.fem.poro), so the four reservoir corners, where
     (J1) has log singularities, lie on the fault itself.  Measured (rms / max
     relative error over patches > 4 h from the corners): h = 10 m 3.6 % /
     5.2 %; h = 5 m 2.9 % / 2.7 %; h = 2.5 m 1.6 % / 2.9 % (rms order 0.3,

@@ -8,12 +8,13 @@ from __future__ import annotations
 import csv
 from pathlib import Path
 
-import h5py
 import numpy as np
 import pytest
 
-from xfemslip.sweep import loads_sweep
-from xfemslip.sweep_run import run_sweep
+import xfemslip
+from xfemslip.conventions import SLIP
+from xfemslip.studies.run import run_sweep
+from xfemslip.studies.sweep import loads_sweep
 
 ROOT = Path(__file__).resolve().parents[2]
 SWEEP = ROOT / "cases" / "sweeps" / "dfn_realizations.toml"
@@ -51,11 +52,11 @@ def test_realizations_follow_the_far_field_slip_window(tmp_path):
     assert [r.status for r in rows] == ["ok"] * 4
     seen = {"inside": 0, "outside": 0}
     for case, row in zip(sweep.cases, rows, strict=True):
-        with h5py.File(tmp_path / case.case_id / "result.h5") as f:
-            slips = [
-                bool(np.any(f[f"fractures/{i}/state"][()] == 2))
-                for i in range(len(case.spec.fractures))
-            ]
+        fractures = xfemslip.read_result(
+            tmp_path / case.case_id / "result.h5"
+        ).fractures
+        assert len(fractures) == len(case.spec.fractures)
+        slips = [bool(np.any(fracture.state == SLIP)) for fracture in fractures]
         assert row.metrics["slipping_fractures"] == sum(slips)
         for fracture, slipping in zip(case.spec.fractures, slips, strict=True):
             ratio = _tendency(fracture.points)

@@ -32,8 +32,8 @@ import numpy as np
 import pytest
 import tomli_w
 from click.testing import CliRunner
-from harness import STICK
 
+from tests.support.harness import STICK
 from xfemslip.case import load_case
 from xfemslip.cli import cli
 from xfemslip.errors import ConvergenceError

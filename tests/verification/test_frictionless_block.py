@@ -31,7 +31,8 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from harness import OPEN, SLIP, STICK, case_text, run_text
+
+from tests.support.harness import OPEN, SLIP, STICK, case_text, run_text
 
 pytestmark = pytest.mark.verification
 

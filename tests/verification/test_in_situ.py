@@ -16,7 +16,7 @@ it.  References:
 - the equilibrium of the whole system with the bulk initial stress included:
   int B^T sigma0 + K u + f_con(u) = the edge forces of the total stress.
 
-Box: the OpenGeoSys peer crack (a = 1 m at 45 degrees, xfemslip.peer), on a
+Box: the OpenGeoSys peer crack (a = 1 m at 45 degrees, xfemslip.reference.peer), on a
 graded mesh of half-width 40 m with cells of h = 0.1 m around the crack.
 Measured slip errors (relative L2): 1.169 % released in situ, 1.158 % loaded
 from zero through the same rollers, 1.089 % loaded from zero through traction
@@ -29,20 +29,20 @@ from __future__ import annotations
 import math
 from pathlib import Path
 
-import h5py
 import numpy as np
 import pytest
 import tomli_w
 from click.testing import CliRunner
 
-from xfemslip import closed_form as cf
-from xfemslip import peer
-from xfemslip.assembly import enriched_part_bbar
+import xfemslip
 from xfemslip.case import load_case
 from xfemslip.cli import cli
-from xfemslip.contact import OPEN, SLIP, STICK
-from xfemslip.depletion import deplete
+from xfemslip.conventions import OPEN, SLIP, STICK
+from xfemslip.fem.assembly import enriched_part_bbar
+from xfemslip.reference import closed_form as cf
+from xfemslip.reference import peer
 from xfemslip.simulation import build_model, newton_solver, run_case
+from xfemslip.studies.depletion import deplete
 
 pytestmark = pytest.mark.verification
 
@@ -105,18 +105,14 @@ def _write(tmp_path, name, doc):
 
 
 def _steps(out):
-    """[(s, slip, opening, state)] of every step of a result.h5."""
-    with h5py.File(out / "result.h5") as f:
-        keys = sorted(f["steps"]) if "steps" in f else [None]
-        rows = []
-        for k in keys:
-            g = f if k is None else f[f"steps/{k}"]
-            fr = g["fractures/0"]
-            rows.append(
-                tuple(fr[n][()] for n in ("s", "slip", "opening"))
-                + (f["fractures/0/state"][()],)
-            )
-        return rows
+    """[(s, slip, opening, state of the final step)] of every step of a
+    result.h5."""
+    result = xfemslip.read_result(out / "result.h5")
+    final = result.fractures[0].state
+    return [
+        (step.fractures[0].s, step.fractures[0].slip, step.fractures[0].opening, final)
+        for step in result.steps
+    ]
 
 
 def _error(s, slip, stress, angle=45.0):

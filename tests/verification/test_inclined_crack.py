@@ -45,16 +45,16 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from harness import SLIP, STICK, read_result
 
-from xfemslip import closed_form as cf
-from xfemslip import verify as V
+from tests.support.harness import SLIP, STICK, read_result
 from xfemslip.case import load_case
+from xfemslip.reference import closed_form as cf
 from xfemslip.simulation import run_case
+from xfemslip.verify import problems as V
 
 pytestmark = pytest.mark.verification
 
-# the box, crack and stress of xfemslip.verify, whose case writer runs them
+# the box, crack and stress of xfemslip.verify.problems, whose case writer runs them
 HALF = V.HALF_BOX  # half-width of the box [m]
 A = V.HALF_LENGTH  # crack half-length [m]
 CENTER = V.CENTER  # off the mesh lines on purpose [m]
@@ -78,7 +78,7 @@ def run_inclined(
 ):
     """Write the case and the four boundary CSV files into folder, run, read the result.
 
-    The case is ``xfemslip.verify``'s (the same box, crack and exact edges).
+    The case is ``xfemslip.verify.problems``'s (the same box, crack and exact edges).
     Returns (s, slip, state, exact slip at s).
     """
     prob = V.Problem("inclined", psi, friction, cohesion, plane)
@@ -170,7 +170,7 @@ def test_slip_matches_closed_form_more(tmp_path, psi, friction, cohesion, plane)
 
 @pytest.mark.slow
 def test_slip_error_converges(tmp_path):
-    """Observed order of the L2 slip error over n = 32, 64, 128 is >= 1 (issue 3).
+    """Observed order of the L2 slip error over n = 32, 64, 128 is >= 1.
 
     The order is the least-squares slope of log(error) against log(h) over the
     three meshes: measured 1.20, errors 0.99 %, 0.59 %, 0.19 %.  It was 0.84

@@ -19,12 +19,12 @@ from __future__ import annotations
 import tomllib
 from pathlib import Path
 
-import h5py
 import numpy as np
 import pytest
 import tomli_w
-from harness import SLIP, STICK, read_result
 
+import xfemslip
+from tests.support.harness import SLIP, STICK, read_result
 from xfemslip.case import load_case
 from xfemslip.simulation import run_case
 
@@ -74,23 +74,23 @@ def test_one_and_five_steps_agree(tmp_path, case, cohesion):
 def test_intermediate_steps_scale_with_the_load(tmp_path):
     """No cohesion: step k of 5 is the final state times k / 5 (homogeneity)."""
     final, h5 = run_steps(tmp_path, "reservoir_depletion", 5)
-    with h5py.File(h5, "r") as f:
-        for k in range(1, 6):
-            g = f[f"steps/{k:04d}"]
-            lam = k / 5
-            np.testing.assert_allclose(
-                g["fractures/0/slip"][()],
-                lam * final.fr["slip"],
-                rtol=0,
-                atol=1e-9 * np.max(np.abs(final.fr["slip"])),
-            )
-            np.testing.assert_allclose(
-                g["fields/displacement"][()],
-                lam * final.displacement,
-                rtol=0,
-                atol=1e-9 * np.max(np.abs(final.displacement)),
-            )
-            np.testing.assert_array_equal(g["fractures/0/state"][()], final.fr["state"])
+    steps = xfemslip.read_result(h5).steps
+    assert [step.step for step in steps] == [1, 2, 3, 4, 5]
+    for k, step in enumerate(steps, start=1):
+        lam = k / 5
+        np.testing.assert_allclose(
+            step.fractures[0].slip,
+            lam * final.fr["slip"],
+            rtol=0,
+            atol=1e-9 * np.max(np.abs(final.fr["slip"])),
+        )
+        np.testing.assert_allclose(
+            step.displacement,
+            lam * final.displacement,
+            rtol=0,
+            atol=1e-9 * np.max(np.abs(final.displacement)),
+        )
+        np.testing.assert_array_equal(step.fractures[0].state, final.fr["state"])
 
 
 def test_cohesion_delays_slip(tmp_path):
@@ -100,9 +100,10 @@ def test_cohesion_delays_slip(tmp_path):
     reservoir load: steps 1 and 2 (lambda 0.2, 0.4) stick everywhere, the
     last step slides."""
     _, h5 = run_steps(tmp_path, "reservoir_depletion", 5, cohesion=3.0e6)
-    with h5py.File(h5, "r") as f:
-        states = [f[f"steps/{k:04d}/fractures/0/state"][()] for k in range(1, 6)]
-        slips = [f[f"steps/{k:04d}/fractures/0/slip"][()] for k in range(1, 6)]
+    steps = xfemslip.read_result(h5).steps
+    assert len(steps) == 5
+    states = [step.fractures[0].state for step in steps]
+    slips = [step.fractures[0].slip for step in steps]
     assert np.all(states[0] == STICK) and np.all(states[1] == STICK)
     # stuck steps are linear in the load: step 2 = 2 x step 1 (elastic penalty jump)
     np.testing.assert_allclose(slips[1], 2 * slips[0], rtol=1e-9)

@@ -1,4 +1,4 @@
-"""Fracture networks: X crossings and T junctions (issue 6, items 4 and 6).
+"""Fracture networks: X crossings and T junctions.
 
 - Order independence: the same network listed in another order, with some
   fractures' points reversed, gives the same per-fracture fields to round-off
@@ -27,11 +27,11 @@ import math
 import numpy as np
 import pytest
 
-from tests.verification.harness import case_text
+from tests.support.harness import case_text
 from xfemslip.case import loads_case
-from xfemslip.kernels import SLIP, STICK
+from xfemslip.conventions import SLIP, STICK
 from xfemslip.simulation import build_model, newton_solver
-from xfemslip.solver import NewtonSolver
+from xfemslip.solve.newton import NewtonSolver
 
 pytestmark = pytest.mark.verification
 

@@ -41,9 +41,9 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from harness import STICK, box_edges, case_text, run_text, write_edge_csv
 
-from xfemslip import closed_form as cf
+from tests.support.harness import STICK, box_edges, case_text, run_text, write_edge_csv
+from xfemslip.reference import closed_form as cf
 
 pytestmark = pytest.mark.verification
 

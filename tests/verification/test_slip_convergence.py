@@ -1,7 +1,7 @@
 """Slip of a frictional crack on a graded far-field mesh (the OpenGeoSys peer
-problem of issue 7) against the closed form of the infinite plane.
+problem) against the closed form of the infinite plane.
 
-Setup (xfemslip.peer, as benchmarks/ogs_compare.py): a crack of half-length
+Setup (xfemslip.reference.peer, as benchmarks/ogs_compare.py): a crack of half-length
 a = 1 m at 45 degrees through the centre of a square box of half-width 200 m
 (the box error is negligible), remote stress (xx, yy, xy) = (-20, -40, 0) MPa
 as edge tractions with a roller bottom edge, f = 0.1, c = 0,
@@ -34,9 +34,9 @@ import math
 import numpy as np
 import pytest
 
-from xfemslip import peer
 from xfemslip.case import loads_case
-from xfemslip.post import fracture_fields
+from xfemslip.post.fields import fracture_fields
+from xfemslip.reference import peer
 from xfemslip.simulation import build_model, newton_solver
 
 pytestmark = pytest.mark.verification

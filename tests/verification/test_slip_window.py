@@ -24,10 +24,10 @@ from pathlib import Path
 import numpy as np
 import pytest
 import tomli_w
-from harness import SLIP, read_result
 
-from xfemslip import closed_form as cf
+from tests.support.harness import SLIP, read_result
 from xfemslip.case import load_case
+from xfemslip.reference import closed_form as cf
 from xfemslip.simulation import run_case
 
 pytestmark = pytest.mark.verification

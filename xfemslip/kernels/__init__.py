@@ -20,13 +20,7 @@ import importlib
 import logging
 import os
 
-from xfemslip.kernels.codes import (
-    OPEN,
-    SLIP,
-    STICK,
-    TANGENT_CONSISTENT,
-    TANGENT_SECANT,
-)
+from xfemslip.kernels._config import numba_settings
 
 logger = logging.getLogger(__name__)
 
@@ -98,14 +92,10 @@ def __getattr__(name):
 
 __all__ = [
     "BACKENDS",
-    "OPEN",
-    "SLIP",
-    "STICK",
-    "TANGENT_CONSISTENT",
-    "TANGENT_SECANT",
     "active",
     "backend",
     "choose",
+    "numba_settings",
     "use",
     *KERNELS,
 ]

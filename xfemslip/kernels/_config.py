@@ -10,6 +10,10 @@ import os
 NUMBA_CACHE = os.environ.get("XFEMSLIP_NUMBA_CACHE", "1") != "0"
 NUMBA_FASTMATH = False
 
+# |Delta g_T| below this (m) has no usable secant; the elastic k_T is used
+# (both backends).
+SECANT_MIN_INCREMENT = 1.0e-300
+
 
 def numba_settings() -> list[tuple[str, str]]:
     """Numba's threading layer, thread count, cache dir and JIT switch (for `info`)."""

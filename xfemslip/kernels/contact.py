@@ -2,7 +2,7 @@
 
 Layering (house style): a scalar return map ``coulomb_return_map`` and a batched
 loop ``contact_response`` over the interface points; the Python driver is
-``xfemslip/contact.py``.  No fastmath here: the law is made of sign tests.
+``xfemslip/contact/interface.py``.  No fastmath here: the law is made of sign tests.
 
 Signs (tension positive): p_N = k_N g_N + p_N0 <= 0 in contact (paper eqs. 5-6,
 with p_N0 the in-situ normal traction), open when that is > 0 (no traction);
@@ -14,15 +14,8 @@ is exceeded (eqs. 27-28).
 import numpy as np
 from numba import njit
 
-from xfemslip.kernels._config import NUMBA_CACHE
-from xfemslip.kernels.codes import (  # noqa: F401  (re-exported names)
-    OPEN,
-    SLIP,
-    STICK,
-    TANGENT_CONSISTENT,
-    TANGENT_SECANT,
-)
-from xfemslip.kernels.codes import SECANT_MIN_INCREMENT as _SECANT_MIN_INCREMENT
+from xfemslip.conventions import OPEN, SLIP, STICK, TANGENT_SECANT
+from xfemslip.kernels._config import NUMBA_CACHE, SECANT_MIN_INCREMENT
 
 
 @njit(cache=NUMBA_CACHE)
@@ -124,7 +117,7 @@ def contact_response(
         if tangent_mode == TANGENT_SECANT and state == SLIP:
             # paper eq. 28: k_T = (p_T^{n+1} - p_T^n) / |Delta w_T|, no n-t coupling
             dg = abs(gt - gt_prev[i])
-            dtt = kt[i] if dg <= _SECANT_MIN_INCREMENT else abs(pt - pt_prev[i]) / dg
+            dtt = kt[i] if dg <= SECANT_MIN_INCREMENT else abs(pt - pt_prev[i]) / dg
             dtt = min(dtt, kt[i])
             dtn = 0.0
         out_gn[i] = gn

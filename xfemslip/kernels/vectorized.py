@@ -21,13 +21,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from xfemslip.kernels.codes import (
-    OPEN,
-    SECANT_MIN_INCREMENT,
-    SLIP,
-    STICK,
-    TANGENT_SECANT,
-)
+from xfemslip.conventions import OPEN, SLIP, STICK, TANGENT_SECANT
+from xfemslip.kernels._config import SECANT_MIN_INCREMENT
 
 _XI_A = np.array([-1.0, 1.0, 1.0, -1.0])
 _ETA_A = np.array([-1.0, -1.0, 1.0, 1.0])

@@ -1,6 +1,0 @@
-"""The stress-matrix helpers (``matrix.py``) are imported by basename."""
-
-import sys
-from pathlib import Path
-
-sys.path.insert(0, str(Path(__file__).resolve().parent))

@@ -1,0 +1,83 @@
+"""enrichment.build_enriched_cells (group-wise evaluation) against a
+cell-by-cell evaluation of every slot with the public candidate_values."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from tests.support.casegen import fracture_spec
+from xfemslip.fem.enrichment import (
+    build_enriched_cells,
+    candidate_values,
+    find_candidates,
+)
+from xfemslip.fem.mesh import build_mesh
+from xfemslip.geometry.fracture import GEOMETRY_TOL, build_fractures
+
+
+def _network(n=24):
+    grid = np.linspace(0.0, 1.0, n + 1)
+    mesh = build_mesh(grid, grid)
+    lines = [
+        ([[0.13, 0.31], [0.82, 0.74]], "branch"),  # crossed by the next (X): its arms
+        ([[0.21, 0.77], [0.71, 0.18]], "branch"),
+        ([[0.52, 0.12], [0.93, 0.33]], "ramp"),
+        ([[0.27, 0.90], [0.62, 0.95]], "branch"),  # second branch-tipped one
+    ]
+    specs = [fracture_spec(p, i, tip) for i, (p, tip) in enumerate(lines)]
+    return mesh, build_fractures(mesh, specs, np.array([0.0, 1.0, 0.0, 1.0]))
+
+
+def test_every_slot_matches_a_cell_by_cell_evaluation():
+    mesh, fractures = _network()
+    cand = find_candidates(mesh, fractures)
+    ec = build_enriched_cells(mesh, fractures, cand)
+    tol = GEOMETRY_TOL * mesh.h_min
+    assert ec.slot_cand.shape[1] > 8  # several groups meet in some cell
+    checked = 0
+    for e, c in enumerate(ec.cells):
+        q = slice(ec.qp_offsets[e], ec.qp_offsets[e + 1])
+        t = slice(ec.tri_offsets[e], ec.tri_offsets[e + 1])
+        tris = ec.tris[t]
+        per = (q.stop - q.start) // tris.shape[0]
+        cent = tris.mean(axis=1)
+        for s, k in enumerate(ec.slot_cand[e]):
+            if k < 0:
+                assert not ec.qp_F[q, s].any() and not ec.tri_F[t, :, s].any()
+                continue
+            fr = fractures[cand.fracture[k]]
+            side = fr.side(cent)
+            cq = np.repeat(cent, per, axis=0)
+            F, g = candidate_values(
+                fractures, cand, k, ec.qp_xy[q], np.repeat(side, per), tol, cq
+            )
+            np.testing.assert_allclose(ec.qp_F[q, s], F, rtol=1e-14, atol=1e-14)
+            np.testing.assert_allclose(ec.qp_gradF[q, s], g, rtol=1e-14, atol=1e-12)
+            Fv, _ = candidate_values(
+                fractures,
+                cand,
+                k,
+                tris.reshape(-1, 2),
+                np.repeat(side, 3),
+                tol,
+                np.repeat(cent, 3, axis=0),
+            )
+            np.testing.assert_allclose(
+                ec.tri_F[t, :, s], Fv.reshape(-1, 3), rtol=1e-14, atol=1e-14
+            )
+            # the slot's node is the candidate's node, its shift F at that node
+            assert mesh.cells[c, ec.slot_node[e, s]] == cand.node[k]
+            checked += 1
+    # every (candidate, cell around its node) pair is a slot, exactly once
+    pairs = {
+        (int(k), int(c))
+        for e, c in enumerate(ec.cells)
+        for k in ec.slot_cand[e]
+        if k >= 0
+    }
+    expected = {
+        (k, int(c))
+        for k, node in enumerate(cand.node)
+        for c in np.nonzero((mesh.cells == node).any(axis=1))[0]
+    }
+    assert pairs == expected and checked == len(expected)

@@ -1,0 +1,204 @@
+"""Figures (xfemslip.plot.figures): what they draw is the data of result.h5 / .vtu,
+the Mohr geometry is the closed form, ``run`` without ``--plot`` never
+imports matplotlib, and the commands write PNG and PDF."""
+
+from __future__ import annotations
+
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+import h5py
+import numpy as np
+import pytest
+from click.testing import CliRunner
+
+from tests.support.casegen import SWEEP_BASE as BASE
+from xfemslip.cli import cli
+from xfemslip.errors import UsageError
+from xfemslip.plot.data import FractureData, _piece_outlines, figure_data
+from xfemslip.plot.figures import KINDS, auto_scale, figure_slip, plot_results
+from xfemslip.plot.mohr import _circle_point
+from xfemslip.reference.closed_form import angle_to_sigma1, principal
+from xfemslip.reference.screen import plane_stresses
+
+ROOT = Path(__file__).resolve().parents[3]
+PNG = b"\x89PNG\r\n\x1a\n"
+
+
+@pytest.fixture
+def runner() -> CliRunner:
+    try:  # click < 8.2 mixes stderr into stdout unless told otherwise
+        return CliRunner(mix_stderr=False)
+    except TypeError:
+        return CliRunner()
+
+
+@pytest.fixture(scope="module")
+def two_runs(tmp_path_factory):
+    """The small case at 45 and 63 degrees (result.h5 + vtu); the first run
+    with --plot."""
+    root = tmp_path_factory.mktemp("plots")
+    runner = CliRunner()
+    outs = []
+    for angle in (45.0, 63.0):
+        case = root / f"a{angle:g}.toml"
+        case.write_text(
+            BASE.replace("angle = 45.0", f"angle = {angle}").replace(
+                'formats = ["h5"]', 'formats = ["h5", "vtu"]'
+            )
+        )
+        out = root / f"{int(angle):03d}_angle={angle:g}"
+        plot = ["--plot"] if angle == 45.0 else []
+        result = runner.invoke(cli, ["run", str(case), "-o", str(out), *plot])
+        assert result.exit_code == 0, result.output
+        outs.append(out)
+    return outs
+
+
+def test_run_plot_writes_every_figure_as_png_and_pdf(two_runs):
+    figures = two_runs[0] / "figures"
+    for kind in KINDS:
+        assert (figures / f"{kind}.png").read_bytes()[:8] == PNG
+        assert (figures / f"{kind}.pdf").read_bytes()[:4] == b"%PDF"
+        assert (figures / f"{kind}.png").stat().st_size < 400_000
+
+
+def test_slip_figure_draws_the_result_data(two_runs):
+    results = [figure_data(out / "result.h5") for out in two_runs]
+    assert [r.label for r in results] == ["angle=45", "angle=63"]
+    fig = figure_slip(results)
+    lines = [ln for ln in fig.axes[0].lines if ln.get_linestyle() == "-"]
+    assert len(lines) == 2
+    for line, out in zip(lines, two_runs, strict=True):
+        with h5py.File(out / "result.h5") as f:
+            s, slip = f["fractures/0/s"][()], f["fractures/0/slip"][()]
+        np.testing.assert_array_equal(line.get_xdata(), s - s.min())
+        np.testing.assert_array_equal(line.get_ydata(), np.abs(slip))
+        assert line.get_label() == out.name.split("_", 1)[1]
+
+
+def test_plot_command_several_results(two_runs, tmp_path, runner):
+    out = tmp_path / "figs"
+    args = ["plot", *map(str, two_runs), "-o", str(out), "--figure", "slip"]
+    result = runner.invoke(cli, [*args, "--figure", "mohr", "--format", "png"])
+    assert result.exit_code == 0, result.stderr
+    assert sorted(p.name for p in out.iterdir()) == ["mohr.png", "slip.png"]
+    assert result.stdout.split() == [str(out / "slip.png"), str(out / "mohr.png")]
+    missing = runner.invoke(cli, ["plot", str(tmp_path / "none.h5")])
+    assert missing.exit_code == 2
+    assert missing.stderr.startswith("Error: ") and "no such file" in missing.stderr
+
+
+def test_deformed_mesh_uses_the_split_mesh(two_runs):
+    data = figure_data(two_runs[0] / "result.h5")
+    assert data.vis_edges is not None and data.vis_points.shape[0] > len(data.points)
+    # the jump: the vis mesh holds points at the same place with different
+    # displacements (one copy per side of the fracture)
+    keys = np.round(data.vis_points / 1e-9).astype(np.int64)
+    _, inverse, counts = np.unique(
+        keys, axis=0, return_inverse=True, return_counts=True
+    )
+    jump = 0.0
+    for group in np.nonzero(counts > 1)[0][:400]:
+        u = data.vis_displacement[inverse.ravel() == group]
+        jump = max(jump, float(np.ptp(np.linalg.norm(u, axis=1))))
+    slip = np.abs(data.fractures[0].slip).max()
+    assert jump > 0.5 * slip
+
+
+def test_piece_outlines_drop_inner_edges_of_one_side():
+    """A unit square fanned into 4 triangles about its centre, cut along y = x:
+    each side is two triangles; their shared edge is inner, the rest remain."""
+    c = [0.5, 0.5]
+    corners = [[0, 0], [1, 0], [1, 1], [0, 1]]
+    tri_pts = [
+        [corners[k], corners[(k + 1) % 4], c] for k in range(4)
+    ]  # bottom, right, top, left
+    pts = np.array(tri_pts, dtype=float).reshape(-1, 2)
+    tris = np.arange(12).reshape(4, 3)
+    diag = np.column_stack([np.linspace(0, 1, 5), np.linspace(0, 1, 5)])
+    fracture = FractureData(
+        index=0,
+        s=np.linspace(0, 1, 5),
+        points=diag,
+        slip=np.zeros(5),
+        normal_traction=np.zeros(5),
+        shear_traction=np.zeros(5),
+        state=np.zeros(5),
+        theta=45.0,
+        friction=0.1,
+        cohesion=0.0,
+    )
+    edges = _piece_outlines(pts, tris, np.zeros(4, int), [fracture])
+    assert edges.shape == (8, 2)
+    segments = {tuple(sorted(map(tuple, pts[e]))) for e in edges}
+    # the two inner edges (corner (1,0)-centre and (0,1)-centre) are gone
+    assert ((0.5, 0.5), (1.0, 0.0)) not in segments
+    assert ((0.0, 1.0), (0.5, 0.5)) not in segments
+    # the diagonal pieces on the fracture are there (each side has its own)
+    assert ((0.0, 0.0), (0.5, 0.5)) in segments and ((0.5, 0.5), (1.0, 1.0)) in segments
+
+
+def test_auto_scale(two_runs):
+    data = figure_data(two_runs[0] / "result.h5")
+    size = 1.0
+    slip = np.abs(data.fractures[0].slip).max()
+    u_max = np.abs(data.displacement).max()
+    expected = max(1.0, min(0.05 * size / slip, 0.15 * size / u_max))
+    assert auto_scale(data) == pytest.approx(expected)
+    assert auto_scale(data) * u_max <= 0.15 * size + 1e-12
+
+
+@pytest.mark.parametrize(
+    "stress", [(-20e6, -40e6, 0.0), (-31e6, -12e6, 9e6), (-5e6, -5.5e6, -3e6)]
+)
+def test_mohr_circle_point_is_the_plane_traction(stress):
+    """The point drawn for a plane at theta (beta from sigma_1 on the circle)
+    is (sigma_n, |tau|) of that plane, computed directly."""
+    s1, s3, dir1 = principal(stress)
+    centre, radius = -(s1 + s3) / 2, (s1 - s3) / 2
+    for theta in np.linspace(0.0, 180.0, 19):
+        x, y = _circle_point(centre, radius, angle_to_sigma1(theta, dir1))
+        sn, tau = plane_stresses(stress, theta)
+        assert x == pytest.approx(float(sn), abs=1e-6 * s1)
+        assert y == pytest.approx(abs(float(tau)), abs=1e-6 * s1)
+
+
+def test_figure_data_errors(tmp_path):
+    with pytest.raises(UsageError, match="no such file"):
+        figure_data(tmp_path / "result.h5")
+    (tmp_path / "result.h5").write_text("not hdf5")
+    with pytest.raises(UsageError, match="not a readable result.h5"):
+        figure_data(tmp_path)
+    with pytest.raises(UsageError, match="2 labels for 1 results"):
+        plot_results([tmp_path], tmp_path / "f", labels=["a", "b"])
+
+
+@pytest.mark.slow
+def test_run_and_sweep_do_not_import_matplotlib(tmp_path):
+    case = tmp_path / "c.toml"
+    case.write_text(BASE)
+    sweep = tmp_path / "s.toml"
+    sweep.write_text('base = "c.toml"\n[vary]\n"material.E" = [5e9]\n')
+    run = ["run", str(case), "-o", str(tmp_path / "o")]
+    sweep_args = ["sweep", str(sweep), "-j", "1", "-o", str(tmp_path / "s")]
+    code = "\n".join(
+        [
+            "import sys",
+            "from click.testing import CliRunner",
+            "from xfemslip.cli import cli",
+            f"for args in ({run!r}, {sweep_args!r}):",
+            "    r = CliRunner().invoke(cli, args)",
+            "    assert r.exit_code == 0, r.output",
+            "top = {m.split('.')[0] for m in sys.modules}",
+            "print(sorted(top & {'matplotlib', 'distributed', 'dask'}))",
+        ]
+    )
+    env = {**os.environ, "PYTHONPATH": str(ROOT)}
+    done = subprocess.run(
+        [sys.executable, "-c", code], capture_output=True, text=True, env=env
+    )
+    assert done.returncode == 0, done.stderr
+    assert done.stdout.strip() == "[]"

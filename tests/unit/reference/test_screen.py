@@ -1,0 +1,182 @@
+"""Closed-form screening (xfemslip.reference.screen) against hand-computed numbers and
+against xfemslip.reference.closed_form; the ``xfemslip screen`` command.
+
+Hand numbers, stress (xx, yy, xy) = (-20, -40, 0) MPa, plane at 45 degrees:
+n = (-1, 1)/sqrt 2, t = (1, 1)/sqrt 2, so sigma_n = (-20 - 40)/2 = -30 MPa and
+tau = t.sigma.n = (20 - 40)/2 = -10 MPa.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+from click.testing import CliRunner
+
+from xfemslip.cli import cli
+from xfemslip.reference.closed_form import crack_tractions, slip_window
+from xfemslip.reference.screen import (
+    coulomb_margin,
+    effective_stress,
+    orientation_table,
+    plane_stresses,
+    pressure_to_slip,
+    screen_fracture,
+    slip_band,
+    slip_tendency,
+)
+
+MPA = 1e6
+PAPER = (-20 * MPA, -40 * MPA, 0.0)
+
+
+@pytest.fixture
+def runner() -> CliRunner:
+    try:  # click < 8.2 mixes stderr into stdout unless told otherwise
+        return CliRunner(mix_stderr=False)
+    except TypeError:
+        return CliRunner()
+
+
+def test_hand_numbers_at_45_degrees():
+    sn, tau = plane_stresses(PAPER, 45.0)
+    assert sn == pytest.approx(-30 * MPA, rel=1e-14)
+    assert tau == pytest.approx(-10 * MPA, rel=1e-14)
+    assert slip_tendency(sn, tau) == pytest.approx(1 / 3)
+    # f = 0.1: 0.1 * 30 - 10 = -7 MPa, slips; to stop it p must drop 70 MPa
+    assert coulomb_margin(sn, tau, 0.1) == pytest.approx(-7 * MPA)
+    fs = screen_fracture("f", 45.0, PAPER, 0.0, 0.1)
+    assert fs.dp_slip == pytest.approx(-70 * MPA) and fs.dp_critical == fs.dp_slip
+    # f = 0.6: 18 - 10 = 8 MPa stable; slips once p rises by 8 / 0.6 MPa
+    fs = screen_fracture("f", 45.0, PAPER, 0.0, 0.6)
+    assert fs.margin == pytest.approx(8 * MPA)
+    assert fs.dp_slip == pytest.approx(8 / 0.6 * MPA)
+    assert fs.dp_open == pytest.approx(30 * MPA)
+    assert fs.dp_critical == pytest.approx(8 / 0.6 * MPA)
+
+
+def test_pore_pressure_makes_the_normal_stress_less_compressive():
+    # p = 10 MPa: sigma' = (-10, -30) MPa; at 45 degrees sigma_n' = -20, tau = -10
+    eff = effective_stress(PAPER, 10 * MPA)
+    assert eff == (-10 * MPA, -30 * MPA, 0.0)
+    fs = screen_fracture("f", 45.0, PAPER, 10 * MPA, 0.6)
+    assert fs.sigma_n_eff == pytest.approx(-20 * MPA)
+    assert fs.slip_tendency == pytest.approx(0.5)
+    assert fs.margin == pytest.approx(2 * MPA)
+    assert fs.dp_slip == pytest.approx(2 / 0.6 * MPA)
+    # the pressure change found is where the margin is zero
+    at = screen_fracture("f", 45.0, PAPER, 10 * MPA + fs.dp_slip, 0.6)
+    assert at.margin == pytest.approx(0.0, abs=1e-6)
+
+
+def test_cohesion_and_opening_come_first_when_friction_is_zero():
+    # f = 0, c = 12 MPa > |tau| = 10 MPa: stable at any pressure until it opens
+    dp_slip, dp_open, dp_crit = pressure_to_slip(-30 * MPA, -10 * MPA, 0.0, 12 * MPA)
+    assert dp_slip == math.inf and dp_open == pytest.approx(30 * MPA)
+    assert dp_crit == pytest.approx(30 * MPA)
+    # f = 0, c = 5 MPa < |tau|: slipping already, whatever the pressure
+    assert pressure_to_slip(-30 * MPA, -10 * MPA, 0.0, 5 * MPA)[0] == -math.inf
+    # large cohesion with friction: opening (30 MPa) before Coulomb (130 MPa)
+    _, _, dp_crit = pressure_to_slip(-30 * MPA, -10 * MPA, 0.1, 20 * MPA)
+    assert dp_crit == pytest.approx(30 * MPA)
+
+
+def test_plane_stresses_match_closed_form_crack_tractions():
+    stress = (-12 * MPA, -35 * MPA, 7 * MPA)
+    thetas = np.linspace(-180.0, 180.0, 73)
+    sn, tau = plane_stresses(stress, thetas)
+    ref = np.array([crack_tractions(stress, t) for t in thetas])
+    np.testing.assert_allclose(sn, ref[:, 0], rtol=1e-12)
+    np.testing.assert_allclose(tau, ref[:, 1], rtol=0, atol=1e-12 * 35 * MPA)
+    # exact zeros at multiples of 90 degrees (no 6e-17 leftovers)
+    assert plane_stresses(PAPER, 90.0)[1] == 0.0
+    assert plane_stresses(PAPER, 0.0)[1] == 0.0
+
+
+@pytest.mark.parametrize(
+    ("stress", "p", "f", "c"),
+    [
+        (PAPER, 0.0, 0.1, 0.0),
+        (PAPER, 0.0, 0.3, 0.0),
+        (PAPER, 8 * MPA, 0.4, 0.5 * MPA),
+        ((-30 * MPA, -18 * MPA, 6 * MPA), 2 * MPA, 0.2, 0.0),  # rotated sigma_1
+    ],
+)
+def test_band_agrees_with_the_orientation_table(stress, p, f, c):
+    """The analytic band (slip_window about sigma_1) and the sampled margins
+    classify every orientation alike (1e-3 degrees away from the band edges)."""
+    band = slip_band(effective_stress(stress, p), f, c)
+    thetas = np.arange(0.0, 180.0, 0.25)
+    table = orientation_table(stress, p, f, c, thetas)
+    in_band = np.zeros(thetas.size, bool)
+    near_edge = np.zeros(thetas.size, bool)
+    for lo, hi in band.theta:
+        in_band |= (thetas > lo) & (thetas < hi)
+        near_edge |= (np.abs(thetas - lo) < 1e-3) | (np.abs(thetas - hi) < 1e-3)
+    np.testing.assert_array_equal(table["slips"][~near_edge], in_band[~near_edge])
+    assert table["slips"].any()
+
+
+def test_band_of_the_paper_state():
+    """sigma_1 = 40 MPa vertical, sigma_3 = 20 MPa, f = 0.1: beta in the window
+    of closed_form.slip_window, theta = 90 -/+ beta; f = 0.6: nothing slips."""
+    band = slip_band(PAPER, 0.1)
+    assert band.dir1 == pytest.approx(90.0)
+    lo, hi = slip_window(40 * MPA, 20 * MPA, 0.1)
+    assert band.beta == pytest.approx((lo, hi))
+    np.testing.assert_allclose(
+        band.theta, [(90 - hi, 90 - lo), (90 + lo, 90 + hi)], rtol=1e-12
+    )
+    # by hand: S = 3 sin(atan 0.1) = 0.29851, beta_min = (asin S - phi)/2
+    phi = math.atan(0.1)
+    assert lo == pytest.approx(math.degrees((math.asin(3 * math.sin(phi)) - phi) / 2))
+    assert slip_band(PAPER, 0.6).beta is None
+    assert slip_band(PAPER, 0.6).theta == ()
+
+
+def test_cli_screen_case(runner, tmp_path):
+    case = "cases/reservoir_depletion.toml"
+    out = tmp_path / "fig"
+    csv_path = tmp_path / "table.csv"
+    result = runner.invoke(
+        cli,
+        ["screen", case, "--step", "45", "--csv", str(csv_path), "--plot", str(out)],
+    )
+    assert result.exit_code == 0, result.stderr
+    text = result.stdout
+    assert "slip band: beta = 5.83..78.46 deg from sigma1" in text
+    assert "fractures[0]: theta = 45.00 deg (beta = 45.00 deg)" in text
+    assert "margin = -7e+06 -> SLIPS already; a pore-pressure drop of 7e+07 Pa" in text
+    assert (out / "mohr.png").stat().st_size > 10_000
+    assert (out / "mohr.pdf").read_bytes()[:4] == b"%PDF"
+    rows = csv_path.read_text().splitlines()
+    assert rows[0].startswith("theta_deg,beta_deg,sigma_n_eff_Pa,tau_Pa")
+    assert len(rows) == 1 + 4  # 0, 45, 90, 135
+    assert rows[2].split(",")[2:4] == ["-30000000", "-10000000"]
+
+
+def test_cli_screen_options(runner):
+    result = runner.invoke(
+        cli,
+        ["screen", "--stress", "-20e6", "-40e6", "0", "-p", "10e6"]
+        + ["--friction", "0.6", "--angle", "45", "--step", "30"],
+    )
+    assert result.exit_code == 0, result.stderr
+    assert "slip band: no orientation slips" in result.stdout
+    assert "angle 45: theta = 45.00 deg" in result.stdout
+    assert "margin = 2e+06 -> stable; slips at a pore-pressure change dp = " in (
+        result.stdout
+    )
+    assert "dp = 3.33333e+06 Pa (Coulomb 3.33333e+06, opening 2e+07)" in result.stdout
+
+
+def test_cli_screen_needs_a_stress_and_a_friction(runner):
+    result = runner.invoke(cli, ["screen"])
+    assert result.exit_code == 2
+    assert result.stderr.strip() == (
+        "Error: screen needs --stress XX YY XY or a CASE with loading.stress"
+    )
+    result = runner.invoke(cli, ["screen", "--stress", "-1e6", "-2e6", "0"])
+    assert result.exit_code == 2
+    assert "needs --friction" in result.stderr

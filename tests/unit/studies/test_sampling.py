@@ -1,0 +1,116 @@
+"""Samples of uncertain inputs against the distributions they claim to follow."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+from scipy import stats
+
+from xfemslip.studies.sampling import (
+    Distribution,
+    draw,
+    induce_correlation,
+    rank_correlation,
+    samples_for_half_width,
+    unit_samples,
+    wilson_interval,
+)
+
+CONTINUOUS = [
+    (Distribution("uniform", (0.4, 0.8)), stats.uniform(loc=0.4, scale=0.4)),
+    (Distribution("normal", (-44.0e6, 2.0e6)), stats.norm(-44.0e6, 2.0e6)),
+    (Distribution("lognormal", (5.0e9, 0.3)), stats.lognorm(s=0.3, scale=5.0e9)),
+    (
+        Distribution("triangular", (0.3, 0.6, 1.0)),
+        stats.triang(c=0.3 / 0.7, loc=0.3, scale=0.7),
+    ),
+]
+
+
+@pytest.mark.parametrize("method", ["lhs", "monte_carlo"])
+@pytest.mark.parametrize("dist, ref", CONTINUOUS, ids=lambda v: getattr(v, "kind", ""))
+def test_marginals_follow_the_distribution(dist, ref, method):
+    """Kolmogorov-Smirnov against the scipy distribution: 4,000 samples; a
+    Latin hypercube is much closer than random (its D is at most 1/n)."""
+    x = draw([dist], 4000, method=method, seed=11)[:, 0]
+    d = stats.kstest(x, ref.cdf).statistic
+    assert d < (1.0 / 4000 + 1e-9 if method == "lhs" else 0.03)
+
+
+def test_latin_hypercube_puts_one_sample_in_every_stratum():
+    u = unit_samples(250, 4, "lhs", np.random.default_rng(3))
+    for j in range(4):
+        assert sorted(np.floor(u[:, j] * 250).astype(int)) == list(range(250))
+
+
+def test_truncated_normal_matches_scipy_truncnorm():
+    """Mean and bounds of a normal truncated to [mean - 1 std, mean + 2 std]."""
+    dist = Distribution("normal", (10.0, 2.0), low=8.0, high=14.0)
+    x = draw([dist], 5000, seed=5)[:, 0]
+    assert x.min() >= 8.0 and x.max() <= 14.0
+    ref = stats.truncnorm(-1.0, 2.0, loc=10.0, scale=2.0)
+    assert abs(x.mean() - ref.mean()) < 1e-3
+    assert abs(dist.mean() - ref.mean()) < 1e-4
+
+
+def test_negative_lognormal_keeps_its_sign_and_truncation():
+    """A compressive stress drawn as median * exp(sigma Z) with median < 0."""
+    dist = Distribution("lognormal", (-40.0e6, 0.1), low=-46.0e6, high=-35.0e6)
+    x = draw([dist], 3000, seed=2)[:, 0]
+    assert np.all(x < 0.0) and x.min() >= -46.0e6 and x.max() <= -35.0e6
+    ref = stats.truncnorm(
+        (math.log(35.0) - math.log(40.0)) / 0.1, (math.log(46.0) - math.log(40.0)) / 0.1
+    )
+    # ln|x| is the truncated normal of ln 40e6, sigma 0.1
+    z = (np.log(-x) - math.log(40.0e6)) / 0.1
+    assert stats.kstest(z, ref.cdf).statistic < 1.0 / 3000 + 1e-9
+
+
+def test_choice_frequencies_follow_the_weights():
+    dist = Distribution("choice", (0.3, 0.6, 0.9), weights=(1.0, 2.0, 1.0))
+    x = draw([dist], 4000, seed=9)[:, 0]
+    counts = [np.count_nonzero(x == v) for v in (0.3, 0.6, 0.9)]
+    assert counts == [1000, 2000, 1000]  # Latin hypercube: exact strata
+
+
+@pytest.mark.parametrize("rho", [-0.7, 0.3, 0.9])
+def test_induced_rank_correlation_keeps_the_marginals(rho):
+    rng = np.random.default_rng(1)
+    u = unit_samples(2000, 2, "lhs", rng)
+    out = induce_correlation(u, np.array([[1.0, rho], [rho, 1.0]]), rng)
+    for j in range(2):
+        np.testing.assert_array_equal(np.sort(out[:, j]), np.sort(u[:, j]))
+    # Iman-Conover gives the correlation of the normal scores; the rank
+    # correlation of bivariate normals is (6 / pi) asin(rho / 2)
+    expected = 6.0 / math.pi * math.asin(rho / 2.0)
+    assert abs(rank_correlation(out[:, 0], out[:, 1]) - expected) < 0.03
+
+
+def test_same_seed_same_samples_other_seed_other_samples():
+    dists = [Distribution("uniform", (0.0, 1.0)), Distribution("normal", (0.0, 1.0))]
+    a = draw(dists, 50, seed=4)
+    np.testing.assert_array_equal(a, draw(dists, 50, seed=4))
+    assert not np.array_equal(a, draw(dists, 50, seed=5))
+
+
+def test_wilson_interval_closed_forms():
+    """k = 0: (0, z^2 / (n + z^2)); k = n/2: symmetric about 1/2; and it
+    covers the true p in about 95 % of binomial trials."""
+    lo, hi = wilson_interval(0, 10)
+    z2 = stats.norm.ppf(0.975) ** 2
+    assert lo == pytest.approx(0.0, abs=1e-15) and hi == pytest.approx(z2 / (10 + z2))
+    lo, hi = wilson_interval(50, 100)
+    assert lo + hi == pytest.approx(1.0)
+    rng = np.random.default_rng(0)
+    k = rng.binomial(200, 0.1, size=20000)
+    lo, hi = wilson_interval(k, 200)
+    coverage = np.mean((lo <= 0.1) & (0.1 <= hi))
+    assert 0.93 < coverage < 0.97
+
+
+def test_samples_for_half_width():
+    # p = 0.5, +-0.05 at 95 %: 0.25 * (1.96 / 0.05)^2 = 384.1 -> 385
+    assert samples_for_half_width(0.5, 0.05) == 385
+    assert samples_for_half_width(0.1, 0.05) < samples_for_half_width(0.5, 0.05)

@@ -1,0 +1,82 @@
+"""Case text from Python values: the one case builder.
+
+Tests, benchmarks and the verification problems describe a case as nested
+mappings and lists, exactly as the case file holds it (``case-format.md``),
+and turn it into TOML here; the text then goes through ``loads_case`` like any
+file, so a built case is validated like a written one.
+
+>>> text = case_text({"mesh": {"elements": [4, 4]}, "domain": {"size": [1.0, 1.0]}})
+>>> print(text.splitlines()[0])
+[mesh]
+
+Values may be NumPy scalars and arrays, tuples and paths; entries that are
+``None`` are left out (so a builder can pass an optional key through).
+Floats keep their full precision (TOML writes the shortest repr that reads
+back to the same double).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from pathlib import PurePath
+from typing import Any
+
+import numpy as np
+import tomli_w
+
+__all__ = ["case_text", "plain", "stress_table", "with_keys"]
+
+
+def plain(value: Any) -> Any:
+    """``value`` as TOML-ready Python: dicts without None entries, lists for
+    tuples and arrays, Python numbers for NumPy scalars, str for paths."""
+    if isinstance(value, Mapping):
+        return {str(k): plain(v) for k, v in value.items() if v is not None}
+    if isinstance(value, np.ndarray):
+        return plain(value.tolist())
+    if isinstance(value, list | tuple):
+        return [plain(v) for v in value]
+    if isinstance(value, np.bool_ | bool):
+        return bool(value)
+    if isinstance(value, np.integer):
+        return int(value)
+    if isinstance(value, np.floating):
+        return float(value)
+    if isinstance(value, PurePath):
+        return str(value)
+    return value
+
+
+def case_text(table: Mapping[str, Any]) -> str:
+    """The TOML text of a case given as a mapping (top-level keys before the
+    tables, as TOML requires; ``tomli_w`` orders them)."""
+    return tomli_w.dumps(plain(table))
+
+
+def stress_table(stress) -> dict[str, float] | None:
+    """``(xx, yy, xy)`` [Pa] as the ``{ xx, yy, xy }`` table of ``[loading]``
+    (None stays None)."""
+    if stress is None:
+        return None
+    xx, yy, xy = (float(v) for v in stress)
+    return {"xx": xx, "yy": yy, "xy": xy}
+
+
+def with_keys(table: Mapping[str, Any], **dotted: Any) -> dict[str, Any]:
+    """A deep copy of ``table`` with the values at dotted key paths set,
+    ``with_keys(case, **{"mesh.elements": [20, 20]})``; a list index is a
+    number in the path (``"fractures.0.friction"``)."""
+    out = plain(table)
+    for path, value in dotted.items():
+        parts = path.split(".")
+        node = out
+        for part in parts[:-1]:
+            node = (
+                node[int(part)] if isinstance(node, list) else node.setdefault(part, {})
+            )
+        last = parts[-1]
+        if isinstance(node, list):
+            node[int(last)] = plain(value)
+        else:
+            node[last] = plain(value)
+    return out

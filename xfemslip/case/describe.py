@@ -1,0 +1,255 @@
+"""``describe``: the resolved SI summary of a case printed by ``xfemslip check``."""
+
+from __future__ import annotations
+
+import math
+from typing import Any
+
+import numpy as np
+
+from xfemslip.case.options import SOLVER_OPTIONS
+from xfemslip.case.specs import (
+    AUTO_PENALTY,
+    EDGES,
+    CaseSpec,
+    EdgeSpec,
+    FractureSpec,
+    LoadingSpec,
+    MaterialSpec,
+    MeshSpec,
+    SolverSpec,
+)
+from xfemslip.case.tables import fmt
+from xfemslip.reference.screen import coulomb_margin, plane_stresses
+
+
+def _with_unit(value: Any, unit: str) -> str:
+    """``5e+09 Pa``; no unit for dimensionless ("-") or unitless ("") values."""
+    text = fmt(value) if isinstance(value, int | float) else str(value)
+    return f"{text} {unit}" if unit not in ("", "-") else text
+
+
+def _describe_axis(coords: np.ndarray, label: str) -> str:
+    """Element sizes along one axis: uniform or graded (min .. max)."""
+    h = np.diff(coords)
+    unit = MeshSpec.UNITS[label]
+    if np.ptp(h) <= 1e-9 * h.max():
+        return f"d{label} = {_with_unit(float(h[0]), unit)} (uniform)"
+    return (
+        f"d{label} = {fmt(float(h.min()))} .. {_with_unit(float(h.max()), unit)} "
+        "(graded)"
+    )
+
+
+def _describe_network_fracture(spec: FractureSpec) -> list[str]:
+    """One line per [network] fracture: where from, ends, length, parameters."""
+    p, units = spec.points, FractureSpec.UNITS
+    length = float(np.hypot(*np.diff(p, axis=0).T).sum())
+    params = ", ".join(
+        f"{k} {fmt(getattr(spec, k))}" if getattr(spec, k) is not None else f"{k} auto"
+        for k in ("friction", "cohesion", "kn", "kt")
+    )
+    ends = (
+        f"({fmt(float(p[0, 0]))}, {fmt(float(p[0, 1]))}) -> "
+        + (f"{len(p) - 2} more -> " if len(p) > 2 else "")
+        + f"({fmt(float(p[-1, 0]))}, {fmt(float(p[-1, 1]))})"
+    )
+    return [
+        f"  [{spec.index}] {ends}, length {_with_unit(length, units['points'])}; "
+        f"{params}; {spec.source}"
+    ]
+
+
+def _describe_fracture(spec: FractureSpec) -> list[str]:
+    """Points, length, segment angles and contact parameters of one fracture."""
+    if spec.source:
+        return _describe_network_fracture(spec)
+    p = spec.points
+    seg = np.diff(p, axis=0)
+    angles = np.degrees(np.arctan2(seg[:, 1], seg[:, 0]))
+    units = FractureSpec.UNITS
+    points = " -> ".join(f"({fmt(float(x))}, {fmt(float(y))})" for x, y in p)
+    params = ", ".join(
+        f"{k} = {_with_unit(getattr(spec, k), units[k])}"
+        if getattr(spec, k) is not None
+        else f"{k} = {fmt(AUTO_PENALTY)} E/h (automatic)"
+        for k in ("friction", "cohesion", "kn", "kt")
+    )
+    tip = spec.tip + (
+        f", radius {_with_unit(spec.tip_radius, units['tip_radius'])}"
+        if spec.tip_radius is not None
+        else (
+            ", radius 0.1 x length within 4-6 tip-cell sizes (automatic)"
+            if spec.tip == "branch"
+            else ""
+        )
+    )
+    return [
+        f"  [{spec.index}] points [{units['points']}]: {points}",
+        f"      length {_with_unit(float(np.hypot(*seg.T).sum()), units['points'])}, "
+        f"angle {', '.join(fmt(float(a)) for a in angles)} deg",
+        f"      {params}",
+        f"      tip: {tip}",
+    ]
+
+
+def in_situ_margin(spec: CaseSpec, fracture: FractureSpec) -> tuple[float, float]:
+    """(Coulomb margin [Pa], effective normal traction [Pa]) of the in-situ
+    stress on the fracture's least stable segment.
+
+    margin = c + f max(0, -sigma_n') - |tau| (xfemslip.reference.screen), with
+    sigma_n' = sigma_n + p0 on the faces (Terzaghi); the segment with the
+    smallest margin counts, and a segment in tension (sigma_n' > 0) before any
+    other.  (nan, nan) without ``loading.initial_stress``.
+    """
+    stress = spec.loading.initial_stress
+    if stress is None:
+        return math.nan, math.nan
+    p0 = spec.pore_pressure.initial if spec.pore_pressure is not None else 0.0
+    seg = np.diff(fracture.points, axis=0)
+    angles = np.degrees(np.arctan2(seg[:, 1], seg[:, 0]))
+    sigma_n, tau = plane_stresses(stress, angles)
+    sigma_n = sigma_n + p0
+    margin = coulomb_margin(sigma_n, tau, fracture.friction, fracture.cohesion)
+    worst = int(np.argmax(sigma_n)) if np.any(sigma_n > 0.0) else int(np.argmin(margin))
+    return float(margin[worst]), float(sigma_n[worst])
+
+
+def _margin_text(spec: CaseSpec, fracture: FractureSpec) -> str:
+    """What the in-situ stress does to the fracture, for ``check``."""
+    margin, sigma_n = in_situ_margin(spec, fracture)
+    if math.isnan(margin):
+        return ""
+    if sigma_n > 0.0:
+        return (
+            f"in-situ: in tension across it (sigma_n' = {fmt(sigma_n / 1e6)} MPa): "
+            "it opens in load step 1"
+        )
+    text = f"in-situ Coulomb margin {fmt(margin / 1e6)} MPa"
+    if margin < 0.0:
+        return text + (
+            " (shear above the friction limit: the excess is released and the "
+            "fracture slips in load step 1)"
+        )
+    return text + " (stable)"
+
+
+def _describe_edge(name: str, edge: EdgeSpec) -> str:
+    """One edge's boundary condition."""
+    if edge.kind == "traction":
+        return f"  {name}: traction = loading.stress . n"
+    if edge.kind == "free":
+        note = " (not given in [boundary])" if edge.source == "default" else ""
+        return f"  {name}: free (zero traction){note}"
+    parts = []
+    for c, label in enumerate(("ux", "uy")):
+        column = edge.values[:, c]
+        if np.isnan(column).all():
+            extra = " (traction = loading.stress . n)" if edge.traction else ""
+            parts.append(f"{label} free{extra}")
+        elif np.ptp(column) == 0.0:
+            parts.append(
+                f"{label} = {_with_unit(float(column[0]), EdgeSpec.UNITS['values'])}"
+            )
+        else:
+            parts.append(
+                f"{label} = {fmt(float(column.min()))} .. "
+                f"{_with_unit(float(column.max()), EdgeSpec.UNITS['values'])}"
+            )
+    return (
+        f"  {name}: displacement {', '.join(parts)} at {len(edge.values)} nodes "
+        f"[{edge.source}]"
+    )
+
+
+def _describe_stress(stress: tuple[float, float, float] | None) -> str:
+    """``(xx, yy, xy) = (...) Pa`` or none."""
+    if stress is None:
+        return "none"
+    values = ", ".join(fmt(v) for v in stress)
+    return f"(xx, yy, xy) = ({values}) {LoadingSpec.UNITS['stress']}"
+
+
+def _describe_pore(spec: CaseSpec) -> list[str]:
+    """[pore_pressure] and [reservoir] lines (none when absent)."""
+    lines = []
+    p = spec.pore_pressure
+    if p is not None:
+        where = "the reservoir" if p.region == "reservoir" else "the whole model"
+        lines.append(
+            f"pore pressure: initial {fmt(p.initial)} Pa, change {fmt(p.change)} Pa "
+            f"over the load steps (< 0 = depletion), Biot coefficient "
+            f"{fmt(p.biot)}, acting in {where}; "
+            "effective stress in the bulk (Biot) and on the fractures (Terzaghi)"
+        )
+    r = spec.reservoir
+    if r is not None:
+        rows = r.boxes if r.polygon is None else r.polygon
+        where = "box(es)" if r.polygon is None else "polygon"
+        shapes = "; ".join(
+            "[" + ", ".join(fmt(float(v)) for v in b) + "]" for b in rows
+        )
+        lines.append(
+            f"reservoir: E = {fmt(r.E)} Pa, nu = {fmt(r.nu)} in {where} "
+            f"{shapes} m (cells whose centre is inside); [material] is the host rock"
+        )
+    return lines
+
+
+def _network_count(spec: CaseSpec) -> str:
+    """`` ([[fractures]] 1, network.file 3, network.generate 40)`` or ""."""
+    sources = [
+        f.source.split(" ", 1)[0] if f.source else "[[fractures]]"
+        for f in spec.fractures
+    ]
+    if all(s == "[[fractures]]" for s in sources):
+        return ""
+    counts = {s: sources.count(s) for s in dict.fromkeys(sources)}
+    return " (" + ", ".join(f"{s} {n}" for s, n in counts.items()) + ")"
+
+
+def describe(spec: CaseSpec) -> str:
+    """Human-readable summary of a resolved case (SI units, tension positive).
+
+    Printed by ``xfemslip check``: domain, mesh (element sizes, graded or not),
+    material, fractures, loading, every edge's condition (edges not given in the
+    file are reported as free), solver options (from SOLVER_OPTIONS) and output.
+    """
+
+    (x0, y0), (w, h) = spec.origin, spec.size
+    nx, ny = spec.mesh.x.size - 1, spec.mesh.y.size - 1
+    m = spec.material
+    lines = [
+        f"case {spec.name!r} ({spec.path})",
+        f"domain: [{fmt(x0)}, {fmt(x0 + w)}] x [{fmt(y0)}, {fmt(y0 + h)}] m "
+        f"(size {fmt(w)} x {fmt(h)} m)",
+        f"mesh: {nx} x {ny} Q4 elements, {(nx + 1) * (ny + 1)} nodes; "
+        f"{_describe_axis(spec.mesh.x, 'x')}; {_describe_axis(spec.mesh.y, 'y')}",
+        f"material: E = {_with_unit(m.E, MaterialSpec.UNITS['E'])}, nu = {fmt(m.nu)}, "
+        f"{m.model}",
+        f"fractures: {len(spec.fractures)}{_network_count(spec)}",
+    ]
+    for fracture in spec.fractures:
+        lines += _describe_fracture(fracture)
+        margin = _margin_text(spec, fracture)
+        if margin:
+            lines[-1] += f"; {margin}" if fracture.source else ""
+            lines += [] if fracture.source else [f"      {margin}"]
+    steps = spec.loading.steps
+    lines += [
+        f"loading: stress {_describe_stress(spec.loading.stress)}; "
+        f"initial_stress {_describe_stress(spec.loading.initial_stress)}; "
+        f"{steps} step{'' if steps == 1 else 's'}",
+        "boundary:",
+    ]
+    lines += [_describe_edge(e, getattr(spec.boundary, e)) for e in EDGES]
+    lines += _describe_pore(spec)
+    lines.append("solver:")
+    for option in SOLVER_OPTIONS:
+        value = getattr(spec.solver, option.name)
+        lines.append(
+            f"  {option.name} = {_with_unit(value, SolverSpec.UNITS[option.name])}"
+            f"  ({option.doc})"
+        )
+    lines.append(f"output: {spec.output.directory} ({', '.join(spec.output.formats)})")
+    return "\n".join(lines)

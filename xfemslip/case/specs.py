@@ -1,0 +1,193 @@
+"""Spec dataclasses of a resolved case: ``CaseSpec`` and its parts."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import ClassVar
+
+import numpy as np
+
+EDGES = ("bottom", "top", "left", "right")
+
+
+@dataclass(frozen=True, kw_only=True)
+class MeshSpec:
+    """Rectilinear structured Q4 mesh: node coordinates along x and y."""
+
+    x: np.ndarray  # (nx+1,) float64, strictly increasing [m]
+    y: np.ndarray  # (ny+1,) float64, strictly increasing [m]
+    UNITS: ClassVar[dict[str, str]] = {"x": "m", "y": "m"}
+
+
+@dataclass(frozen=True, kw_only=True)
+class MaterialSpec:
+    E: float  # Young's modulus [Pa]
+    nu: float  # Poisson's ratio [-]
+    model: str  # "plane_strain" | "plane_stress"
+    UNITS: ClassVar[dict[str, str]] = {"E": "Pa", "nu": "-", "model": ""}
+
+
+# Penalty stiffness when a fracture omits kn / kt: k = AUTO_PENALTY * E / h with
+# h the local cell size (sqrt of the area of the cut cell).  Measured on the
+# inclined crack (benchmarks/RESULTS.md, "Penalty"): below ~1e3 the stuck faces'
+# elastic penalty slip is the larger error (2e-4 of the free slip at 100, 3e-2
+# at 1), from 1e3 up it sits at the discretisation floor (5e-5); the slip error
+# (0.42 % at a/20) and the Newton iterations (2 per step on the plate case up
+# to 1e5) do not change.  A stiffer penalty only worsens the conditioning.
+AUTO_PENALTY = 1.0e3
+
+# Length of a contact patch in local cell sizes ([solver] contact_patch): the
+# penalty law acts on the jump averaged over each patch (contact.ContactSet).
+# Measured on the inclined crack at h = a/20: normal-traction oscillation (max
+# deviation / mean) 23 % pointwise (0), 1.2 % with 1-cell patches, 0.3 % with
+# 1.5-cell patches, slip error unchanged (benchmarks/RESULTS.md).
+CONTACT_PATCH_CELLS = 1.5
+
+
+@dataclass(frozen=True, kw_only=True)
+class FractureSpec:
+    index: int  # [[fractures]] position; [network] ones follow (network.py)
+    points: np.ndarray  # (k, 2) float64 polyline vertices, k >= 2 [m]
+    friction: float  # Coulomb coefficient f [-]
+    cohesion: float  # c_f [Pa]
+    kn: float | None  # normal penalty [Pa/m]; None = AUTO_PENALTY * E / h
+    kt: float | None  # tangential penalty [Pa/m]; None = AUTO_PENALTY * E / h
+    tip: str = "branch"  # crack-tip treatment: "branch" | "ramp"
+    tip_radius: float | None = None  # branch enrichment radius [m]; None = automatic
+    source: str = ""  # "" = [[fractures]]; else where [network] took it from
+    UNITS: ClassVar[dict[str, str]] = {
+        "points": "m",
+        "tip_radius": "m",
+        "friction": "-",
+        "cohesion": "Pa",
+        "kn": "Pa/m",
+        "kt": "Pa/m",
+    }
+
+
+@dataclass(frozen=True, kw_only=True)
+class LoadingSpec:
+    stress: tuple[float, float, float] | None  # final far-field (xx, yy, xy) [Pa]
+    initial_stress: tuple[float, float, float] | None  # in-situ (xx, yy, xy) [Pa]
+    steps: int
+    UNITS: ClassVar[dict[str, str]] = {
+        "stress": "Pa",
+        "initial_stress": "Pa",
+        "steps": "-",
+    }
+
+
+@dataclass(frozen=True, kw_only=True)
+class EdgeSpec:
+    """One edge's boundary condition.
+
+    kind: "traction" (traction = loading.stress . n), "free" (no traction), or
+    "displacement".  For "displacement": ``values`` holds the prescribed final
+    displacement at every node of the edge, ordered by increasing coordinate
+    along the edge (shape (n_edge_nodes, 2), NaN where a component is free);
+    ``traction`` says whether the free component carries loading.stress . n.
+    ``source`` is "table" or the CSV file's path; for an edge left out of
+    ``[boundary]`` (hence "free") it is "default".
+    """
+
+    kind: str
+    values: np.ndarray | None = None  # (n_edge_nodes, 2) float64 [m], NaN = free
+    traction: bool = False
+    source: str = ""
+    UNITS: ClassVar[dict[str, str]] = {"values": "m"}
+
+
+@dataclass(frozen=True, kw_only=True)
+class BoundarySpec:
+    bottom: EdgeSpec
+    top: EdgeSpec
+    left: EdgeSpec
+    right: EdgeSpec
+
+
+@dataclass(frozen=True, kw_only=True)
+class SolverSpec:
+    tolerance: float = 1.0e-8  # eta_0 on ||residual|| / ||F_ext||
+    max_iterations: int = 30  # Newton iterations per load step
+    tangent: str = "consistent"  # "consistent" | "secant" (paper eq. 28)
+    contact_patch: float = CONTACT_PATCH_CELLS  # patch length [cells]; 0 = pointwise
+    max_step_cuts: int = 5  # bisections of a failing load step
+    linear_solver: str = "auto"  # "auto" | "superlu" | "amg" (xfemslip.solve.linear)
+    kernels: str = "auto"  # "auto" | "numba" | "numpy" (xfemslip.kernels)
+    UNITS: ClassVar[dict[str, str]] = {
+        "tolerance": "-",
+        "max_iterations": "-",
+        "tangent": "",
+        "contact_patch": "cells",
+        "max_step_cuts": "-",
+        "linear_solver": "",
+        "kernels": "",
+    }
+
+
+@dataclass(frozen=True, kw_only=True)
+class OutputSpec:
+    directory: Path  # resolved: output.directory, else out/<name> (relative to cwd)
+    formats: tuple[str, ...] = ("h5", "vtu")
+
+
+@dataclass(frozen=True, kw_only=True)
+class PorePressureSpec:
+    """[pore_pressure]: initial pore pressure and its change (depletion < 0).
+
+    The change ``change`` [Pa] is applied proportionally over the load steps
+    (``loading.steps``), in the whole model (``region = "all"``) or inside the
+    ``[reservoir]`` only (``region = "reservoir"``).
+    """
+
+    initial: float  # p0 [Pa]
+    change: float  # final dp [Pa]; < 0 = depletion
+    biot: float  # alpha, 0 < alpha <= 1 [-]
+    region: str  # "all" | "reservoir"
+    UNITS: ClassVar[dict[str, str]] = {
+        "initial": "Pa",
+        "change": "Pa",
+        "biot": "-",
+        "region": "",
+    }
+
+
+@dataclass(frozen=True, kw_only=True)
+class ReservoirSpec:
+    """[reservoir]: a region of boxes, or one polygon, with its own elastic
+    constants.
+
+    ``boxes`` (k, 4) float64 [x0, y0, x1, y1] [m] ((0, 4) with a polygon);
+    ``polygon`` (k, 2) float64 vertices [m] or None.  An intact cell belongs
+    to the reservoir when its centre lies in the region (xfemslip.fem.poro).
+    """
+
+    boxes: np.ndarray  # (k, 4) float64 [m]
+    E: float  # [Pa]
+    nu: float  # [-]
+    polygon: np.ndarray | None = None  # (k, 2) float64 [m]
+    UNITS: ClassVar[dict[str, str]] = {
+        "boxes": "m",
+        "polygon": "m",
+        "E": "Pa",
+        "nu": "-",
+    }
+
+
+@dataclass(frozen=True, kw_only=True)
+class CaseSpec:
+    path: Path  # the case file
+    text: str  # the case file's text as read
+    name: str
+    origin: tuple[float, float]  # lower-left corner [m]
+    size: tuple[float, float]  # width, height [m]
+    mesh: MeshSpec
+    material: MaterialSpec
+    fractures: tuple[FractureSpec, ...] = field(default_factory=tuple)
+    loading: LoadingSpec
+    boundary: BoundarySpec
+    solver: SolverSpec
+    output: OutputSpec
+    pore_pressure: PorePressureSpec | None = None  # None: no pore pressure
+    reservoir: ReservoirSpec | None = None  # None: one material everywhere

@@ -1,0 +1,410 @@
+"""Commands ``xfemslip sweep | plot | screen``.
+
+These only parse arguments, print and map errors to exit codes
+(through ``cli.common.reported_errors``); the work is in
+:mod:`xfemslip.studies.sweep`, :mod:`xfemslip.studies.run`,
+:mod:`xfemslip.plot.figures` and :mod:`xfemslip.reference.screen`.
+matplotlib is imported only when a figure is drawn, Dask only with
+``--scheduler``.
+"""
+
+from __future__ import annotations
+
+import os
+import sys
+from pathlib import Path
+
+import click
+
+from xfemslip.case.files import path_problem
+from xfemslip.cli.common import (
+    EXIT_FAILURE,
+    FiniteFloat,
+    PathParam,
+    configure_logging,
+    debug_option,
+    load_case_file,
+    reported_errors,
+    shown_path,
+)
+from xfemslip.errors import UsageError
+
+# Each local worker holds its own interpreter, NumPy, SciPy and model
+# (~0.2-1 GB); more than a few per CPU only adds memory.
+MAX_JOBS = 4 * (os.cpu_count() or 1)
+# A figure of a few inches at this resolution is already ~100 megapixels.
+MAX_DPI = 2400.0
+KINDS = ("displacement", "principal_stress", "deformed_mesh", "slip", "mohr")
+
+
+# --------------------------------------------------------------------------- #
+# sweep
+# --------------------------------------------------------------------------- #
+
+
+@click.command()
+@click.argument("sweep_file", metavar="SWEEP", type=PathParam(path_type=Path))
+@click.option(
+    "-o",
+    "--output",
+    type=PathParam(file_okay=False, path_type=Path, empty_ok=False),
+    default=None,
+    help="Sweep folder [default: output.directory of the sweep, else "
+    "out/sweeps/<name>].",
+)
+@click.option(
+    "-j",
+    "--jobs",
+    type=click.IntRange(min=1, max=MAX_JOBS),
+    default=None,
+    help="Local worker processes [default: the number of CPUs, at most "
+    f"{MAX_JOBS} = 4 x CPUs]; 1 runs the cases in this process.",
+)
+@click.option(
+    "--scheduler",
+    metavar="ADDRESS",
+    default=None,
+    help="Run on an existing Dask cluster (e.g. tcp://host:8786) instead of "
+    "local processes; needs `pip install xfemslip[dask]`.",
+)
+@click.option("--force", is_flag=True, help="Rerun cases that already have a result.")
+@click.option("-v", "--verbose", is_flag=True, help="Log every case's messages.")
+@debug_option
+def sweep(sweep_file, output, jobs, scheduler, force, verbose, debug) -> None:
+    """Run the cases of the sweep file SWEEP (base case + varied parameters).
+
+    Each case writes into <folder>/<case id>/; cases with a converged result
+    of the same case text are skipped, cases that cannot be built are
+    reported and not run.  A table of the results is printed and written to
+    <folder>/summary.csv.  Exit 1 if a case failed or was refused.
+    """
+    with reported_errors(debug):
+        configure_logging(verbose, not verbose)
+        problem = path_problem(sweep_file)
+        if problem:
+            raise UsageError(f"{shown_path(sweep_file)}: the path {problem}")
+        if not sweep_file.is_file():
+            raise UsageError(f"{sweep_file}: no such file")
+        from xfemslip.studies.run import format_table, require_dask, run_sweep
+        from xfemslip.studies.sweep import load_sweep
+
+        if scheduler:
+            require_dask()
+        spec = load_sweep(sweep_file)
+        folder = output or spec.directory
+        n_jobs = jobs or os.cpu_count() or 1
+        where = f"Dask at {scheduler}" if scheduler else f"{n_jobs} local process(es)"
+        click.echo(
+            f"{spec.name}: {len(spec.cases)} case(s) -> {folder} ({where})", err=True
+        )
+        with click.progressbar(
+            length=len(spec.cases),
+            label=spec.name,
+            file=sys.stderr,  # click.get_text_stream is deprecated (Click 8.2)
+        ) as bar:
+            rows = run_sweep(
+                spec,
+                folder,
+                jobs=n_jobs,
+                scheduler=scheduler,
+                force=force,
+                progress=lambda row: bar.update(1),
+            )
+        click.echo(format_table(spec.keys, rows))
+        _print_dfn_aggregate(spec.keys, rows)
+        failed = sum(r.status == "failed" for r in rows)
+        refused = sum(r.status == "refused" for r in rows)
+        skipped = sum(r.status == "skipped" for r in rows)
+        click.echo(
+            f"summary: {folder / 'summary.csv'} ({len(rows) - failed - refused} "
+            f"done, {skipped} of them skipped as already done, "
+            f"{failed} failed, {refused} refused)",
+            err=True,
+        )
+        if failed or refused:
+            raise click.exceptions.Exit(EXIT_FAILURE)
+
+
+def _print_dfn_aggregate(keys, rows) -> None:
+    """Over network realizations: the aggregate table of dfn_summary.csv."""
+    from xfemslip.studies.dfn_summary import aggregate, format_aggregate, is_dfn_sweep
+
+    if is_dfn_sweep(keys):
+        click.echo("\nover the realizations (dfn_summary.csv):")
+        click.echo(format_aggregate(aggregate(rows)))
+
+
+# --------------------------------------------------------------------------- #
+# plot
+# --------------------------------------------------------------------------- #
+
+
+def _default_figure_dir(results: list[Path]) -> Path:
+    """One result: <its folder>/figures; several: <their common folder>/figures."""
+    folders = [(p if p.is_dir() else p.parent).resolve() for p in results]
+    if len(folders) == 1:
+        return folders[0] / "figures"
+    return Path(os.path.commonpath(folders)) / "figures"
+
+
+@click.command()
+@click.argument("results", nargs=-1, required=True, type=PathParam(path_type=Path))
+@click.option(
+    "-o",
+    "--output",
+    type=PathParam(file_okay=False, path_type=Path, empty_ok=False),
+    default=None,
+    help="Folder for the figures [default: <result folder>/figures, or the "
+    "results' common folder /figures].",
+)
+@click.option(
+    "--figure",
+    "kinds",
+    multiple=True,
+    type=click.Choice(KINDS),
+    help="Draw only this figure (repeatable) [default: all].",
+)
+@click.option(
+    "--format",
+    "formats",
+    multiple=True,
+    type=click.Choice(("png", "pdf")),
+    help="File format (repeatable) [default: png and pdf].",
+)
+@click.option(
+    "--label",
+    "labels",
+    multiple=True,
+    help="Legend label of each result, in order (repeatable).",
+)
+@click.option(
+    "--scale",
+    type=FiniteFloat(min=0.0, min_open=True),
+    default=None,
+    help="Displacement magnification of the deformed mesh [default: auto].",
+)
+@click.option(
+    "--dpi",
+    type=FiniteFloat(min=10.0, max=MAX_DPI),
+    default=110.0,
+    show_default=True,
+    help="Resolution of the PNG files.",
+)
+@debug_option
+def plot(results, output, kinds, formats, labels, scale, dpi, debug) -> None:
+    """Draw the paper's figures of one or several RESULTS (result.h5 files or
+    their folders); several results are drawn side by side or overlaid."""
+    with reported_errors(debug):
+        from xfemslip.plot.figures import plot_results
+
+        out_dir = output or _default_figure_dir(list(results))
+        written = plot_results(
+            list(results),
+            out_dir,
+            kinds=kinds or KINDS,
+            formats=formats or ("png", "pdf"),
+            labels=labels or None,
+            scale=scale,
+            dpi=dpi,
+        )
+        for path in written:
+            click.echo(str(path))
+
+
+def plot_run(out_dir: Path) -> None:
+    """``xfemslip run --plot``: every figure of the run into <out_dir>/figures."""
+    from xfemslip.plot.figures import plot_results
+
+    for path in plot_results([out_dir / "result.h5"], out_dir / "figures"):
+        click.echo(str(path))
+
+
+# --------------------------------------------------------------------------- #
+# screen
+# --------------------------------------------------------------------------- #
+
+
+@click.command()
+@click.argument("case", required=False, type=PathParam(path_type=Path))
+@click.option(
+    "--stress",
+    nargs=3,
+    type=FiniteFloat(),
+    default=None,
+    metavar="XX YY XY",
+    help="Total far-field stress [Pa], tension positive "
+    "[default: loading.stress of CASE].",
+)
+@click.option(
+    "-p",
+    "--pore-pressure",
+    type=FiniteFloat(),
+    default=None,
+    help="Pore pressure p [Pa]; effective stress = stress + p I "
+    "[default: the final far-field pore pressure of CASE's [pore_pressure], "
+    "else 0].",
+)
+@click.option(
+    "--friction",
+    type=FiniteFloat(min=0.0),
+    default=None,
+    help="Friction coefficient f [default: the first fracture's].",
+)
+@click.option(
+    "--cohesion",
+    type=FiniteFloat(min=0.0),
+    default=None,
+    help="Cohesion c [Pa] [default: the first fracture's, else 0].",
+)
+@click.option(
+    "--angle",
+    "angles",
+    multiple=True,
+    type=FiniteFloat(),
+    help="A fracture angle to screen [deg, CCW from +x] (repeatable) "
+    "[default: the fractures of CASE].",
+)
+@click.option(
+    "--step",
+    type=FiniteFloat(min=0.1, max=90.0),
+    default=5.0,
+    show_default=True,
+    help="Angle step of the orientation table [deg].",
+)
+@click.option(
+    "--csv",
+    "csv_path",
+    type=PathParam(dir_okay=False, path_type=Path, empty_ok=False),
+    default=None,
+    help="Also write the orientation table as CSV.",
+)
+@click.option(
+    "--plot",
+    "plot_dir",
+    type=PathParam(file_okay=False, path_type=Path, empty_ok=False),
+    default=None,
+    help="Also draw the Mohr diagram into this folder.",
+)
+@click.option(
+    "--format",
+    "formats",
+    multiple=True,
+    type=click.Choice(("png", "pdf")),
+    help="Format of the --plot files (repeatable) [default: png and pdf].",
+)
+@debug_option
+def screen(
+    case,
+    stress,
+    pore_pressure,
+    friction,
+    cohesion,
+    angles,
+    step,
+    csv_path,
+    plot_dir,
+    formats,
+    debug,
+) -> None:
+    """Closed-form slip screening of every orientation (and of the fractures of
+    CASE): slip tendency, Coulomb margin, the band that slips and the
+    pore-pressure change at which each fracture slips.  Stresses in Pa,
+    tension positive."""
+    with reported_errors(debug):
+        from xfemslip.reference import screen as scr
+
+        stress, fractures = _screen_inputs(case, stress, friction, cohesion, angles)
+        if pore_pressure is None:
+            pore_pressure = _case_pore_pressure(case)
+        f0 = friction if friction is not None else fractures[0][2]
+        c0 = cohesion if cohesion is not None else fractures[0][3]
+        screened = [
+            scr.screen_fracture(
+                label,
+                theta,
+                stress,
+                pore_pressure,
+                f if friction is None else friction,
+                c if cohesion is None else cohesion,
+            )
+            for label, theta, f, c in fractures
+            if label
+        ]
+        click.echo(scr.format_report(stress, pore_pressure, f0, c0, step, screened))
+        if csv_path is not None:
+            _write_screen_csv(
+                csv_path,
+                scr.orientation_table(stress, pore_pressure, f0, c0, _angles(step)),
+            )
+        if plot_dir is not None:
+            from xfemslip.plot.figures import plot_screen
+
+            for path in plot_screen(
+                plot_dir,
+                stress,
+                pore_pressure,
+                f0,
+                c0,
+                [(s.label, s.theta, s.friction, s.cohesion) for s in screened],
+                formats or ("png", "pdf"),
+            ):
+                click.echo(str(path), err=True)
+
+
+def _angles(step: float):
+    import numpy as np
+
+    return np.arange(0.0, 180.0, step)
+
+
+def _case_pore_pressure(case) -> float:
+    """Final far-field pore pressure of CASE's [pore_pressure] (initial, plus
+    the change when it acts in the whole model), else 0 [Pa]."""
+    spec = load_case_file(case) if case is not None else None
+    pp = None if spec is None else spec.pore_pressure
+    if pp is None:
+        return 0.0
+    return pp.initial + (pp.change if pp.region == "all" else 0.0)
+
+
+def _screen_inputs(case, stress, friction, cohesion, angles):
+    """(stress, [(label, theta, f, c)]) from CASE and the options; a
+    fracture-less entry (label "") carries the defaults of f and c."""
+    spec = load_case_file(case) if case is not None else None
+    if stress is None:
+        if spec is None or spec.loading.stress is None:
+            raise UsageError(
+                "screen needs --stress XX YY XY or a CASE with loading.stress"
+            )
+        stress = spec.loading.stress
+    if angles:
+        fractures = [(f"angle {a:g}", a, friction, cohesion) for a in angles]
+    elif spec is not None and spec.fractures:
+        from xfemslip.reference.screen import case_fractures
+
+        fractures = case_fractures(spec)
+    else:
+        fractures = [("", 0.0, friction, cohesion)]
+    f0 = friction if friction is not None else fractures[0][2]
+    if f0 is None:
+        raise UsageError("screen needs --friction (or a CASE with a fracture)")
+    c0 = cohesion if cohesion is not None else (fractures[0][3] or 0.0)
+    fractures = [
+        (lab, th, f0 if f is None else f, c0 if c is None else c)
+        for lab, th, f, c in fractures
+    ]
+    return tuple(float(v) for v in stress), fractures
+
+
+def _write_screen_csv(path: Path, table: dict) -> None:
+    from xfemslip.io.csv import write_csv
+
+    names = list(table)
+    rows = (
+        [
+            f"{table[n][i]:.9g}" if n != "slips" else str(bool(table[n][i])).lower()
+            for n in names
+        ]
+        for i in range(len(table[names[0]]))
+    )
+    write_csv(path, names, rows)

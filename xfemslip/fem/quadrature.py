@@ -1,0 +1,229 @@
+"""Quadrature: sub-cell rules of enriched cells and interface points on fractures.
+
+Enriched cells are cut into convex sub-polygons along every line across which
+an enrichment function is not smooth (the fracture segments, the two kink
+lines of each tip ramp and the junction lines, see ``Fracture.kink_lines``
+and ``enrichment._cell_lines``), each sub-polygon is
+fan-triangulated and integrated with the 7-point degree-5 Dunavant rule, which
+is exact for the degree-4 integrand of B^T D B inside a sub-cell (bilinear N
+times linear F).  The side of the fracture (H in eq. 12) is taken at each
+sub-cell's centroid, never at a point on the fracture.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from xfemslip.geometry.fracture import GEOMETRY_TOL
+
+# Dunavant (1985) degree-5 rule on the reference triangle: barycentric points and
+# weights (summing to 1).
+_A1, _B1 = 0.059715871789770, 0.470142064105115
+_A2, _B2 = 0.797426985353087, 0.101286507323456
+TRI_BARY = np.array(
+    [
+        [1 / 3, 1 / 3, 1 / 3],
+        [_A1, _B1, _B1],
+        [_B1, _A1, _B1],
+        [_B1, _B1, _A1],
+        [_A2, _B2, _B2],
+        [_B2, _A2, _B2],
+        [_B2, _B2, _A2],
+    ]
+)
+TRI_W = np.array([0.225] + [0.132394152788506] * 3 + [0.125939180544827] * 3)
+
+# Gauss-Legendre points per fracture piece: exact for the degree-6 penalty
+# integrand (jump = 2 R N a is at most cubic along a piece).
+LINE_POINTS, LINE_WEIGHTS = np.polynomial.legendre.leggauss(4)
+
+
+def split_polygon(poly: np.ndarray, point: np.ndarray, normal: np.ndarray, tol: float):
+    """Split a convex polygon (k, 2) by a line; returns a list of 1 or 2 polygons.
+
+    Vertices within tol of the line count as on it, so a line through a vertex
+    or along an edge never makes a sliver.
+    """
+    d = (poly - point) @ normal
+    d[np.abs(d) <= tol] = 0.0
+    if np.all(d >= 0.0) or np.all(d <= 0.0):
+        return [poly]
+    pos, neg = [], []
+    k = poly.shape[0]
+    for i in range(k):
+        p, q = poly[i], poly[(i + 1) % k]
+        dp, dq = d[i], d[(i + 1) % k]
+        if dp >= 0.0:
+            pos.append(p)
+        if dp <= 0.0:
+            neg.append(p)
+        if dp * dq < 0.0:
+            x = p + dp / (dp - dq) * (q - p)
+            pos.append(x)
+            neg.append(x)
+    # a line within tol of a corner can leave a degenerate piece (3 coincident
+    # points): keep only pieces with area
+    pieces = [np.array(v) for v in (pos, neg) if len(v) >= 3]
+    pieces = [v for v in pieces if polygon_area(v) > tol * tol]
+    return pieces or [poly]
+
+
+def polygon_area(poly: np.ndarray) -> float:
+    x, y = poly[:, 0], poly[:, 1]
+    return 0.5 * float(np.dot(x, np.roll(y, -1)) - np.dot(y, np.roll(x, -1)))
+
+
+def fan_triangles(poly: np.ndarray, min_area: float) -> np.ndarray:
+    """Triangles (t, 3, 2) of a convex polygon, dropping degenerate ones."""
+    tris = np.array(
+        [[poly[0], poly[i], poly[i + 1]] for i in range(1, poly.shape[0] - 1)]
+    )
+    if tris.size == 0:
+        return np.zeros((0, 3, 2))
+    e1 = tris[:, 1] - tris[:, 0]
+    e2 = tris[:, 2] - tris[:, 0]
+    area = 0.5 * (e1[:, 0] * e2[:, 1] - e1[:, 1] * e2[:, 0])
+    return tris[area > min_area]
+
+
+def cell_subtriangles(bounds: np.ndarray, lines, tol: float, apexes=()) -> np.ndarray:
+    """Sub-triangles (t, 3, 2) of a rectangle cut along the given lines.
+
+    A sub-polygon with a vertex at one of the ``apexes`` (crack tips) is fanned
+    from that vertex, so the tip is vertex 0 of its triangles (Duffy rule).
+    """
+    x0, x1, y0, y1 = bounds
+    polys = [np.array([[x0, y0], [x1, y0], [x1, y1], [x0, y1]])]
+    for point, normal in lines:
+        polys = [
+            piece for poly in polys for piece in split_polygon(poly, point, normal, tol)
+        ]
+    for i, poly in enumerate(polys):
+        for apex in apexes:
+            dist = np.linalg.norm(poly - apex, axis=1)
+            j = int(np.argmin(dist))
+            if dist[j] <= tol:
+                polys[i] = np.roll(poly, -j, axis=0)
+                break
+    min_area = (tol * tol) * 1e-3
+    return np.concatenate([fan_triangles(p, min_area) for p in polys], axis=0)
+
+
+# Collapsed (Duffy) product rule for triangles with a 1/sqrt(r) gradient
+# singularity at vertex 0: x = v0 + u (v1 - v0 + v (v2 - v1)), dA = 2 A u du dv,
+# with u = s^2 so that both the 1/r of |grad B|^2 and the 1/sqrt(r) of
+# grad N . grad B become polynomials in (s, v): dA = 4 A s^3 ds dv.
+DUFFY_POINTS = 8
+_g, _gw = np.polynomial.legendre.leggauss(DUFFY_POINTS)
+_DS, _DV = np.meshgrid(0.5 * (_g + 1.0), 0.5 * (_g + 1.0), indexing="ij")
+_DW = np.outer(0.5 * _gw, 0.5 * _gw)
+
+
+def duffy_rule(tris: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Collapsed Gauss points (t*P, 2) and weights (t*P,) on triangles (t, 3, 2)."""
+    v0, v1, v2 = tris[:, 0], tris[:, 1], tris[:, 2]
+    e1 = v1 - v0
+    e2 = v2 - v0
+    area = 0.5 * np.abs(e1[:, 0] * e2[:, 1] - e1[:, 1] * e2[:, 0])
+    sq = _DS.ravel()
+    u = sq * sq
+    v = _DV.ravel()
+    xy = v0[:, None, :] + u[None, :, None] * (
+        (v1 - v0)[:, None, :] + v[None, :, None] * (v2 - v1)[:, None, :]
+    )
+    w = 4.0 * area[:, None] * (sq**3 * _DW.ravel())[None, :]
+    return xy.reshape(-1, 2), w.reshape(-1)
+
+
+def triangle_rule(tris: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Quadrature points (t*7, 2) and weights (t*7,) on triangles (t, 3, 2)."""
+    e1 = tris[:, 1] - tris[:, 0]
+    e2 = tris[:, 2] - tris[:, 0]
+    area = 0.5 * np.abs(e1[:, 0] * e2[:, 1] - e1[:, 1] * e2[:, 0])
+    xy = np.einsum("qk,tkd->tqd", TRI_BARY, tris).reshape(-1, 2)
+    w = (area[:, None] * TRI_W[None, :]).reshape(-1)
+    return xy, w
+
+
+@dataclass(frozen=True)
+class InterfacePoints:
+    """Contact integration points of all fractures (flat arrays, n points)."""
+
+    fracture: np.ndarray  # (n,) int64, position in the fracture list
+    cell: np.ndarray  # (n,) int64
+    xy: np.ndarray  # (n, 2) [m]
+    s: np.ndarray  # (n,) arc length from the fracture's first point [m]
+    weight: np.ndarray  # (n,) [m]
+    normal: np.ndarray  # (n, 2)
+    tangent: np.ndarray  # (n, 2)
+    ramp: np.ndarray  # (n,) tip ramp R [-]
+
+    @property
+    def n(self) -> int:
+        return self.fracture.size
+
+
+def interface_points(fractures, min_cell: float | None = None) -> InterfacePoints:
+    """Gauss points on every piece of every fracture, split at the ramp kinks.
+
+    min_cell : smallest element size [m]; sub-pieces shorter than
+    GEOMETRY_TOL * min_cell (a kink falling on a piece's end) are skipped
+    (default: 1e-12 of the segment length).
+    """
+    cols = {
+        k: [] for k in ("fracture", "cell", "xy", "s", "weight", "normal", "tangent")
+    }
+    for fi, fr in enumerate(fractures):
+        for cell, seg, (ta, tb) in zip(
+            fr.piece_cell, fr.piece_seg, fr.piece_t, strict=True
+        ):
+            p0 = fr.points[seg]
+            d = fr.points[seg + 1] - p0
+            cuts = [ta, tb]
+            for tip in fr.tips:
+                dd = d @ tip.direction
+                if abs(dd) > 0.0:
+                    t = (-tip.ramp_length - (p0 - tip.point) @ tip.direction) / dd
+                    if ta < t < tb:
+                        cuts.append(t)
+            cuts = np.sort(cuts)
+            tol = GEOMETRY_TOL * min_cell if min_cell else 1e-12 * fr.length[seg]
+            keep = np.diff(cuts) * fr.length[seg] > tol
+            for a, b in zip(cuts[:-1][keep], cuts[1:][keep], strict=True):
+                t = 0.5 * (a + b) + 0.5 * (b - a) * LINE_POINTS
+                cols["fracture"].append(np.full(t.size, fi))
+                cols["cell"].append(np.full(t.size, cell))
+                cols["xy"].append(p0 + t[:, None] * d)
+                cols["s"].append(fr.arc_length(np.full(t.size, seg), t))
+                cols["weight"].append(0.5 * (b - a) * fr.length[seg] * LINE_WEIGHTS)
+                cols["normal"].append(np.tile(fr.normal[seg], (t.size, 1)))
+                cols["tangent"].append(np.tile(fr.tangent[seg], (t.size, 1)))
+    if not cols["fracture"]:
+        empty2 = np.zeros((0, 2))
+        return InterfacePoints(
+            np.zeros(0, np.int64),
+            np.zeros(0, np.int64),
+            empty2,
+            np.zeros(0),
+            np.zeros(0),
+            empty2,
+            empty2,
+            np.zeros(0),
+        )
+    arr = {k: np.concatenate(v) for k, v in cols.items()}
+    ramp = np.empty(arr["s"].size)
+    for fi, fr in enumerate(fractures):
+        m = arr["fracture"] == fi
+        ramp[m] = fr.ramp(arr["xy"][m])[0]
+    return InterfacePoints(
+        fracture=arr["fracture"].astype(np.int64),
+        cell=arr["cell"].astype(np.int64),
+        xy=arr["xy"],
+        s=arr["s"],
+        weight=arr["weight"],
+        normal=arr["normal"],
+        tangent=arr["tangent"],
+        ramp=ramp,
+    )

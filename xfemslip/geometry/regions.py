@@ -1,0 +1,105 @@
+"""Reservoir regions: axis-aligned boxes or one simple polygon (pure NumPy).
+
+Used by xfemslip.case.pore (validation: does the region hold a cell centre, is the
+polygon simple) and poro.py (which cells, quadrature points and fracture
+faces lie in the reservoir).  Membership is strict for boxes; a point exactly
+on a polygon edge may fall on either side (even-odd rule).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from xfemslip.geometry.polyline import first_meeting
+
+
+def in_boxes(xy: np.ndarray, boxes: np.ndarray) -> np.ndarray:
+    """(n,) bool: points strictly inside one of the boxes (k, 4) [x0, y0, x1, y1]."""
+    xy = np.asarray(xy, float).reshape(-1, 2)
+    inside = np.zeros(xy.shape[0], bool)
+    for x0, y0, x1, y1 in np.asarray(boxes, float).reshape(-1, 4):
+        inside |= (xy[:, 0] > x0) & (xy[:, 0] < x1) & (xy[:, 1] > y0) & (xy[:, 1] < y1)
+    return inside
+
+
+# Point-edge pairs tested at once by in_polygon (bounds a chunk's memory).
+_PAIR_CHUNK = 1 << 20
+
+
+def in_polygon(xy: np.ndarray, polygon: np.ndarray) -> np.ndarray:
+    """(n,) bool: points inside the polygon (k, 2) [m] (even-odd crossings of a
+    ray towards +x).
+
+    An edge P-Q can only cross the ray of a point whose y lies in
+    [min(P_y, Q_y), max(P_y, Q_y)); with the points sorted by y those points
+    are a contiguous run, so only these (point, edge) pairs are formed, in
+    chunks: the work follows the number of edges a horizontal line meets, not
+    points x edges.
+    """
+    xy = np.asarray(xy, float).reshape(-1, 2)
+    P = np.asarray(polygon, float)
+    Q = np.roll(P, -1, axis=0)
+    order = np.argsort(xy[:, 1], kind="stable")
+    ys = xy[order, 1]
+    first = np.searchsorted(ys, np.minimum(P[:, 1], Q[:, 1]), side="left")
+    stop = np.searchsorted(ys, np.maximum(P[:, 1], Q[:, 1]), side="left")
+    count = stop - first
+    crossings = np.zeros(xy.shape[0], np.int64)
+    edge = 0
+    while edge < len(P):
+        end = edge + max(
+            1, int(np.searchsorted(np.cumsum(count[edge:]), _PAIR_CHUNK, "right"))
+        )
+        block = count[edge:end]
+        e = np.repeat(np.arange(edge, end), block)
+        pos = np.repeat(first[edge:end] - np.cumsum(block) + block, block)
+        pt = order[pos + np.arange(e.size)]
+        x, y = xy[pt, 0], xy[pt, 1]
+        with np.errstate(divide="ignore", invalid="ignore"):
+            x_cross = P[e, 0] + (y - P[e, 1]) * (Q[e, 0] - P[e, 0]) / (
+                Q[e, 1] - P[e, 1]
+            )
+        crossings += np.bincount(pt[x < x_cross], minlength=xy.shape[0])
+        edge = end
+    return crossings % 2 == 1
+
+
+def in_region(xy: np.ndarray, reservoir) -> np.ndarray:
+    """(n,) bool: points in the reservoir (its polygon, else its boxes)."""
+    if reservoir.polygon is not None:
+        return in_polygon(xy, reservoir.polygon)
+    return in_boxes(xy, reservoir.boxes)
+
+
+def edges(reservoir) -> list[tuple[str, np.ndarray, np.ndarray]]:
+    """(name, start, end) of every edge of the region, named by case key."""
+    if reservoir.polygon is not None:
+        P = np.asarray(reservoir.polygon, float)
+        return [(f"polygon edge {i}", P[i], P[(i + 1) % len(P)]) for i in range(len(P))]
+    out = []
+    for i, (x0, y0, x1, y1) in enumerate(np.asarray(reservoir.boxes, float)):
+        out += [
+            (f"box {i}: x0 = {x0:g}", np.array([x0, y0]), np.array([x0, y1])),
+            (f"box {i}: x1 = {x1:g}", np.array([x1, y0]), np.array([x1, y1])),
+            (f"box {i}: y0 = {y0:g}", np.array([x0, y0]), np.array([x1, y0])),
+            (f"box {i}: y1 = {y1:g}", np.array([x0, y1]), np.array([x1, y1])),
+        ]
+    return out
+
+
+def polygon_problem(polygon: np.ndarray) -> str | None:
+    """Why the polygon (k >= 3, 2) is not simple, or None: zero area, or two
+    edges that meet other than at their shared vertex."""
+    P = np.asarray(polygon, float)
+    k = len(P)
+    area = 0.5 * np.sum(P[:, 0] * np.roll(P[:, 1], -1) - np.roll(P[:, 0], -1) * P[:, 1])
+    repeated = np.flatnonzero(np.all(P == np.roll(P, -1, axis=0), axis=1))
+    if repeated.size:
+        i = int(repeated[0])
+        return f"repeats vertex {i} (vertices {i} and {(i + 1) % k} coincide)"
+    pair = first_meeting(P, closed=True)
+    if pair is not None:
+        return f"is not simple: edges {pair[0]} and {pair[1]} cross or touch"
+    if area == 0.0:
+        return "has zero area"
+    return None

@@ -1,0 +1,272 @@
+"""``result.h5``: the complete result of a run (``output-format.md``, version 1).
+
+Layout (every dataset carries ``attrs["units"]``: ``"m"``, ``"Pa"`` or ``"-"``)::
+
+    /                         attrs: format_version, xfemslip_version, case_toml,
+                                     converged, load_steps, newton_iterations,
+                                     wall_time_s (+ any extra attrs of the caller)
+    /mesh/points              (N, 2) float64 [m]
+    /mesh/cells               (M, 4) int64   [-]  Q4, counter-clockwise
+    /fields/displacement      (N, 2) float64 [m]      final converged step
+    /fields/stress            (M, 3) float64 [Pa]     sxx, syy, sxy
+    /fields/stress_zz         (M,)   float64 [Pa]
+    /fields/principal_stress  (M, 2) float64 [Pa]     s_max, s_min
+    /fractures/<i>/s, points, slip, opening, normal_traction, shear_traction,
+                   state (int8: 0 open, 1 stick, 2 slip),
+                   contact_pressure = max(0, -normal_traction) [Pa]
+    with [pore_pressure] (xfemslip.fem.poro) also: /fields/effective_stress (M, 3)
+    sigma + alpha p I, /fields/pore_pressure (M,), and per fracture
+    fluid_pressure and effective_normal_traction (normal_traction is total)
+    /steps/<kkkk>/            only when load_steps > 1; attrs load_factor,
+                              newton_iterations; holds fields/displacement and
+                              fractures/<i>/* of that step
+
+``<i>`` is the fracture's index in the case file (its position in
+``StepFields.fractures``).  ``contact_pressure`` is an extra dataset for readers
+who think compression-positive; it is *named* so and never replaces
+``normal_traction`` (tension positive).
+
+When ``steps`` is empty (the first load step did not converge) the file holds
+the mesh and the root attributes only: no ``/fields``, ``/fractures`` or
+``/steps``.  The file is written atomically (:mod:`xfemslip.io.atomic`) and
+carries no timestamps, so the same input gives the same bytes.  The root
+attribute ``run_id`` (:func:`xfemslip.post.result.run_id`, given by the caller)
+is the id that every file of its output set carries.
+"""
+
+from __future__ import annotations
+
+import io
+import logging
+from collections.abc import Mapping, Sequence
+from pathlib import Path
+
+import h5py
+import numpy as np
+
+from xfemslip import __version__, interrupt
+from xfemslip.conventions import STATE_CODES
+from xfemslip.io.atomic import atomic_path, refuse_non_finite
+from xfemslip.post.fields import FractureFields, StepFields
+
+logger = logging.getLogger(__name__)
+
+FORMAT_VERSION = 1
+
+# Root attributes of output-format.md that the caller must provide.
+REQUIRED_ATTRS = ("case_toml", "converged", "newton_iterations", "wall_time_s")
+
+# (name, units, dtype, trailing shape) of each fracture dataset; K rows each.
+FRACTURE_DATASETS = (
+    ("s", "m", np.float64, ()),
+    ("points", "m", np.float64, (2,)),
+    ("slip", "m", np.float64, ()),
+    ("opening", "m", np.float64, ()),
+    ("normal_traction", "Pa", np.float64, ()),
+    ("shear_traction", "Pa", np.float64, ()),
+    ("state", "-", np.int8, ()),
+)
+
+
+def write_result(
+    path: Path | str,
+    *,
+    points: np.ndarray,
+    cells: np.ndarray,
+    steps: Sequence[StepFields],
+    attrs: Mapping[str, object],
+    load_steps: int,
+) -> None:
+    """Write ``result.h5`` atomically.
+
+    Parameters
+    ----------
+    path : Path
+        Final file name (normally ``<out_dir>/result.h5``).
+    points : (N, 2) float64 [m]
+        Node coordinates.
+    cells : (M, 4) int64
+        Q4 connectivity, counter-clockwise.
+    steps : list of StepFields
+        The converged load steps in order; the last one is written at the root.
+        May be empty (then the file holds the mesh only).
+    attrs : mapping
+        Root attributes: at least ``case_toml``, ``converged``,
+        ``newton_iterations`` and ``wall_time_s``; ``format_version``,
+        ``xfemslip_version`` and ``load_steps`` default to 1, the package
+        version and ``load_steps``.  Extra entries (scalars, strings or arrays)
+        are written as given.
+    load_steps : int
+        Number of load steps of the case; ``/steps/`` is written when > 1.
+
+    Raises
+    ------
+    ValueError
+        Missing required attributes or arrays of the wrong shape (programming
+        errors).
+    OutputError
+        The file cannot be written.
+    """
+    points = _as_array(points, np.float64, (None, 2), "points")
+    cells = _as_array(cells, np.int64, (None, 4), "cells")
+    root_attrs = _root_attrs(attrs, load_steps)
+    # HDF5 builds the file in memory and Python writes it out: a write that
+    # fails (a full disk) is then a plain OSError here, whereas a failure inside
+    # the HDF5 library leaves identifiers it cannot close, which print errors
+    # from their destructors and can crash the interpreter at exit.
+    with atomic_path(Path(path)) as tmp:
+        image = io.BytesIO()
+        with h5py.File(image, "w", track_order=True) as h5:
+            _fill(h5, root_attrs, points, cells, steps, load_steps)
+        with open(tmp, "wb") as fh:
+            fh.write(image.getbuffer())
+
+
+def _fill(h5, root_attrs, points, cells, steps, load_steps) -> None:
+    """The content of ``result.h5`` (see the module docstring)."""
+    n_nodes, n_cells = points.shape[0], cells.shape[0]
+    for key, value in root_attrs.items():
+        h5.attrs[key] = value
+    mesh = h5.create_group("mesh", track_order=True)
+    _dataset(mesh, "points", points, "m")
+    _dataset(mesh, "cells", cells, "-")
+    if not steps:
+        logger.debug("no converged step: writing the mesh only")
+        return
+    final = steps[-1]
+    _write_bulk_fields(
+        h5.create_group("fields", track_order=True), final, n_nodes, n_cells
+    )
+    _write_fractures(h5, final.fractures)
+    if load_steps > 1:
+        steps_group = h5.create_group("steps", track_order=True)
+        for step in steps:
+            _write_step(steps_group, step, n_nodes)
+
+
+def _root_attrs(attrs: Mapping[str, object], load_steps: int) -> dict[str, object]:
+    """Root attributes: contract defaults, then the caller's; checked for the rest."""
+    missing = [key for key in REQUIRED_ATTRS if key not in attrs]
+    if missing:
+        raise ValueError(f"write_result: missing root attributes {missing}")
+    merged: dict[str, object] = {
+        "format_version": FORMAT_VERSION,
+        "xfemslip_version": __version__,
+        "case_toml": None,
+        "converged": None,
+        "load_steps": int(load_steps),
+        "newton_iterations": None,
+        "wall_time_s": None,
+    }
+    merged.update(attrs)
+    for key, value in merged.items():
+        if value is None:
+            raise ValueError(f"write_result: root attribute {key!r} is None")
+        if isinstance(value, bool):
+            merged[key] = np.bool_(value)
+    return merged
+
+
+def _write_bulk_fields(
+    group: h5py.Group, step: StepFields, n_nodes: int, n_cells: int
+) -> None:
+    """``/fields/*`` of the final step."""
+    _dataset(
+        group,
+        "displacement",
+        _as_array(step.displacement, np.float64, (n_nodes, 2), "displacement"),
+        "m",
+    )
+    _dataset(
+        group,
+        "stress",
+        _as_array(step.stress, np.float64, (n_cells, 3), "stress"),
+        "Pa",
+    )
+    _dataset(
+        group,
+        "stress_zz",
+        _as_array(step.stress_zz, np.float64, (n_cells,), "stress_zz"),
+        "Pa",
+    )
+    _dataset(
+        group,
+        "principal_stress",
+        _as_array(step.principal_stress, np.float64, (n_cells, 2), "principal_stress"),
+        "Pa",
+    )
+    # with pore pressure only (xfemslip.fem.poro); /fields/stress stays total
+    optional = (("effective_stress", (n_cells, 3)), ("pore_pressure", (n_cells,)))
+    for name, shape in optional:
+        value = getattr(step, name, None)
+        if value is not None:
+            _dataset(group, name, _as_array(value, np.float64, shape, name), "Pa")
+
+
+def _write_step(steps_group: h5py.Group, step: StepFields, n_nodes: int) -> None:
+    """``/steps/<kkkk>/``: displacement and fracture fields of one load step."""
+    group = steps_group.create_group(f"{int(step.step):04d}", track_order=True)
+    group.attrs["load_factor"] = float(step.load_factor)
+    group.attrs["newton_iterations"] = int(step.newton_iterations)
+    fields = group.create_group("fields", track_order=True)
+    _dataset(
+        fields,
+        "displacement",
+        _as_array(step.displacement, np.float64, (n_nodes, 2), "displacement"),
+        "m",
+    )
+    _write_fractures(group, step.fractures)
+
+
+def _write_fractures(parent: h5py.Group, fractures: Sequence[FractureFields]) -> None:
+    """``<parent>/fractures/<i>/*`` for each fracture (``i`` = case-file index)."""
+    if not fractures:
+        return
+    group = parent.create_group("fractures", track_order=True)
+    for index, fracture in enumerate(fractures):
+        _write_fracture(group.create_group(str(index), track_order=True), fracture)
+
+
+def _write_fracture(group: h5py.Group, fracture: FractureFields) -> None:
+    """The contact fields of one fracture, K points each, plus contact_pressure."""
+    n_points = np.shape(fracture.s)[0]
+    for name, units, dtype, trailing in FRACTURE_DATASETS:
+        value = _as_array(getattr(fracture, name), dtype, (n_points, *trailing), name)
+        dataset = _dataset(group, name, value, units)
+        if name == "state":
+            dataset.attrs["codes"] = STATE_CODES
+    normal = _as_array(
+        fracture.normal_traction, np.float64, (n_points,), "normal_traction"
+    )
+    # + 0.0 turns the -0.0 of max(-0.0, 0.0) into 0.0.
+    _dataset(group, "contact_pressure", np.maximum(-normal, 0.0) + 0.0, "Pa")
+    for name in ("fluid_pressure", "effective_normal_traction"):  # pore pressure
+        value = getattr(fracture, name, None)
+        if value is not None:
+            _dataset(group, name, _as_array(value, np.float64, (n_points,), name), "Pa")
+
+
+def _dataset(
+    group: h5py.Group, name: str, value: np.ndarray, units: str
+) -> h5py.Dataset:
+    """Create one dataset without timestamps and tag it with its units."""
+    interrupt.checkpoint()  # between data sets: a deferred signal stops here
+    refuse_non_finite(value, f"{group.name}/{name}")
+    dataset = group.create_dataset(name, data=value, track_times=False)
+    dataset.attrs["units"] = units
+    return dataset
+
+
+def _as_array(value, dtype, shape: tuple, name: str) -> np.ndarray:
+    """``value`` as a C-contiguous array of ``dtype`` and ``shape`` (None = any)."""
+    array = np.ascontiguousarray(value, dtype=dtype)
+    ok = array.ndim == len(shape) and all(
+        want is None or want == got
+        for want, got in zip(shape, array.shape, strict=True)
+    )
+    if not ok:
+        want = tuple("*" if n is None else n for n in shape)
+        raise ValueError(
+            f"write_result: {name} has shape {array.shape}, expected {want}"
+        )
+    return array

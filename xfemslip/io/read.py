@@ -1,0 +1,161 @@
+"""The reader of ``result.h5``: the one place a result file is read back.
+
+``read_result(path)`` returns the :class:`~xfemslip.post.result.Result` that
+:func:`xfemslip.run_case` returned for the run that wrote the file, array for
+array (``output-format.md``: the element stresses are stored for the final
+step only, so the other steps carry None there).  ``read_attrs(path)`` reads
+the root attributes alone (whether a sweep member is done, without loading
+its fields).  The figures, the sweep summaries, ``dfn --result`` and the tests
+go through these two.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any
+
+import h5py
+import numpy as np
+
+from xfemslip.errors import UsageError
+from xfemslip.post.fields import FractureFields, StepFields
+from xfemslip.post.result import Result
+
+__all__ = ["read_attrs", "read_result"]
+
+# Datasets of each fracture group read into FractureFields (contact_pressure
+# is derived from normal_traction and not kept).
+FRACTURE_ARRAYS = (
+    "s",
+    "points",
+    "slip",
+    "opening",
+    "normal_traction",
+    "shear_traction",
+    "state",
+)
+OPTIONAL_FRACTURE_ARRAYS = ("fluid_pressure", "effective_normal_traction")
+BULK_ARRAYS = ("stress", "stress_zz", "principal_stress")
+OPTIONAL_BULK_ARRAYS = ("effective_stress", "pore_pressure")
+
+
+def _result_file(path: str | Path) -> Path:
+    """``path``, or ``path/result.h5`` for a folder; UsageError when missing."""
+    path = Path(path)
+    if path.is_dir():
+        path = path / "result.h5"
+    if not path.is_file():
+        raise UsageError(f"{path}: no such file (expected a result.h5)")
+    return path
+
+
+def _open(path: Path) -> h5py.File:
+    try:
+        return h5py.File(path, "r")
+    except OSError as exc:
+        raise UsageError(f"{path}: not a readable result.h5: {exc}") from None
+
+
+def _plain(value: Any) -> Any:
+    """An attribute as Python: NumPy scalars become bool, int, float; arrays
+    stay arrays."""
+    if isinstance(value, np.generic):
+        return value.item()
+    if isinstance(value, bytes):
+        return value.decode("utf-8")
+    return value
+
+
+def read_attrs(path: str | Path) -> dict[str, Any]:
+    """The root attributes of a ``result.h5`` (or of ``path/result.h5``).
+
+    Raises UsageError when the file is missing or not HDF5.
+    """
+    path = _result_file(path)
+    with _open(path) as h5:
+        return {key: _plain(value) for key, value in h5.attrs.items()}
+
+
+def _fractures(group: h5py.Group | None) -> list[FractureFields]:
+    """``<group>/fractures/<i>/*`` in the order of ``i`` (case-file index)."""
+    if group is None or "fractures" not in group:
+        return []
+    parent = group["fractures"]
+    out = []
+    for name in sorted(parent, key=int):
+        g = parent[name]
+        arrays = {key: g[key][()] for key in FRACTURE_ARRAYS}
+        arrays |= {key: g[key][()] for key in OPTIONAL_FRACTURE_ARRAYS if key in g}
+        out.append(FractureFields(**arrays))
+    return out
+
+
+def _bulk(h5: h5py.File) -> dict[str, np.ndarray]:
+    fields = h5["fields"]
+    arrays = {key: fields[key][()] for key in BULK_ARRAYS}
+    arrays |= {key: fields[key][()] for key in OPTIONAL_BULK_ARRAYS if key in fields}
+    return arrays
+
+
+def _steps(h5: h5py.File, attrs: dict) -> list[StepFields]:
+    """Every converged step: /steps/<k> with the final one's bulk fields from
+    /fields; a one-step run has the root only."""
+    if "fields" not in h5:
+        return []  # the first load step did not converge
+    bulk = _bulk(h5)
+    if "steps" not in h5:
+        return [
+            StepFields(
+                step=1,
+                load_factor=1.0,
+                newton_iterations=int(attrs["newton_iterations"]),
+                displacement=h5["fields/displacement"][()],
+                fractures=_fractures(h5),
+                **bulk,
+            )
+        ]
+    names = sorted(h5["steps"], key=int)
+    steps = []
+    for name in names:
+        group = h5["steps"][name]
+        last = name == names[-1]
+        empty = dict.fromkeys(BULK_ARRAYS)
+        steps.append(
+            StepFields(
+                step=int(name),
+                load_factor=float(group.attrs["load_factor"]),
+                newton_iterations=int(group.attrs["newton_iterations"]),
+                displacement=group["fields/displacement"][()],
+                fractures=_fractures(group),
+                **(bulk if last else empty),
+            )
+        )
+    return steps
+
+
+def read_result(path: str | Path) -> Result:
+    """Read a ``result.h5`` (or ``path/result.h5``) into a Result.
+
+    A file whose first load step did not converge gives a Result without
+    steps.  Raises UsageError when the file is missing, not HDF5, or lacks a
+    dataset of the format.
+    """
+    path = _result_file(path)
+    with _open(path) as h5:
+        attrs = {key: _plain(value) for key, value in h5.attrs.items()}
+        for name in ("mesh/points", "mesh/cells"):
+            if name not in h5:
+                raise UsageError(f"{path}: not a result.h5 of xfemslip (no /{name})")
+        try:
+            return Result(
+                attrs=attrs,
+                points=h5["mesh/points"][()],
+                cells=h5["mesh/cells"][()],
+                steps=_steps(h5, attrs),
+                out_dir=path.parent,
+            )
+        except KeyError:  # a dataset or attribute of the format is missing
+            raise UsageError(
+                f"{path}: not a result.h5 of xfemslip (a dataset of "
+                "output-format.md is missing)"
+            ) from None

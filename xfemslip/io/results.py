@@ -1,0 +1,101 @@
+"""The output set of a run: ``result.h5`` and the ParaView files, in one folder.
+
+``run_folder(out_dir, overwrite)`` takes the output folder (locked, refused
+when it holds results of an earlier run and not ``overwrite``; the set is
+swapped in whole, :mod:`xfemslip.io.folder`); ``write_results`` writes a
+:class:`~xfemslip.post.result.Result` into its staging folder:
+
+- ``result.h5`` (:mod:`xfemslip.io.hdf5`), always;
+- with ``"vtu"`` in the case's ``output.formats`` and at least one converged
+  step: ``result.vtu`` and ``fractures.vtu`` of the final step and, with more
+  than one load step, ``steps/result_<kkkk>.vtu`` (and fractures) per step and
+  the series ``result.pvd`` (:mod:`xfemslip.io.vtu`).
+
+Every file carries the set's ``run_id``.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Sequence
+from pathlib import Path
+
+from xfemslip import interrupt
+from xfemslip.io import hdf5
+from xfemslip.io.folder import output_folder
+from xfemslip.post.fields import VisMesh
+from xfemslip.post.result import Result
+
+__all__ = ["OUTPUT_FILES", "run_folder", "write_results"]
+
+# The files a run writes into its folder (an earlier set of them is refused
+# without --overwrite).
+OUTPUT_FILES = ("result.h5", "result.vtu", "fractures.vtu", "result.pvd")
+
+
+def run_folder(out_dir: Path | str, overwrite: bool):
+    """The output folder of a run as a context manager yielding its Staging."""
+    return output_folder(out_dir, overwrite=overwrite, results=OUTPUT_FILES)
+
+
+def write_results(
+    folder: Path,
+    result: Result,
+    *,
+    formats: Sequence[str],
+    vis_mesh: Callable[[int], VisMesh],
+    fracture_ids: Sequence[int],
+) -> None:
+    """Write the output set of ``result`` into ``folder``.
+
+    formats : the case's ``output.formats`` ("h5" always, "vtu" optional);
+    vis_mesh : the split visualisation mesh of step ``i`` (0-based index into
+        ``result.steps``), built only when a VTU file is written;
+    fracture_ids : the case-file index of each fracture of the steps.
+    """
+    hdf5.write_result(
+        folder / "result.h5",
+        points=result.points,
+        cells=result.cells,
+        steps=result.steps,
+        attrs=result.attrs,
+        load_steps=result.load_steps,
+    )
+    if "vtu" in formats and result.steps:
+        _write_vtu(folder, result, vis_mesh, fracture_ids)
+
+
+def _write_vtu(folder, result, vis_mesh, fracture_ids) -> None:
+    """The VTU (and PVD) files of the converged steps, stamped with run_id."""
+    # here, not at the top: meshio costs 0.3 s of imports that a run writing
+    # result.h5 alone does not pay
+    from xfemslip.io import vtu
+
+    series = result.load_steps > 1
+    set_id = result.run_id
+    entries = []
+    last = len(result.steps) - 1
+    for i, f in enumerate(result.steps):
+        interrupt.checkpoint()  # between files: a deferred signal stops here
+        cell_data = {
+            "stress": f.stress,
+            "stress_zz": f.stress_zz,
+            "principal_stress": f.principal_stress,
+        }
+        if f.effective_stress is not None:
+            cell_data["effective_stress"] = f.effective_stress
+            cell_data["pore_pressure"] = f.pore_pressure
+        fr = list(zip(fracture_ids, f.fractures, strict=True))
+        names = []
+        if series:
+            (folder / "steps").mkdir(exist_ok=True)
+            names.append(f"steps/%s_{f.step:04d}.vtu")
+            entries.append((f.load_factor, f"steps/result_{f.step:04d}.vtu"))
+        if i == last:
+            names.append("%s.vtu")
+        vis = vis_mesh(i)
+        for name in names:
+            vtu.write_bulk(folder / (name % "result"), vis, cell_data, run_id=set_id)
+            if fr:
+                vtu.write_fractures(folder / (name % "fractures"), fr, run_id=set_id)
+    if series:
+        vtu.write_pvd(folder / "result.pvd", entries, run_id=set_id)

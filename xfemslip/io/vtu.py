@@ -1,0 +1,319 @@
+"""ParaView output via meshio: ``result.vtu``, ``fractures.vtu``, ``result.pvd``.
+
+- ``write_bulk``: the bulk mesh with cut elements split along the fractures
+  (:class:`~xfemslip.post.fields.VisMesh`), so that "Warp By Vector" on the point
+  field ``displacement`` shows the jump.  Points and displacement are padded to
+  3D with z = 0, as ParaView expects.
+- ``write_fractures``: every fracture as a polyline through its contact
+  integration points, with the contact fields as point data.
+- ``write_pvd``: a ParaView collection (time series over load steps).
+
+Every file is written atomically (:mod:`xfemslip.io.atomic`).  meshio is
+given ``file_format="vtu"`` explicitly because the temporary name has another
+suffix.  Given a ``run_id``, each file carries it: the VTU files as the field
+data array ``run_id`` (1,) int64, the PVD as a comment.
+"""
+
+from __future__ import annotations
+
+import logging
+import re
+import shutil
+from collections.abc import Mapping, Sequence
+from pathlib import Path
+from xml.sax.saxutils import quoteattr
+
+import meshio
+import numpy as np
+
+from xfemslip.io.atomic import atomic_path, refuse_non_finite
+from xfemslip.post.fields import FractureFields, VisMesh
+
+logger = logging.getLogger(__name__)
+
+FRACTURE_POINT_DATA = ("slip", "opening", "normal_traction", "shear_traction")
+
+
+def write_bulk(
+    path: Path | str,
+    vis: VisMesh,
+    cell_data: Mapping[str, np.ndarray],
+    *,
+    run_id: int | None = None,
+) -> None:
+    """Write the visualisation mesh as an unstructured grid (``result.vtu``).
+
+    Parameters
+    ----------
+    path : Path
+        Final file name.
+    vis : VisMesh
+        Points (P, 2) [m], displacement (P, 2) [m], quads (Q, 4) and triangles
+        (T, 3) with their bulk element ids ``quad_cell`` (Q,) and
+        ``triangle_cell`` (T,).  An empty block is left out.
+    cell_data : mapping of name -> (M,) or (M, k) array
+        Values per BULK element (e.g. ``stress`` [Pa]); each vis cell gets the
+        value of its bulk element.  ``cell_id`` (the bulk element id) is added.
+    run_id : int, optional
+        The output set's id, written as the field data array ``run_id`` (1,)
+        int64.
+
+    Raises
+    ------
+    ValueError
+        Inconsistent shapes, or ``cell_id`` given in ``cell_data``.
+    OutputError
+        The file cannot be written.
+    """
+    if "cell_id" in cell_data:
+        raise ValueError("write_bulk: 'cell_id' is reserved (added automatically)")
+    points = _pad_3d(vis.points, "points")
+    displacement = _pad_3d(vis.displacement, "displacement")
+    if displacement.shape != points.shape:
+        raise ValueError(
+            f"write_bulk: displacement has shape {vis.displacement.shape}"
+            f", points {np.shape(vis.points)}"
+        )
+    blocks = [
+        (
+            cell_type,
+            np.asarray(conn, dtype=np.int64).reshape(-1, n_vertices),
+            np.asarray(owner, dtype=np.int64).reshape(-1),
+        )
+        for cell_type, conn, owner, n_vertices in (
+            ("quad", vis.quads, vis.quad_cell, 4),
+            ("triangle", vis.triangles, vis.triangle_cell, 3),
+        )
+    ]
+    blocks = [block for block in blocks if block[1].shape[0] > 0]
+    for cell_type, conn, owner in blocks:
+        if owner.shape[0] != conn.shape[0]:
+            raise ValueError(
+                f"write_bulk: {cell_type} block has {conn.shape[0]} "
+                f"cells but {owner.shape[0]} bulk ids"
+            )
+    gathered = {"cell_id": [owner for _, _, owner in blocks]}
+    for name, values in cell_data.items():
+        values = np.asarray(values)
+        gathered[name] = [values[owner] for _, _, owner in blocks]
+    mesh = meshio.Mesh(
+        points,
+        [(cell_type, conn) for cell_type, conn, _ in blocks],
+        point_data={"displacement": displacement},
+        cell_data=gathered,
+        field_data=_field_data(run_id),
+    )
+    _write_vtu(path, mesh)
+
+
+def write_fractures(
+    path: Path | str,
+    fractures: Sequence[tuple[int, FractureFields]],
+    *,
+    run_id: int | None = None,
+) -> bool:
+    """Write the fractures as polylines with their contact fields (``fractures.vtu``).
+
+    Parameters
+    ----------
+    path : Path
+        Final file name.
+    fractures : list of (index, FractureFields)
+        ``index`` is the fracture's position in the case file.  Each fracture's
+        K points, sorted by ``s``, are joined by "line" cells; a fracture with a
+        single point becomes a "vertex" cell, one with none is left out.
+    run_id : int, optional
+        The output set's id (field data ``run_id``, as in :func:`write_bulk`).
+
+    Point data: ``slip``, ``opening`` [m], ``normal_traction``,
+    ``shear_traction``, ``contact_pressure`` = max(0, -normal_traction) [Pa],
+    ``state`` (int32: 0 open, 1 stick, 2 slip), ``s`` [m] and ``fracture``
+    (the index).  Points are 3D with z = 0.
+
+    Returns
+    -------
+    bool
+        False when there is no fracture point at all: then nothing is written
+        (a VTU without cells cannot be read back by meshio), and the caller
+        decides whether to list the file anywhere.
+
+    Raises
+    ------
+    OutputError
+        The file cannot be written.
+    """
+    parts = [_fracture_part(index, fields) for index, fields in fractures]
+    parts = [part for part in parts if part["points"].shape[0] > 0]
+    if not parts:
+        logger.debug("%s: no fracture points, file not written", path)
+        return False
+    lines, vertices, offset = [], [], 0
+    for part in parts:
+        n_points = part["points"].shape[0]
+        ids = np.arange(offset, offset + n_points, dtype=np.int64)
+        if n_points >= 2:
+            lines.append(np.column_stack([ids[:-1], ids[1:]]))
+        else:
+            vertices.append(ids[:, None])
+        offset += n_points
+    cells = [
+        (name, np.concatenate(block))
+        for name, block in (("line", lines), ("vertex", vertices))
+        if block
+    ]
+    point_data = {
+        name: np.concatenate([part[name] for part in parts])
+        for name in parts[0]
+        if name != "points"
+    }
+    points = _pad_3d(np.concatenate([part["points"] for part in parts]), "points")
+    mesh = meshio.Mesh(
+        points, cells, point_data=point_data, field_data=_field_data(run_id)
+    )
+    _write_vtu(path, mesh)
+    return True
+
+
+def write_pvd(
+    path: Path | str,
+    entries: Sequence[tuple[float, str]],
+    *,
+    run_id: int | None = None,
+) -> None:
+    """Write a ParaView collection file (``result.pvd``).
+
+    Parameters
+    ----------
+    path : Path
+        Final file name.
+    entries : list of (timestep, file)
+        ``timestep`` is typically the load factor; ``file`` is the data set's
+        path relative to the .pvd file.  Data sets that share a timestep (e.g.
+        the bulk mesh and the fractures of one load step) get consecutive
+        ``part`` numbers from 0, so ParaView shows them together.
+    run_id : int, optional
+        The output set's id, written as the comment ``<!-- xfemslip run_id N
+        -->`` after the XML declaration (a comment: ParaView's collection
+        reader gives meaning to every attribute of a data set).
+
+    Raises
+    ------
+    OutputError
+        The file cannot be written.
+    """
+    lines = ['<?xml version="1.0"?>']
+    if run_id is not None:
+        lines.append(f"<!-- xfemslip run_id {int(run_id)} -->")
+    lines += [
+        '<VTKFile type="Collection" version="0.1" byte_order="LittleEndian">',
+        "  <Collection>",
+    ]
+    parts: dict[float, int] = {}
+    for timestep, file in entries:
+        part = parts.get(float(timestep), 0)
+        parts[float(timestep)] = part + 1
+        lines.append(
+            f'    <DataSet timestep="{float(timestep)!r}" group="" '
+            f'part="{part}" file={quoteattr(str(file))}/>'
+        )
+    lines += ["  </Collection>", "</VTKFile>", ""]
+    with atomic_path(Path(path)) as tmp:
+        tmp.write_text("\n".join(lines), encoding="utf-8")
+
+
+def _field_data(run_id: int | None) -> dict[str, np.ndarray]:
+    """VTU field data: the set's ``run_id`` when given."""
+    if run_id is None:
+        return {}
+    return {"run_id": np.array([run_id], dtype=np.int64)}
+
+
+def _fracture_part(index: int, fields: FractureFields) -> dict[str, np.ndarray]:
+    """Point arrays of one fracture, sorted by arc length s."""
+    s = np.asarray(fields.s, dtype=np.float64).reshape(-1)
+    order = np.argsort(s, kind="stable")
+    n_points = s.shape[0]
+    part = {"points": np.asarray(fields.points, dtype=np.float64).reshape(n_points, 2)}
+    for name in FRACTURE_POINT_DATA:
+        part[name] = np.asarray(getattr(fields, name), dtype=np.float64).reshape(
+            n_points
+        )
+    # + 0.0 turns the -0.0 of max(-0.0, 0.0) into 0.0.
+    part["contact_pressure"] = np.maximum(-part["normal_traction"], 0.0) + 0.0
+    part["state"] = np.asarray(fields.state, dtype=np.int32).reshape(n_points)
+    part["s"] = s
+    part["fracture"] = np.full(n_points, index, dtype=np.int32)
+    return {name: value[order] for name, value in part.items()}
+
+
+def _pad_3d(xy, name: str) -> np.ndarray:
+    """(P, 2) -> (P, 3) float64 with z = 0 (ParaView works in 3D)."""
+    xy = np.asarray(xy, dtype=np.float64)
+    if xy.ndim != 2 or xy.shape[1] != 2:
+        raise ValueError(f"{name} has shape {xy.shape}, expected (P, 2)")
+    return np.column_stack([xy, np.zeros(xy.shape[0])])
+
+
+def _write_vtu(path: Path | str, mesh: meshio.Mesh) -> None:
+    """Write ``mesh`` as VTU (binary, zlib) through a temporary file."""
+    refuse_non_finite(mesh.points, f"{path}: points")
+    for name, value in mesh.point_data.items():
+        refuse_non_finite(value, f"{path}: {name}")
+    for name, blocks in mesh.cell_data.items():
+        for value in blocks:
+            refuse_non_finite(value, f"{path}: {name}")
+    run_id = mesh.field_data.get("run_id")
+    with atomic_path(Path(path)) as tmp:
+        if run_id is None:
+            meshio.write(tmp, mesh, file_format="vtu")
+            return
+        raw = tmp.with_name(f"{tmp.name}.raw")
+        try:
+            meshio.write(raw, mesh, file_format="vtu")
+            _add_field_data(raw, tmp, int(run_id[0]))
+        finally:
+            raw.unlink(missing_ok=True)
+
+
+# meshio (5.3) does not write field data; VTK reads it as a child of the grid.
+_FIELD_DATA = (
+    '\n<FieldData>\n<DataArray type="Int64" Name="run_id" NumberOfTuples="1" '
+    'format="ascii">\n{}\n</DataArray>\n</FieldData>'
+)
+_GRID_TAG = b"<UnstructuredGrid>"
+
+
+def _add_field_data(src: Path, dst: Path, run_id: int) -> None:
+    """Copy the VTU ``src`` to ``dst`` with the ``run_id`` field data array
+    inserted after the grid's opening tag (which meshio writes in its first
+    lines)."""
+    with open(src, "rb") as fin, open(dst, "wb") as fout:
+        head = fin.read(4096)
+        at = head.index(_GRID_TAG) + len(_GRID_TAG)
+        fout.write(head[:at] + _FIELD_DATA.format(run_id).encode() + head[at:])
+        shutil.copyfileobj(fin, fout, 1 << 20)
+
+
+_VTU_RUN_ID = re.compile(rb'Name="run_id" NumberOfTuples="1" format="ascii">\s*(\d+)')
+_PVD_RUN_ID = re.compile(rb"<!-- xfemslip run_id (\d+) -->")
+
+
+def read_run_id(path: Path | str) -> int | None:
+    """The ``run_id`` of a VTU or PVD file written here (None when it has none
+    or cannot be read); only the file's first 4 kB are read."""
+    path = Path(path)
+    pattern = _PVD_RUN_ID if path.suffix == ".pvd" else _VTU_RUN_ID
+    try:
+        with open(path, "rb") as fh:
+            match = pattern.search(fh.read(4096))
+    except OSError:
+        return None
+    return int(match[1]) if match else None
+
+
+def pvd_files(path: Path | str) -> list[str]:
+    """The data set files a PVD names (relative to it)."""
+    from xml.etree import ElementTree
+
+    root = ElementTree.parse(path).getroot()
+    return [item.get("file", "") for item in root.iter("DataSet")]

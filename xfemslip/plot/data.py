@@ -1,0 +1,233 @@
+"""What the figures need from a run, read from its documented output files.
+
+``figure_data(path)`` reads ``result.h5`` (through
+:func:`xfemslip.io.read.read_result`) and, when it lies beside it,
+``result.vtu``: its split mesh (cut elements as triangles on each
+side of the fracture, with their own points) is what lets a contour or a
+deformed mesh show the displacement jump.  No matplotlib here.
+"""
+
+from __future__ import annotations
+
+import math
+import re
+import tomllib
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from xfemslip.errors import UsageError
+from xfemslip.io.read import read_result
+
+
+@dataclass
+class FractureData:
+    """One fracture of a result, ordered by arc length s."""
+
+    index: int
+    s: np.ndarray  # (K,) [m]
+    points: np.ndarray  # (K, 2) [m]
+    slip: np.ndarray  # (K,) [m]
+    # (K,) [Pa]: the effective normal traction sigma_n + p_f when the result
+    # has pore pressure (what the Coulomb criterion sees), else sigma_n
+    normal_traction: np.ndarray
+    shear_traction: np.ndarray  # (K,) [Pa]
+    state: np.ndarray  # (K,) 0 open, 1 stick, 2 slip
+    theta: float  # chord angle, first to last point of the case file [deg]
+    friction: float
+    cohesion: float  # [Pa]
+
+
+@dataclass
+class ResultData:
+    """A run's result, enough for every figure."""
+
+    path: Path
+    label: str
+    converged: bool
+    points: np.ndarray  # (N, 2) [m]
+    cells: np.ndarray  # (M, 4)
+    displacement: np.ndarray  # (N, 2) [m]
+    stress: np.ndarray  # (M, 3) [Pa]
+    principal: np.ndarray  # (M, 2) [Pa] s_max, s_min
+    stress_state: tuple[float, float, float]  # far field (xx, yy, xy) [Pa]
+    stress_source: str  # "loading.stress" or "mean element stress"
+    fractures: list[FractureData] = field(default_factory=list)
+    # far-field pore pressure of the final step [Pa] ([pore_pressure]: initial,
+    # plus the change when it acts in the whole model); 0 without one
+    pore_pressure: float = 0.0
+    vis_points: np.ndarray | None = None  # (P, 2) split mesh from result.vtu
+    vis_displacement: np.ndarray | None = None  # (P, 2)
+    vis_triangles: np.ndarray | None = None  # (T, 3): quads split in two + cut
+    vis_edges: np.ndarray | None = None  # (E, 2) point pairs: the element outlines
+
+
+def default_label(path: Path, case: dict) -> str:
+    """The result's folder name without a sweep index (``002_angle=45`` ->
+    ``angle=45``), or the case name for a folder called like a file."""
+    folder = path.resolve().parent.name
+    label = re.sub(r"^\d+_", "", folder)
+    return label or str(case.get("name", path.stem))
+
+
+def _chord_angle(table: dict) -> float:
+    """Fracture angle [deg] from the case table: ``angle`` or first->last point."""
+    if "angle" in table:
+        return float(table["angle"])
+    pts = np.asarray(table.get("points", [[0, 0], [1, 0]]), dtype=float)
+    d = pts[-1] - pts[0]
+    return math.degrees(math.atan2(d[1], d[0]))
+
+
+def _stress_state(case: dict, stress: np.ndarray, cell_area: np.ndarray):
+    """Far-field stress: loading.stress, else the area-weighted mean stress."""
+    given = case.get("loading", {}).get("stress")
+    if isinstance(given, dict) and {"xx", "yy"} <= set(given):
+        return (float(given["xx"]), float(given["yy"]), float(given.get("xy", 0.0))), (
+            "loading.stress"
+        )
+    mean = (stress * cell_area[:, None]).sum(axis=0) / cell_area.sum()
+    return tuple(float(v) for v in mean), "mean element stress"
+
+
+def _far_pore_pressure(case: dict) -> float:
+    """Pore pressure in the far field at the final step [Pa] (0 without one)."""
+    pp = case.get("pore_pressure")
+    if not isinstance(pp, dict):
+        return 0.0
+    change = pp.get("change", 0.0) if pp.get("region", "all") == "all" else 0.0
+    return float(pp.get("initial", 0.0)) + float(change)
+
+
+def _fracture_data(result, case: dict) -> list[FractureData]:
+    """The fractures of the case's [[fractures]] tables, final step."""
+    tables = case.get("fractures", [])
+    out = []
+    for i, (table, ff) in enumerate(zip(tables, result.fractures, strict=False)):
+        out.append(
+            FractureData(
+                index=i,
+                s=ff.s,
+                points=ff.points,
+                slip=ff.slip,
+                normal_traction=(
+                    ff.effective_normal_traction
+                    if ff.effective_normal_traction is not None
+                    else ff.normal_traction
+                ),
+                shear_traction=ff.shear_traction,
+                state=ff.state,
+                theta=_chord_angle(table),
+                friction=float(table.get("friction", 0.0)),
+                cohesion=float(table.get("cohesion", 0.0)),
+            )
+        )
+    return out
+
+
+def _read_vtu(data: ResultData, path: Path) -> None:
+    """Fill the split visualisation mesh from ``result.vtu`` (if readable)."""
+    import meshio
+
+    try:
+        mesh = meshio.read(path)
+    except Exception:  # a broken VTU only costs the jump in the plots
+        return
+    if "displacement" not in mesh.point_data or "cell_id" not in mesh.cell_data:
+        return
+    tris, edges = [], []
+    pts = mesh.points[:, :2]
+    for block, cell_id in zip(mesh.cells, mesh.cell_data["cell_id"], strict=True):
+        if block.type == "quad":
+            q = block.data
+            tris += [q[:, [0, 1, 2]], q[:, [0, 2, 3]]]
+            edges += [q[:, [k, (k + 1) % 4]] for k in range(4)]
+        elif block.type == "triangle":
+            tris.append(block.data)
+            edges.append(_piece_outlines(pts, block.data, cell_id, data.fractures))
+    if not tris:
+        return
+    data.vis_points = pts
+    data.vis_displacement = mesh.point_data["displacement"][:, :2]
+    data.vis_triangles = np.concatenate(tris).astype(np.int64)
+    data.vis_edges = np.concatenate(edges).astype(np.int64)
+
+
+def _side(points: np.ndarray, fractures: list[FractureData]) -> np.ndarray:
+    """Side (+1 / -1) of each point w.r.t. the nearest fracture point's frame."""
+    if not fractures:
+        return np.ones(len(points))
+    best = np.full(len(points), np.inf)
+    side = np.ones(len(points))
+    for fr in fractures:
+        if len(fr.points) < 2:
+            continue
+        t = np.gradient(fr.points, axis=0)
+        t /= np.linalg.norm(t, axis=1)[:, None]
+        d = points[:, None, :] - fr.points[None, :, :]  # (P, K, 2)
+        dist = np.linalg.norm(d, axis=2)
+        k = np.argmin(dist, axis=1)
+        rows = np.arange(len(points))
+        cross = t[k, 0] * d[rows, k, 1] - t[k, 1] * d[rows, k, 0]
+        closer = dist[rows, k] < best
+        best[closer] = dist[rows, k][closer]
+        side[closer] = np.where(cross[closer] >= 0.0, 1.0, -1.0)
+    return side
+
+
+def _piece_outlines(pts, tris, cell_id, fractures) -> np.ndarray:
+    """Outline edges of the pieces of the split elements: the sub-triangles of
+    one element on one side of the fracture, without their inner edges.
+
+    Every sub-triangle has points of its own, so edges are matched by their
+    (rounded) undeformed coordinates."""
+    side = _side(pts[tris].mean(axis=1), fractures)
+    scale = max(float(np.ptp(pts, axis=0).max()), 1e-300)
+    key_of = np.round(pts / (1e-9 * scale)).astype(np.int64)
+    count: dict = {}
+    first: dict = {}
+    for tri, cell, sd in zip(tris, cell_id, side, strict=True):
+        for a, b in ((0, 1), (1, 2), (2, 0)):
+            ka, kb = tuple(key_of[tri[a]]), tuple(key_of[tri[b]])
+            key = (int(cell), sd, min(ka, kb), max(ka, kb))
+            count[key] = count.get(key, 0) + 1
+            first.setdefault(key, (tri[a], tri[b]))
+    return np.array([first[k] for k, n in count.items() if n == 1]).reshape(-1, 2)
+
+
+def figure_data(path: str | Path, label: str | None = None) -> ResultData:
+    """What the figures need of ``result.h5`` (read by
+    :func:`xfemslip.io.read.read_result`) and of ``result.vtu`` beside it.
+    UsageError when the file is missing, not HDF5, or holds no converged
+    fields."""
+    path = Path(path)
+    if path.is_dir():
+        path = path / "result.h5"
+    result = read_result(path)
+    if not result.steps:
+        raise UsageError(f"{path}: holds no converged load step to plot")
+    case = tomllib.loads(str(result.attrs.get("case_toml", "")))
+    points, cells = result.points, result.cells
+    d1 = points[cells[:, 2]] - points[cells[:, 0]]
+    d2 = points[cells[:, 3]] - points[cells[:, 1]]
+    area = 0.5 * np.abs(d1[:, 0] * d2[:, 1] - d1[:, 1] * d2[:, 0])
+    state, source = _stress_state(case, result.stress, area)
+    data = ResultData(
+        path=path,
+        label=label or default_label(path, case),
+        converged=result.converged,
+        points=points,
+        cells=cells,
+        displacement=result.displacement,
+        stress=result.stress,
+        principal=result.principal_stress,
+        stress_state=state,
+        stress_source=source,
+        pore_pressure=_far_pore_pressure(case),
+        fractures=_fracture_data(result, case),
+    )
+    vtu = path.with_name("result.vtu")
+    if vtu.is_file():
+        _read_vtu(data, vtu)
+    return data

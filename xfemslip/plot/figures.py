@@ -1,0 +1,486 @@
+"""Figures as the seed paper shows them (matplotlib, imported only here).
+
+``plot_results(paths, out_dir)`` writes, for one result or several side by
+side (one column per result):
+
+- ``displacement``: u_x and u_y contours (paper Figs. 4, 6, 7, 10, 11, 14, 15);
+- ``principal_stress``: the two principal stresses per element, tension
+  positive, colour bar in Pa (Figs. 8, 9, 16, 17);
+- ``deformed_mesh``: the mesh with magnified displacement; cut elements are
+  drawn split along the fracture (result.vtu), so the jump shows (Fig. 3);
+- ``slip``: |slip| along each fracture against the distance from its first
+  point, every result overlaid (Fig. 12);
+- ``mohr``: the Mohr-Coulomb diagram of the far-field stress with each
+  fracture's point, the failure line and the band of orientations that slip
+  (Fig. 13); the contact points of the run are drawn too;
+- ``network`` (only when asked for, first result only): |slip| along every
+  fracture of a network over the deformed split mesh, and the contact state.
+
+Every figure is saved as PNG and PDF.  Only the object-oriented API
+(``matplotlib.figure.Figure``) is used: no pyplot, no GUI backend.
+"""
+
+from __future__ import annotations
+
+import logging
+from collections.abc import Sequence
+from pathlib import Path
+
+import numpy as np
+from matplotlib.collections import LineCollection, PolyCollection
+from matplotlib.colors import Normalize
+from matplotlib.figure import Figure
+from matplotlib.tri import Triangulation
+
+from xfemslip.conventions import SLIP
+from xfemslip.errors import UsageError
+from xfemslip.plot.data import ResultData, figure_data
+from xfemslip.plot.mohr import add_legend, draw_mohr, mohr_figsize
+
+logger = logging.getLogger(__name__)
+
+KINDS = ("displacement", "principal_stress", "deformed_mesh", "slip", "mohr")
+FORMATS = ("png", "pdf")
+PANEL = 3.6  # inches per panel
+DPI = 110
+
+
+# --------------------------------------------------------------------------- #
+# Helpers
+# --------------------------------------------------------------------------- #
+
+
+def _grid(n_rows: int, n_cols: int, height: float = PANEL):
+    """A figure and its (n_rows, n_cols) array of axes; with one column (one
+    result) the rows are laid out side by side instead."""
+    shape = (n_cols, n_rows) if n_cols == 1 else (n_rows, n_cols)
+    fig = Figure(
+        figsize=(PANEL * shape[1] + 0.9, height * shape[0] + 0.4), layout="constrained"
+    )
+    axes = fig.subplots(*shape, squeeze=False)
+    return fig, (axes.T if n_cols == 1 else axes)
+
+
+def _frame(ax, data: ResultData, title: str, fractures: bool = True) -> None:
+    """Equal axes in metres, the fractures drawn, a title."""
+    for fr in data.fractures if fractures else ():
+        if fr.points.size:
+            ax.plot(fr.points[:, 0], fr.points[:, 1], color="k", lw=0.6)
+    ax.set_aspect("equal")
+    ax.set_xlabel("x [m]")
+    ax.set_ylabel("y [m]")
+    ax.set_title(title, fontsize=9)
+
+
+def _triangulation(data: ResultData):
+    """(Triangulation, displacement (P, 2)): the split mesh when available."""
+    if data.vis_triangles is not None:
+        pts, tri, u = data.vis_points, data.vis_triangles, data.vis_displacement
+    else:
+        c = data.cells
+        pts, u = data.points, data.displacement
+        tri = np.concatenate([c[:, [0, 1, 2]], c[:, [0, 2, 3]]])
+    return Triangulation(pts[:, 0], pts[:, 1], tri), u
+
+
+def _norm(values: np.ndarray):
+    """(norm, colormap): when the sign changes, blue-red symmetric about 0
+    (compression blue, tension red); else a sequential map."""
+    lo, hi = float(np.min(values)), float(np.max(values))
+    if lo < 0.0 < hi:
+        bound = max(-lo, hi)
+        return Normalize(-bound, bound), "RdBu_r"
+    return Normalize(lo, hi), "viridis"
+
+
+# --------------------------------------------------------------------------- #
+# Figures
+# --------------------------------------------------------------------------- #
+
+
+def figure_displacement(results: Sequence[ResultData]) -> Figure:
+    """u_x (top row) and u_y (bottom row) contours [m], one column per result."""
+    fig, axes = _grid(2, len(results))
+    for j, data in enumerate(results):
+        tri, u = _triangulation(data)
+        for i, (comp, word) in enumerate(((0, "horizontal"), (1, "vertical"))):
+            ax = axes[i, j]
+            cs = ax.tricontourf(tri, u[:, comp], levels=20, cmap="viridis")
+            fig.colorbar(cs, ax=ax, label=f"$u_{'xy'[comp]}$ [m]", shrink=0.8)
+            _frame(ax, data, f"{data.label}\n{word} displacement $u_{'xy'[comp]}$ [m]")
+    return fig
+
+
+def figure_principal(results: Sequence[ResultData]) -> Figure:
+    """Principal stresses per element [Pa], tension positive."""
+    fig, axes = _grid(2, len(results))
+    rows = (
+        (1, r"$\sigma_{min}$ (most compressive) [Pa]"),
+        (0, r"$\sigma_{max}$ (least compressive) [Pa]"),
+    )
+    for j, data in enumerate(results):
+        polys = data.points[data.cells]
+        for i, (col, title) in enumerate(rows):
+            values = data.principal[:, col]
+            norm, cmap = _norm(values)
+            coll = PolyCollection(
+                polys,
+                array=values,
+                cmap=cmap,
+                norm=norm,
+                edgecolors="face",
+                linewidths=0.1,
+            )
+            ax = axes[i, j]
+            ax.add_collection(coll)
+            ax.margins(0.0)
+            ax.autoscale_view()
+            fig.colorbar(coll, ax=ax, label="[Pa], tension positive", shrink=0.8)
+            _frame(ax, data, f"{data.label}\n{title}")
+    return fig
+
+
+def auto_scale(data: ResultData) -> float:
+    """Magnification: the largest slip drawn as 5 % of the domain, but no
+    displacement larger than 15 % of it (and never below 1)."""
+    size = float(np.ptp(data.points, axis=0).max())
+    u_max = float(np.abs(data.displacement).max()) or 1.0
+    slip = max(
+        (float(np.abs(f.slip).max()) for f in data.fractures if f.slip.size),
+        default=0.0,
+    )
+    scale = 0.05 * size / slip if slip > 0.0 else 0.05 * size / u_max
+    return max(1.0, min(scale, 0.15 * size / u_max))
+
+
+def _draw_mesh(ax, data: ResultData, factor: float) -> str:
+    """The deformed element outlines; returns a note for the title."""
+    if data.vis_edges is None:
+        moved = data.points + factor * data.displacement
+        ax.add_collection(
+            PolyCollection(
+                moved[data.cells], facecolors="none", edgecolors="0.25", linewidths=0.3
+            )
+        )
+        return "no result.vtu: the jump is not shown"
+    moved = data.vis_points + factor * data.vis_displacement
+    ax.add_collection(
+        LineCollection(moved[data.vis_edges], colors="0.2", linewidths=0.35)
+    )
+    return "cut elements split along the fracture"
+
+
+def _zoom_box(data: ResultData, factor: float):
+    """(x0, x1, y0, y1) around the first fracture's middle, deformed."""
+    fr = next((f for f in data.fractures if f.points.size), None)
+    size = float(np.ptp(data.points, axis=0).max())
+    centre = fr.points[len(fr.points) // 2] if fr is not None else data.points.mean(0)
+    near = np.argmin(np.linalg.norm(data.points - centre, axis=1))
+    centre = centre + factor * data.displacement[near]
+    half = 0.1 * size
+    return centre[0] - half, centre[0] + half, centre[1] - half, centre[1] + half
+
+
+def figure_deformed(
+    results: Sequence[ResultData], scale: float | None = None
+) -> Figure:
+    """The deformed mesh, displacement magnified, and a zoom on the fracture's
+    middle; cut elements are drawn split so the jump shows (paper Fig. 3)."""
+    fig, axes = _grid(2, len(results), height=PANEL + 0.3)
+    for j, data in enumerate(results):
+        factor = scale if scale is not None else auto_scale(data)
+        for i, zoom in enumerate((False, True)):
+            ax = axes[i, j]
+            note = _draw_mesh(ax, data, factor)
+            if zoom:
+                x0, x1, y0, y1 = _zoom_box(data, factor)
+                ax.set_xlim(x0, x1)
+                ax.set_ylim(y0, y1)
+                ax.locator_params(nbins=4)
+                title = f"{data.label}\nzoom on the middle of the fracture"
+            else:
+                ax.autoscale_view()
+                title = (
+                    f"{data.label}\ndeformed mesh, displacement x {factor:.3g}"
+                    f"\n({note})"
+                )
+            _frame(ax, data, title, fractures=False)
+    return fig
+
+
+def figure_slip(results: Sequence[ResultData]) -> Figure:
+    """|slip| [m] along every fracture against arc length, results overlaid."""
+    fig = Figure(figsize=(6.4, 4.2), layout="constrained")
+    ax = fig.subplots()
+    for k, data in enumerate(results):
+        for fr in data.fractures:
+            label = (
+                data.label
+                if len(data.fractures) == 1
+                else (f"{data.label}, fracture {fr.index}")
+            )
+            s = fr.s - fr.s.min() if fr.s.size else fr.s
+            # one result with several fractures (a network): one colour each
+            colour = f"C{(k if len(results) > 1 else fr.index) % 10}"
+            (line,) = ax.plot(s, np.abs(fr.slip), lw=1.4, color=colour, label=label)
+            in_slip = fr.state == SLIP
+            ax.plot(
+                s[in_slip], np.abs(fr.slip[in_slip]), ".", ms=3, color=line.get_color()
+            )
+    ax.set_xlabel("distance from the first tip along the fracture x_0 [m]")
+    ax.set_ylabel("slip |[[u]] . t| [m]")
+    ax.set_title("Slip along the fracture (dots: points in slip)", fontsize=10)
+    ax.ticklabel_format(axis="y", style="sci", scilimits=(-3, 3))
+    ax.grid(alpha=0.3)
+    ax.legend(fontsize=8)
+    return fig
+
+
+STATE_COLOURS = {0: "0.6", 1: "tab:blue", 2: "tab:red"}  # open, stick, slip
+
+
+def _fracture_segments(fr) -> np.ndarray:
+    """(K-1, 2, 2) segments between consecutive contact points of a fracture,
+    broken where the fracture's polyline is (a gap of more than 3 spacings)."""
+    p = fr.points
+    if len(p) < 2:
+        return np.zeros((0, 2, 2))
+    seg = np.stack([p[:-1], p[1:]], axis=1)
+    gap = np.linalg.norm(p[1:] - p[:-1], axis=1)
+    return seg[gap <= 3.0 * np.median(gap)]
+
+
+def figure_network(data: ResultData, scale: float | None = None) -> Figure:
+    """A fracture network: |slip| along every fracture over the deformed,
+    split mesh (left) and the contact state of every point (right), each
+    fracture numbered as in the case file."""
+    fig, axes = _grid(1, 2)
+    ax_slip, ax_state = axes[0]
+    factor = scale if scale is not None else auto_scale(data)
+    _draw_mesh(ax_slip, data, factor)
+    slips = [np.abs(f.slip) for f in data.fractures if f.slip.size]
+    top = max((float(v.max()) for v in slips), default=0.0) or 1.0
+    norm = Normalize(0.0, top)
+    for fr in data.fractures:
+        seg = _fracture_segments(fr)
+        if not seg.size:
+            continue
+        # drawn where the deformed mesh has moved it (nearest node)
+        near = np.argmin(
+            np.linalg.norm(seg.reshape(-1, 1, 2) - data.points[None], axis=2), axis=1
+        )
+        moved = seg + factor * data.displacement[near].reshape(seg.shape)
+        mid = 0.5 * (np.abs(fr.slip[:-1]) + np.abs(fr.slip[1:]))
+        gap = np.linalg.norm(fr.points[1:] - fr.points[:-1], axis=1)
+        mid = mid[gap <= 3.0 * np.median(gap)]
+        lc = LineCollection(moved, array=mid, cmap="plasma", norm=norm, linewidths=2.2)
+        ax_slip.add_collection(lc)
+        state_seg = seg
+        colours = [STATE_COLOURS.get(int(c), "k") for c in fr.state[:-1]]
+        colours = [
+            c for c, g in zip(colours, gap, strict=True) if g <= 3 * np.median(gap)
+        ]
+        ax_state.add_collection(
+            LineCollection(state_seg, colors=colours, linewidths=2.2)
+        )
+        m = fr.points[len(fr.points) // 3]  # not the middle: Xs cross there
+        ax_state.annotate(
+            str(fr.index), m, fontsize=7, xytext=(3, 3), textcoords="offset points"
+        )
+    fig.colorbar(
+        ax_slip.collections[-1] if ax_slip.collections else None,
+        ax=ax_slip,
+        label="|slip| [m]",
+        shrink=0.8,
+    )
+    ax_slip.autoscale_view()
+    _frame(
+        ax_slip,
+        data,
+        f"{data.label}\n|slip| on the deformed, split mesh (x {factor:.3g})",
+        fractures=False,
+    )
+    b = data.points
+    ax_state.set_xlim(b[:, 0].min(), b[:, 0].max())
+    ax_state.set_ylim(b[:, 1].min(), b[:, 1].max())
+    for code, name in ((2, "slip"), (1, "stick"), (0, "open")):
+        ax_state.plot([], [], color=STATE_COLOURS[code], lw=2.2, label=name)
+    ax_state.legend(fontsize=7, loc="lower right")
+    _frame(ax_state, data, f"{data.label}\ncontact state", fractures=False)
+    return fig
+
+
+def _point_labels(results: Sequence[ResultData]) -> dict:
+    """Label of each (result, fracture) point on the Mohr circle; results whose
+    points coincide (same stress and angle) share one label, on the first."""
+    labels, first = {}, {}
+    for k, data in enumerate(results):
+        for f in data.fractures:
+            if len(results) == 1:
+                labels[k, f.index] = f"fracture {f.index}, $\\theta$ = {f.theta:g} deg"
+                continue
+            key = (data.stress_state, round(f.theta % 180.0, 9))
+            if key in first:
+                labels[k, f.index] = ""
+                labels[first[key]] += f", {data.label}"
+            else:
+                first[key] = (k, f.index)
+                labels[k, f.index] = data.label
+    return labels
+
+
+def figure_mohr(results: Sequence[ResultData]) -> Figure:
+    """The Mohr-Coulomb diagram of every result's stress and fractures; a
+    circle per distinct stress state, a failure line per distinct (f, c)."""
+    fig = Figure(
+        figsize=mohr_figsize(results[0].stress_state, results[0].pore_pressure),
+        layout="constrained",
+    )
+    ax = fig.subplots()
+    circles, criteria = set(), set()
+    labels = _point_labels(results)
+    for k, data in enumerate(results):
+        fractures = [
+            (labels[k, f.index], f.theta, f.friction, f.cohesion)
+            for f in data.fractures
+        ]
+        keys = {(data.stress_state, f, c) for _, _, f, c in fractures}
+        draw_mohr(
+            ax,
+            data.stress_state,
+            data.pore_pressure,
+            fractures=fractures,
+            contact=[(f.normal_traction, f.shear_traction) for f in data.fractures],
+            color=f"C{k % 10}",
+            first=k == 0,
+            circle=data.stress_state not in circles,
+            criterion=not keys <= criteria,
+            inset_lines=[
+                (f.theta, f"C{j % 10}")
+                for j, other in enumerate(results)
+                for f in other.fractures
+            ],
+        )
+        circles.add(data.stress_state)
+        criteria |= keys
+    source = results[0].stress_source
+    ax.set_title(
+        f"Mohr-Coulomb diagram (far field: {source}; pore pressure "
+        f"{results[0].pore_pressure:g} Pa; "
+        "tension positive)",
+        fontsize=9,
+    )
+    add_legend(fig)
+    return fig
+
+
+# --------------------------------------------------------------------------- #
+# Entry point
+# --------------------------------------------------------------------------- #
+
+
+def _save_all(out_dir: Path, makers: dict, formats, dpi=DPI) -> list[Path]:
+    """Write ``<out_dir>/<name>.<fmt>`` for each figure ``makers[name]()`` and
+    format, as one set (:func:`xfemslip.io.fileset.replace_files`: no
+    figure of an earlier command is left beside the new ones half-replaced);
+    returns the paths in the order of ``makers`` and ``formats``."""
+    from xfemslip.io.fileset import replace_files
+
+    figures: dict[str, Figure] = {}
+
+    def writer(name: str, fmt: str):
+        def write(tmp: Path) -> None:
+            if name not in figures:
+                figures[name] = makers[name]()
+            figures[name].savefig(tmp, format=fmt, dpi=dpi, bbox_inches="tight")
+
+        return write
+
+    paths = {
+        Path(out_dir) / f"{name}.{fmt}": writer(name, fmt)
+        for name in makers
+        for fmt in formats
+    }
+    written = set(replace_files(paths))
+    return [path for path in paths if path in written]
+
+
+def plot_screen(
+    out_dir,
+    stress,
+    pore_pressure,
+    friction,
+    cohesion,
+    fractures,
+    formats: Sequence[str] = FORMATS,
+) -> list[Path]:
+    """The Mohr diagram of ``xfemslip screen``: ``<out_dir>/mohr.<fmt>``;
+    ``fractures`` = [(label, theta [deg], f, c)]."""
+    return _save_all(
+        Path(out_dir),
+        {
+            "mohr": lambda: _screen_figure(
+                stress, pore_pressure, friction, cohesion, fractures
+            )
+        },
+        formats,
+    )
+
+
+def _screen_figure(stress, pore_pressure, friction, cohesion, fractures) -> Figure:
+    """The Mohr diagram of :func:`plot_screen`."""
+    fig = Figure(figsize=mohr_figsize(stress, pore_pressure), layout="constrained")
+    ax = fig.subplots()
+    if not fractures:
+        fractures = [("", 0.0, friction, cohesion)]
+        draw_mohr(ax, stress, pore_pressure, fractures=[], first=True)
+        draw_mohr(
+            ax, stress, pore_pressure, fractures=fractures, first=False, circle=False
+        )
+    else:
+        draw_mohr(ax, stress, pore_pressure, fractures=fractures)
+    ax.set_title(
+        f"Mohr-Coulomb screening (pore pressure {pore_pressure:g} Pa; "
+        "tension positive)",
+        fontsize=9,
+    )
+    add_legend(fig)
+    return fig
+
+
+def plot_results(
+    paths: Sequence[str | Path],
+    out_dir: str | Path,
+    *,
+    kinds: Sequence[str] = KINDS,
+    formats: Sequence[str] = FORMATS,
+    labels: Sequence[str] | None = None,
+    scale: float | None = None,
+    dpi: float = DPI,
+) -> list[Path]:
+    """Read the results and write the figures; returns the files written.
+
+    ``kinds`` from KINDS, ``formats`` "png" / "pdf", ``labels`` one per result
+    (default: the folder name), ``scale`` the deformed mesh's magnification
+    (default :func:`auto_scale`), ``dpi`` of the PNG files."""
+    if labels and len(labels) != len(paths):
+        raise UsageError(f"got {len(labels)} labels for {len(paths)} results")
+    results = [
+        figure_data(p, labels[i] if labels else None) for i, p in enumerate(paths)
+    ]
+    makers = {
+        "displacement": lambda: figure_displacement(results),
+        "principal_stress": lambda: figure_principal(results),
+        "deformed_mesh": lambda: figure_deformed(results, scale),
+        "slip": lambda: figure_slip(results),
+        "mohr": lambda: figure_mohr(results),
+        # not in KINDS (asked for by name): one figure per result
+        "network": lambda: figure_network(results[0], scale),
+    }
+    drawn = {}
+    for kind in kinds:
+        if kind in ("slip", "mohr") and not any(r.fractures for r in results):
+            logger.info("no fracture: %s figure skipped", kind)
+            continue
+        drawn[kind] = makers[kind]
+    return _save_all(Path(out_dir), drawn, formats, dpi)

@@ -1,0 +1,278 @@
+"""The fields of a converged load step, in the output sign convention.
+
+The containers (``StepFields``, ``FractureFields``, ``VisMesh``) hold plain
+arrays, tension positive (``output-format.md``); ``step_fields`` fills them
+from a model and a converged step, and the writers (:mod:`xfemslip.io`) and
+:class:`xfemslip.post.result.Result` carry them.
+
+Stress: sigma = sigma0 + D eps (- alpha (p - p0) I with pore pressure, see
+xfemslip.fem.poro), averaged over each element (sub-cells included
+for enriched elements).  Out-of-plane stress in plane strain:
+sigma_zz = nu (sigma_xx + sigma_yy) (the in-situ sigma_zz is taken as
+nu (sigma0_xx + sigma0_yy), consistent with plane strain); zero in plane stress.
+Fracture fields: slip = [[u]] . t, opening = [[u]] . n, p_N, p_T and the state
+codes of :mod:`xfemslip.conventions`.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from xfemslip.fem.poro import fluid_pressure
+
+
+@dataclass
+class FractureFields:
+    """Contact fields of one fracture at its K integration points, sorted by s."""
+
+    s: np.ndarray  # (K,) arc length from the first point [m]
+    points: np.ndarray  # (K, 2) [m]
+    slip: np.ndarray  # (K,) [[u]].t [m]
+    opening: np.ndarray  # (K,) [[u]].n [m]
+    normal_traction: np.ndarray  # (K,) p_N [Pa], compression negative
+    shear_traction: np.ndarray  # (K,) p_T along t [Pa]
+    state: np.ndarray  # (K,) int8: 0 open, 1 stick, 2 slip
+    # with [pore_pressure] only (xfemslip.fem.poro); normal_traction is then total
+    fluid_pressure: np.ndarray | None = None  # (K,) p_f [Pa]
+    effective_normal_traction: np.ndarray | None = None  # (K,) p_N + p_f [Pa]
+
+
+@dataclass
+class StepFields:
+    """Fields of one converged load step."""
+
+    step: int  # 1-based
+    load_factor: float  # lambda in (0, 1]
+    newton_iterations: int
+    displacement: np.ndarray  # (N, 2) [m]
+    # (None for a step other than the last one read back from result.h5,
+    # which stores them for the final step only)
+    stress: np.ndarray | None  # (M, 3) [Pa] element average sxx, syy, sxy
+    stress_zz: np.ndarray | None  # (M,) [Pa]
+    principal_stress: np.ndarray | None  # (M, 2) [Pa] s_max, s_min
+    fractures: list[FractureFields] = field(default_factory=list)
+    # with [pore_pressure] only (xfemslip.fem.poro)
+    effective_stress: np.ndarray | None = None  # (M, 3) sigma + alpha p I [Pa]
+    pore_pressure: np.ndarray | None = None  # (M,) [Pa]
+
+
+@dataclass
+class VisMesh:
+    """Bulk mesh for ParaView with cut elements split along the fractures.
+
+    Uncut elements are quads on shared points; each cut element is replaced by
+    triangles on points of its own, so the displacement can jump across the
+    fracture.  ``*_cell`` maps every vis cell to its bulk element (for cell data).
+    """
+
+    points: np.ndarray  # (P, 2) [m]
+    displacement: np.ndarray  # (P, 2) [m]
+    quads: np.ndarray  # (Q, 4) int64
+    quad_cell: np.ndarray  # (Q,) int64
+    triangles: np.ndarray  # (T, 3) int64
+    triangle_cell: np.ndarray  # (T,) int64
+
+
+def cell_strain(mesh, bulk, u) -> np.ndarray:
+    """Element-average strain (M, 3) [exx, eyy, gxy]."""
+    eps = np.zeros((mesh.n_cells, 3))
+    c = bulk.std_cells
+    b = mesh.bounds[c]
+    hx, hy = b[:, 1] - b[:, 0], b[:, 3] - b[:, 2]
+    U = u[: 2 * mesh.n_nodes].reshape(-1, 2)[mesh.cells[c]]  # (ns, 4, 2)
+    xa = np.array([-1.0, 1.0, 1.0, -1.0])
+    ya = np.array([-1.0, -1.0, 1.0, 1.0])
+    dNdx = xa[None, :] / (2.0 * hx[:, None])  # gradient at the centre = cell average
+    dNdy = ya[None, :] / (2.0 * hy[:, None])
+    eps[c, 0] = np.sum(dNdx * U[:, :, 0], axis=1)
+    eps[c, 1] = np.sum(dNdy * U[:, :, 1], axis=1)
+    eps[c, 2] = np.sum(dNdy * U[:, :, 0] + dNdx * U[:, :, 1], axis=1)
+    if bulk.enr_dofs.shape[0]:
+        ue = np.where(bulk.enr_dofs >= 0, u[np.maximum(bulk.enr_dofs, 0)], 0.0)
+        eps[bulk.enriched_cells] = np.einsum("eij,ej->ei", bulk.enr_Bbar, ue)
+    return eps
+
+
+def bulk_fields(
+    mesh, bulk, D, u, initial_stress, nu, model, cell_material=None, biot_p=None
+):
+    """stress (M, 3), stress_zz (M,), principal_stress (M, 2) [Pa] (total).
+
+    With several materials (xfemslip.fem.poro): D (k, 3, 3), nu (k,) and
+    ``cell_material`` (M,).  With pore pressure, ``biot_p`` = (alpha p0,
+    alpha p (M,)) [Pa] at this step: sigma = sigma0 + D eps - alpha (p - p0) m
+    and, in plane strain, sigma_zz = nu (sigma'_xx + sigma'_yy) - alpha p with
+    sigma' = sigma0 + alpha p0 m + D eps (see xfemslip.fem.poro).
+    """
+    eps = cell_strain(mesh, bulk, u)
+    if cell_material is None:
+        stress = eps @ np.asarray(D).reshape(3, 3).T
+        nu_c = np.full(mesh.n_cells, float(np.ravel(nu)[0]))
+    else:
+        stress = np.einsum("mij,mj->mi", np.asarray(D)[cell_material], eps)
+        nu_c = np.asarray(nu, float)[cell_material]
+    if initial_stress is not None:
+        stress = stress + np.asarray(initial_stress, float)[None, :]
+    a0, a = (0.0, np.zeros(mesh.n_cells)) if biot_p is None else biot_p
+    # stress is sigma0 + D eps here, i.e. sigma' - alpha p0 m
+    szz = (
+        nu_c * (stress[:, 0] + stress[:, 1] + 2.0 * a0) - a
+        if model == "plane_strain"
+        else np.zeros(len(stress))
+    )
+    stress = stress - (a - a0)[:, None] * np.array([1.0, 1.0, 0.0])
+    centre = 0.5 * (stress[:, 0] + stress[:, 1])
+    radius = np.hypot(0.5 * (stress[:, 0] - stress[:, 1]), stress[:, 2])
+    principal = np.column_stack([centre + radius, centre - radius])
+    return stress, szz, principal
+
+
+def fracture_fields(ip, res, n_fractures, fluid=None) -> list[FractureFields]:
+    """Contact fields per fracture, ordered by arc length.
+
+    fluid : (n,) fluid pressure at the interface points [Pa] or None.  The
+    contact law gives the effective normal traction sigma_n'; with a fluid,
+    ``normal_traction`` is the total sigma_n' - p_f and the effective one and
+    p_f are reported too (xfemslip.fem.poro).
+    """
+    out = []
+    for fi in range(n_fractures):
+        m = np.nonzero(ip.fracture == fi)[0]
+        m = m[np.argsort(ip.s[m], kind="stable")]
+        pn = res.point_pn[m].copy()
+        extra = {}
+        if fluid is not None:
+            pf = np.asarray(fluid, float)[m].copy()
+            extra = {"fluid_pressure": pf, "effective_normal_traction": pn}
+            pn = pn - pf
+        out.append(
+            FractureFields(
+                s=ip.s[m].copy(),
+                points=ip.xy[m].copy(),
+                slip=res.point_gt[m].copy(),
+                opening=res.point_gn[m].copy(),
+                normal_traction=pn,
+                shear_traction=res.point_pt[m].copy(),
+                state=res.point_state[m].astype(np.int8),
+                **extra,
+            )
+        )
+    return out
+
+
+def vis_mesh(mesh, ec, bulk, u) -> VisMesh:
+    """Bulk mesh with enriched cells split into sub-triangles, each on its side."""
+    n_std = 2 * mesh.n_nodes
+    U = u[:n_std].reshape(-1, 2)
+    is_enr = np.zeros(mesh.n_cells, bool)
+    is_enr[ec.cells] = True
+    quads = mesh.cells[~is_enr]
+    quad_cell = np.nonzero(~is_enr)[0]
+    nt = ec.tris.shape[0]
+    if nt == 0:
+        return VisMesh(
+            points=mesh.nodes.copy(),
+            displacement=U.copy(),
+            quads=quads,
+            quad_cell=quad_cell,
+            triangles=np.zeros((0, 3), np.int64),
+            triangle_cell=np.zeros(0, np.int64),
+        )
+    tri_owner = np.repeat(
+        np.arange(ec.cells.size), np.diff(ec.tri_offsets)
+    )  # enriched index
+    cell = ec.cells[tri_owner]
+    pts = ec.tris.reshape(-1, 2)
+    owner_v = np.repeat(tri_owner, 3)
+    N = mesh.shape_at(np.repeat(cell, 3), pts)  # (3nt, 4)
+    disp = np.einsum("va,vac->vc", N, U[mesh.cells[np.repeat(cell, 3)]])
+    Fv = ec.tri_F.reshape(-1, ec.tri_F.shape[2])  # (3nt, S)
+    dofs = bulk.enr_dofs[owner_v]  # (3nt, 8+2S)
+    for s in range(ec.slot_cand.shape[1]):
+        a = ec.slot_node[owner_v, s]
+        d = dofs[:, 8 + 2 * s]
+        ok = (a >= 0) & (d >= 0)
+        phi = np.where(
+            ok,
+            N[np.arange(len(a)), np.maximum(a, 0)]
+            * (Fv[:, s] - ec.slot_fnode[owner_v, s]),
+            0.0,
+        )
+        amp = np.where(
+            ok[:, None], u[np.stack([np.maximum(d, 0), np.maximum(d, 0) + 1], 1)], 0.0
+        )
+        disp += phi[:, None] * amp
+    base = mesh.n_nodes
+    triangles = base + np.arange(3 * nt, dtype=np.int64).reshape(nt, 3)
+    return VisMesh(
+        points=np.vstack([mesh.nodes, pts]),
+        displacement=np.vstack([U, disp]),
+        quads=quads,
+        quad_cell=quad_cell,
+        triangles=triangles,
+        triangle_cell=cell.astype(np.int64),
+    )
+
+
+def step_fields(model, r) -> StepFields:
+    """The fields of the converged step ``r`` (a ``StepResult``) of ``model``
+    (a :class:`xfemslip.simulation.Model`)."""
+    spec = model.spec
+    mats, pore = model.materials, model.pore
+    hetero = spec.reservoir is not None
+    biot_p = None
+    if pore is not None:
+        p = pore.cell_pressure(r.load_factor)
+        biot_p = (pore.biot * pore.initial, pore.biot * p)
+    stress, szz, principal = bulk_fields(
+        model.mesh,
+        model.bulk,
+        mats.D if hetero else model.D,
+        r.u,
+        spec.loading.initial_stress,
+        mats.nu if hetero else spec.material.nu,
+        spec.material.model,
+        cell_material=mats.cell if hetero else None,
+        biot_p=biot_p,
+    )
+    extra = {}
+    fluid = None
+    if pore is not None:
+        extra = {
+            "effective_stress": stress + biot_p[1][:, None] * [1.0, 1.0, 0.0],
+            "pore_pressure": p,
+        }
+        fluid = fluid_pressure(model.ip, pore, r.load_factor)
+    n_std = 2 * model.mesh.n_nodes
+    return StepFields(
+        step=r.step,
+        load_factor=r.load_factor,
+        newton_iterations=r.iterations,
+        displacement=r.u[:n_std].reshape(-1, 2).copy(),
+        stress=stress,
+        stress_zz=szz,
+        principal_stress=principal,
+        fractures=fracture_fields(model.ip, r.contact, len(model.fractures), fluid),
+        **extra,
+    )
+
+
+def first_non_finite(steps) -> tuple[int, str] | None:
+    """(index, field name) of the first of ``steps`` (StepFields) holding NaN
+    or inf, or None: such a step is never written."""
+    for index, f in enumerate(steps):
+        arrays = {
+            "displacement": f.displacement,
+            "stress": f.stress,
+            "stress_zz": f.stress_zz,
+            "principal_stress": f.principal_stress,
+        }
+        for i, fr in enumerate(f.fractures):
+            for name in ("slip", "opening", "normal_traction", "shear_traction"):
+                arrays[f"fractures[{i}].{name}"] = getattr(fr, name)
+        for name, value in arrays.items():
+            if not np.all(np.isfinite(value)):
+                return index, name
+    return None

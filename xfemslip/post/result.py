@@ -1,0 +1,156 @@
+"""``Result``: what a run gives back, in memory or read back from ``result.h5``.
+
+:func:`xfemslip.run_case` returns one without reading a file, and
+:func:`xfemslip.read_result` reads one from ``result.h5``; both hold the same
+arrays (``output-format.md``):
+
+- ``attrs``: the root attributes of ``result.h5`` (``format_version``,
+  ``xfemslip_version``, ``case_toml``, ``converged``, ``load_steps``,
+  ``newton_iterations``, ``newton_iterations_per_step``,
+  ``load_step_cuts_per_step``, ``wall_time_s``, ``tangent``,
+  ``contact_patch_cells``, ``n_dofs``, ``kernels``, ``status_codes``,
+  ``run_id``) as Python scalars, strings and NumPy arrays;
+- ``points`` (N, 2) [m] and ``cells`` (M, 4) of the mesh;
+- ``steps``: a :class:`~xfemslip.post.fields.StepFields` per converged load
+  step, in order: displacement (N, 2) [m], the fields of every fracture
+  (``s``, ``points``, ``slip``, ``opening``, ``normal_traction``,
+  ``shear_traction``, ``state``), and the element stresses.  ``result.h5``
+  keeps the element stresses of the final step only, so in a result read
+  back they are None for the other steps.
+
+``run_id`` is the digest every file of one output set carries.
+"""
+
+from __future__ import annotations
+
+import hashlib
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass, field, fields
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from xfemslip.post.fields import FractureFields, StepFields
+
+__all__ = ["TIMED_ATTRS", "Result", "run_id"]
+
+
+@dataclass
+class Result:
+    """A run's mesh, the fields of its converged load steps and its attributes.
+
+    The properties give the attributes a run summary reports (``converged``,
+    ``load_steps``, ``newton_iterations`` ...) and the fields of the final
+    step (``displacement``, ``stress``, ``fractures`` ...).
+    """
+
+    attrs: dict[str, Any]
+    points: np.ndarray  # (N, 2) [m]
+    cells: np.ndarray  # (M, 4) int64
+    steps: list[StepFields] = field(default_factory=list)
+    # the folder the output set was written to (None: nothing written)
+    out_dir: Path | None = None
+
+    @property
+    def converged(self) -> bool:
+        return bool(self.attrs["converged"])
+
+    @property
+    def load_steps(self) -> int:
+        return int(self.attrs["load_steps"])
+
+    @property
+    def newton_iterations(self) -> int:
+        return int(self.attrs["newton_iterations"])
+
+    @property
+    def iterations_per_step(self) -> list[int]:
+        """Newton iterations of each converged step."""
+        return [int(n) for n in self.attrs["newton_iterations_per_step"]]
+
+    @property
+    def wall_time_s(self) -> float:
+        return float(self.attrs["wall_time_s"])
+
+    @property
+    def n_dofs(self) -> int:
+        return int(self.attrs["n_dofs"])
+
+    @property
+    def run_id(self) -> int:
+        return int(self.attrs["run_id"])
+
+    @property
+    def final(self) -> StepFields | None:
+        """The last converged step (None when no step converged)."""
+        return self.steps[-1] if self.steps else None
+
+    @property
+    def displacement(self) -> np.ndarray:
+        """(N, 2) [m] nodal displacement of the final step."""
+        return self._final().displacement
+
+    @property
+    def stress(self) -> np.ndarray:
+        """(M, 3) [Pa] element-average sxx, syy, sxy of the final step."""
+        return self._final().stress
+
+    @property
+    def principal_stress(self) -> np.ndarray:
+        """(M, 2) [Pa] s_max, s_min of the final step."""
+        return self._final().principal_stress
+
+    @property
+    def fractures(self) -> list[FractureFields]:
+        """The fracture fields of the final step, by case-file index."""
+        return self._final().fractures
+
+    def _final(self) -> StepFields:
+        if not self.steps:
+            raise ValueError("the result holds no converged load step")
+        return self.steps[-1]
+
+
+# Root attributes that hold a time, so differ between runs of the same case.
+TIMED_ATTRS = ("wall_time_s",)
+
+
+def run_id(
+    attrs: Mapping[str, object],
+    points: np.ndarray,
+    cells: np.ndarray,
+    steps: Sequence[StepFields],
+) -> int:
+    """The ``run_id`` every file of one output set carries (output-format.md).
+
+    A digest (SHA-256, first 63 bits as a non-negative int64) of the root
+    attributes except the timed ones (the case text among them), the mesh and
+    every array of every step.  Files of one run share it; two runs share it
+    only when they wrote the same numbers, so files stamped alike never show
+    different results, and the same input gives the same bytes.
+    """
+    digest = hashlib.sha256()
+
+    def add(name: str, value) -> None:
+        array = np.ascontiguousarray(value)
+        digest.update(f"{name}:{array.dtype.str}:{array.shape};".encode())
+        digest.update(array.tobytes())
+
+    for key in sorted(attrs):
+        if key not in TIMED_ATTRS and key != "run_id":
+            add(f"attr {key}", attrs[key])
+    add("points", points)
+    add("cells", cells)
+    for step in steps:
+        for item in fields(step):
+            value = getattr(step, item.name)
+            if item.name == "fractures":
+                for index, fracture in enumerate(value):
+                    for part in fields(fracture):
+                        data = getattr(fracture, part.name)
+                        if data is not None:
+                            add(f"{step.step} {index} {part.name}", data)
+            elif value is not None:
+                add(f"{step.step} {item.name}", value)
+    return int.from_bytes(digest.digest()[:8], "big") >> 1

@@ -1,0 +1,799 @@
+"""Load stepping and Newton-Raphson (paper eq. 21).
+
+Residual r(u) = K_bulk u + f_con(u) - f_0 - lambda F_ext on the free dofs, where
+f_0 is the contact force of the in-situ traction sigma0 . n at zero jump (the
+force that balances the initial stress; zero without one).  Where the contact
+law cannot carry that traction (shear above the friction limit, tension), f_0
+differs from f_con(0) and the excess is released in the first load step
+(ContactSet.in_situ_force).  Convergence: eta = ||r_free|| / ||F_ref|| <=
+tolerance, where F_ref stacks the applied forces on the free dofs, the
+released in-situ excess and the reactions on the prescribed ones, so
+displacement-driven cases (no applied force at all) have a meaningful
+reference (eta of the paper with F_ext including reactions).
+
+Tangents: "consistent" uses the exact derivative of the return map (not
+symmetric while slipping), which gives quadratic convergence once the
+stick/slip set has settled; "secant" is the paper's eq. 28 update.  With the
+consistent tangent the first solve of a step uses a predicted stick/slip set
+(xfemslip.contact.predictor): when the guess is right the step converges in one
+solve, when it is wrong Newton goes on from there under the true law.  The linear
+systems go to xfemslip.solve.linear (SuperLU with the factorization kept, or
+AMG-preconditioned GMRES), which handles the non-symmetric case.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import logging
+import math
+from dataclasses import dataclass
+
+import numpy as np
+import scipy.sparse as sp
+
+from xfemslip.case.specs import AUTO_PENALTY
+from xfemslip.contact import branches as local_branches
+from xfemslip.contact.branches import force_branches
+from xfemslip.contact.interface import ContactResult, ContactSet
+from xfemslip.contact.predictor import predict_state, predicted_law
+from xfemslip.conventions import (
+    OPEN,
+    SLIP,
+    SLIP_BACKWARD,
+    STICK,
+    TANGENT_CONSISTENT,
+    TANGENT_SECANT,
+    TANGENTS,
+)
+from xfemslip.errors import ConvergenceError
+from xfemslip.fem.assembly import coo_block
+from xfemslip.solve.linear import LinearSolver
+
+logger = logging.getLogger(__name__)
+
+# kn*h/E above this is named in the message of a Newton failure as a likely cause.
+PENALTY_RATIO_HIGH = 1.0e5
+# Top of the penalty range where Newton was measured to converge on every
+# shipped case, kn = kt = 10^k E/h for k = -1..9 (benchmarks/penalty_range.py,
+# README "Known limits"): 0.1 to 1e6.  Above it the contact stiffness swamps
+# the bulk stiffness by that ratio and the residual stalls at round-off (eta
+# 1e-8 to 6e-8, stick/slip states settled), just above the default
+# tolerance; every Newton failure then names the penalty and this value.
+PENALTY_RATIO_MEASURED = 1.0e6
+# Step halvings tried by the line search before keeping the best trial.
+LINE_SEARCH_CUTS = 6
+# Ping-pong remedy: a contact point whose branch of the law (stick, slip +t,
+# slip -t) alternates A, B, A, B, A, B over six successive iterates is
+# cycling.  It is then frozen in STICK (force_branches) until Newton
+# converges; the true law is then restored and Newton continues from there,
+# so an accepted step always satisfies the true law.  At most
+# PINGPONG_MAX_FREEZES freezes per attempt; after that the attempt fails and
+# the load step is bisected.
+PINGPONG_MAX_FREEZES = 2
+# Periods A, B of the alternation that count as cycling (3: six iterates).
+PINGPONG_PERIODS = 3
+# Slip-reversal remedy (NewtonSolver._reversals): times a patch may be held
+# in stick within one Newton solve.  Once (a patch that reverses again after
+# the release is let through) left 5 of the 20 allow-DFN seeds failing with
+# the predictor on; without a limit a patch can be held and released
+# forever (seed 1, predictor off); 2 and 3 converge on all 20 seeds both
+# ways (benchmarks/RESULTS.md, "Newton on fracture networks").
+REVERSAL_HOLDS = 2
+# Local branch searches (xfemslip.contact.branches) per Newton solve: a patch
+# that reverses its slip again after REVERSAL_HOLDS holds has no consistent
+# branch while its neighbours keep theirs (refined DFN realizations:
+# docs/performance.md, "Fracture networks", refined meshes); the
+# stick/slip set of it and its neighbours is then searched.
+LOCAL_SEARCHES = 2
+# Load-step bisection: a load step that does not converge is cut in halves, at
+# most this many times by default ([solver] max_step_cuts), so the smallest
+# sub-step is 1/2**5 = 1/32 of the step.  Every converged sub-step commits the
+# friction history, exactly as a load step does; a failed attempt leaves the
+# committed state untouched (nothing is committed before convergence).
+DEFAULT_STEP_CUTS = 5
+
+
+@dataclass
+class Problem:
+    K: sp.csr_matrix  # bulk stiffness (n_dofs, n_dofs)
+    F_unit: np.ndarray  # external force at load factor 1 (n_dofs,)
+    fixed: np.ndarray  # prescribed dofs
+    fixed_values: np.ndarray  # their final values
+    contact: ContactSet
+    n_dofs: int
+    # (fracture index in the case file, mask of its contact points) for each
+    # fracture that cuts the domain in two with one part left without any
+    # prescribed displacement: that part is held by the fracture alone.
+    floating: list = None
+    # largest penalty stiffness relative to the bulk, max(kn, kt) * h_min / E [-]
+    penalty_ratio: float = 0.0
+    # (n_nodes, 2) node coordinates: rigid-body modes of the AMG linear solver
+    node_xy: np.ndarray = None
+    # far-field stress (xx, yy, xy) [Pa] added from load factor 0 to 1
+    # (predictor.stress_increment), or None: only used to guess the stick/slip
+    # set of a step (predictor.py)
+    load_stress: tuple = None
+
+
+@dataclass
+class StepResult:
+    step: int
+    load_factor: float
+    u: np.ndarray
+    contact: ContactResult
+    iterations: int
+    residuals: list  # eta at every iteration (of the last sub-step)
+    switches: list  # stick/slip/open switches at every iteration (idem)
+    cuts: int = 0  # load-step bisections needed in this step
+    substeps: int = 1  # converged sub-steps that make up this step
+    freezes: int = 0  # ping-pong freezes (all sub-steps)
+    factors: list = None  # load factors of the converged sub-steps, in order
+    # sub-steps whose first Newton solve used the predicted stick/slip set
+    predicted: int = 0
+    # Newton steps re-solved with slip-reversing patches held in stick (each
+    # one extra linear solve; NewtonSolver._reversals), all sub-steps
+    reversals: int = 0
+    # local branch searches that found a consistent stick/slip set for a
+    # patch reversing after its holds and its neighbours (all sub-steps)
+    searches: int = 0
+
+
+def _regime(state, pt):
+    """Branch of the contact law at each point: open, stick, slip forward (+t),
+    slip backward.  A switch between any two changes the tangent, so it is what
+    the log and the ConvergenceError count as a stick/slip switch."""
+    return np.where(state == SLIP, np.where(pt >= 0.0, SLIP, SLIP_BACKWARD), state)
+
+
+class NewtonSolver:
+    """Newton-Raphson over load steps on a Problem; keeps the converged steps."""
+
+    def __init__(
+        self,
+        problem: Problem,
+        tolerance: float,
+        max_iterations: int,
+        tangent: str,
+        linear_solver: str = "auto",
+        *,
+        max_step_cuts: int = DEFAULT_STEP_CUTS,
+        predictor: bool = True,
+    ):
+        self.p = problem
+        # guess the stick/slip set of each step (consistent tangent only: the
+        # secant one is not exact within a set, so the guess would not pay)
+        self.predictor = (
+            bool(predictor) and tangent == "consistent" and problem.contact.n > 0
+        )
+        self.max_cuts = int(max_step_cuts)
+        self.tol = tolerance
+        self.max_it = max_iterations
+        self.mode = TANGENTS[tangent]
+        n = problem.n_dofs
+        free = np.ones(n, bool)
+        free[problem.fixed] = False
+        self.free = np.nonzero(free)[0]
+        self.reduced = -np.ones(n, np.int64)
+        self.reduced[self.free] = np.arange(self.free.size)
+        self.K_ff = problem.K[self.free][:, self.free].tocsr()
+        self.linear = LinearSolver(self.K_ff, linear_solver, self.free, problem.node_xy)
+        c = problem.contact
+        self.c_dofs = np.where(c.dofs >= 0, self.reduced[np.maximum(c.dofs, 0)], -1)
+        # tangent blocks of the contact evaluations whose tangent is never
+        # used (_scratch_blocks)
+        self._scratch = None
+        zero = c.evaluate(
+            np.zeros(n),
+            self.mode,
+            c.pt_committed,
+            c.gt_committed,
+            scratch=self._scratch_blocks(),
+        )
+        self.f_c0 = c.in_situ_force(zero)
+        # the contact law at zero jump: what it admits of the in-situ traction
+        # (kept for the log and deplete; its tangent blocks are not needed)
+        self.in_situ = zero
+        # the in-situ excess over the contact law (ContactSet.in_situ_force),
+        # released from the first load step on: a load like lam F_ext, so it
+        # is stacked into the reference of eta (None: nothing to release)
+        self._release = (
+            None if self.f_c0 is zero.force else (self.f_c0 - zero.force)[self.free]
+        )
+        self.completed: list[StepResult] = []
+        # committed normal traction and load factor (for the predictor)
+        self._pn_committed = c.pn0.copy()
+        self._lam_committed = 0.0
+
+    def run(self, steps: int) -> list[StepResult]:
+        """Proportional loading in ``steps`` equal load steps."""
+        return self.run_path([k / steps for k in range(1, steps + 1)])
+
+    def run_path(self, factors) -> list[StepResult]:
+        """Load steps ending at the load factors ``factors`` (from 0), in order.
+
+        Proportional loading is ``run``; a path like [1, 0, 1, 0] loads and
+        unloads (friction is path dependent: the history carries over).
+        """
+        u = np.zeros(self.p.n_dofs)
+        lam0 = 0.0
+        n = len(factors)
+        for k, lam in enumerate(factors, start=1):
+            u = self._advance(u, lam0, float(lam), k, n)
+            lam0 = float(lam)
+        return self.completed
+
+    def _residual(self, u, lam, res: ContactResult):
+        f_int = self.p.K @ u + res.force - self.f_c0
+        r = f_int - lam * self.p.F_unit
+        ref2 = float(
+            np.sum((lam * self.p.F_unit[self.free]) ** 2) + np.sum(r[self.p.fixed] ** 2)
+        )
+        if self._release is not None:
+            ref2 += float(np.sum(self._release**2))
+        ref = math.sqrt(ref2)
+        norm = float(np.linalg.norm(r[self.free]))
+        eta = norm / ref if ref > 0.0 else (0.0 if norm == 0.0 else math.inf)
+        return r[self.free], eta
+
+    def _advance(self, u, lam0, lam1, k, steps):
+        """Load step k from lam0 to lam1, bisected on failure (max_cuts times).
+
+        The step is split into 2**max_cuts units; ``size`` is the current
+        sub-step in units.  A converged sub-step commits the contact history
+        and the next one tries twice the size; a failed one is retried from
+        the last committed state at half the size.
+        """
+        units = 1 << self.max_cuts
+        done, size = 0, units
+        cuts = substeps = iterations = freezes = predicted = reversals = 0
+        searches = 0
+        factors = []  # load factors of the converged sub-steps
+        while done < units:
+            end = min(done + size, units)
+            lam = lam1 if end == units else lam0 + (lam1 - lam0) * end / units
+            try:
+                u_new, res, log = self._newton(u, lam, k, steps)
+            except ConvergenceError as err:
+                if not err.retryable or size == 1:
+                    if cuts:
+                        raise self._after_cuts(err, cuts, size / units) from None
+                    raise
+                size //= 2
+                cuts += 1
+                lam_from = lam0 + (lam1 - lam0) * done / units
+                lam_to = lam0 + (lam1 - lam0) * (done + size) / units
+                logger.info(
+                    "step %d/%d: cutting the load step (cut %d of at most %d): "
+                    "load factor %.6g -> %.6g (%s)",
+                    k,
+                    steps,
+                    cuts,
+                    self.max_cuts,
+                    lam_from,
+                    lam_to,
+                    err.reason,
+                )
+                continue
+            self.p.contact.commit(res)
+            self._pn_committed = res.pn.copy()
+            self._lam_committed = lam
+            u = u_new
+            done = end
+            factors.append(lam)
+            if cuts:  # after a success, try a sub-step twice as long again
+                size = min(2 * size, units)
+            substeps += 1
+            iterations += log.iterations
+            freezes += log.freezes
+            predicted += log.predicted
+            reversals += log.reversals
+            searches += log.found
+        if cuts:
+            logger.info(
+                "step %d/%d converged in %d sub-steps after %d cut(s)",
+                k,
+                steps,
+                substeps,
+                cuts,
+            )
+        self.completed.append(
+            StepResult(
+                k,
+                lam1,
+                u.copy(),
+                # kept until the output is written; its tangent blocks (the
+                # largest part on crowded networks) are never read again
+                dataclasses.replace(res, blocks=None),
+                iterations,
+                log.residuals,
+                log.switches,
+                cuts=cuts,
+                substeps=substeps,
+                freezes=freezes,
+                factors=factors,
+                predicted=predicted,
+                reversals=reversals,
+                searches=searches,
+            )
+        )
+        return u
+
+    def _after_cuts(self, err, cuts, fraction):
+        """The error of the last attempt, saying that bisection did not help."""
+        why = (
+            f"even after cutting the load step {cuts} time(s) (sub-steps down to "
+            f"{fraction:.3g} of it): {err.reason}"
+        )
+        return ConvergenceError(
+            self._message(err.step, why, err.iteration, err.residual, err.flips),
+            step=err.step,
+            iteration=err.iteration,
+            residual=err.residual,
+            increment=err.increment,
+            flips=err.flips,
+            reason=why,
+            retryable=err.retryable,
+        )
+
+    def _newton(self, u, lam, k, steps):
+        """Newton to load factor lam from u and the committed history.
+
+        Returns (u, contact result, _NewtonLog); raises ConvergenceError.
+        Nothing is committed here.
+        """
+        c = self.p.contact
+        u = u.copy()
+        u[self.p.fixed] = lam * self.p.fixed_values
+        pt_prev, gt_prev = c.pt_committed.copy(), c.gt_committed.copy()
+        prev_regime = _regime(c.state_committed, c.pt_committed)
+        log = _NewtonLog()
+        history = []  # regimes of the iterates under the current law
+        law = c  # the contact law evaluated: c, or c with frozen points
+        frozen = None
+        held = np.zeros(c.n, np.int64)  # times each patch was held (_reversals)
+        forced = False  # law forces the branches of a local search
+        res = law.evaluate(u, self.mode, pt_prev, gt_prev)
+        r, eta = self._residual(u, lam, res)
+        for it in range(self.max_it + 1):
+            regime = _regime(res.state, res.pt)
+            flips = int(np.count_nonzero(regime != prev_regime))
+            log.residuals.append(eta)
+            log.switches.append(flips)
+            history.append(regime)
+            logger.info(
+                "step %d/%d iteration %d: eta = %.3e; contact points: %d slip, %d "
+                "stick, "
+                "%d open; %d switched%s",
+                k,
+                steps,
+                it,
+                eta,
+                np.count_nonzero(res.state == SLIP),
+                np.count_nonzero(res.state == STICK),
+                np.count_nonzero(res.state == OPEN),
+                flips,
+                "" if frozen is None else f"; {int(frozen.sum())} frozen",
+            )
+            if not np.isfinite(eta):
+                raise self._fail(k, it, eta, flips, "the residual is not finite")
+            if eta <= self.tol and (frozen is not None or forced):
+                # converged with frozen points: restore the true law, go on
+                logger.info(
+                    "step %d/%d: converged with %d frozen point(s)%s; "
+                    "releasing them and checking the true contact law",
+                    k,
+                    steps,
+                    0 if frozen is None else int(frozen.sum()),
+                    " and searched branches" if forced else "",
+                )
+                law, frozen, forced, history = c, None, False, []
+                res = law.evaluate(u, self.mode, pt_prev, gt_prev)
+                r, eta = self._residual(u, lam, res)
+                regime = _regime(res.state, res.pt)
+                history.append(regime)
+            if eta <= self.tol:
+                self._check_floating(res, k, it, eta)
+                if not (np.all(np.isfinite(u)) and _finite(res)):
+                    raise self._fail(
+                        k, it, eta, flips, "the solution is not finite (overflow)"
+                    )
+                log.iterations = it
+                return u, res, log
+            if it == self.max_it:
+                raise self._fail(
+                    k, it, eta, flips, self._no_convergence_reason(log.switches)
+                )
+            cycling = _cycling(history)
+            if cycling is not None and log.freezes < PINGPONG_MAX_FREEZES:
+                frozen = cycling if frozen is None else (frozen | cycling)
+                law = force_branches(c, stick_at=frozen)
+                log.freezes += 1
+                logger.info(
+                    "step %d/%d iteration %d: %d contact point(s) ping-pong "
+                    "between stick and slip; freezing their state (freeze %d of "
+                    "at most %d)",
+                    k,
+                    steps,
+                    it,
+                    int(cycling.sum()),
+                    log.freezes,
+                    PINGPONG_MAX_FREEZES,
+                )
+                history = []
+                res = law.evaluate(u, self.mode, pt_prev, gt_prev)
+                r, eta = self._residual(u, lam, res)
+            guess = self._guess(u, lam, regime) if it == 0 and frozen is None else None
+            if guess is not None:  # first solve with the predicted set
+                log.predicted = 1
+                du = self._solve(guess[0], guess[1], k, it, eta)
+                guess = None  # its tangent blocks are not needed any more
+            else:
+                du = self._solve(res, r, k, it, eta)
+                flipped, stubborn = self._reversals(
+                    u, du, regime, law, pt_prev, gt_prev, held
+                )
+                if (
+                    flipped is None
+                    and stubborn is not None
+                    and log.searches < LOCAL_SEARCHES
+                ):
+                    log.searches += 1
+                    searched = self._local_search(u, res, r, law, stubborn)
+                    if searched is not None:
+                        law, forced = searched, True
+                        log.found += 1
+                        logger.info(
+                            "step %d/%d iteration %d: the Newton step reverses "
+                            "the slip of %d contact patch(es) held %d times "
+                            "already; a consistent stick/slip set of them and "
+                            "their neighbours was found: solving with it",
+                            k,
+                            steps,
+                            it,
+                            int(stubborn.sum()),
+                            REVERSAL_HOLDS,
+                        )
+                        res = law.evaluate(u, self.mode, pt_prev, gt_prev)
+                        r, eta = self._residual(u, lam, res)
+                        regime = _regime(res.state, res.pt)
+                        du = self._solve(res, r, k, it, eta)
+                if flipped is not None:
+                    held += flipped
+                    frozen = flipped if frozen is None else (frozen | flipped)
+                    law = force_branches(c, stick_at=frozen)
+                    log.reversals += 1
+                    logger.info(
+                        "step %d/%d iteration %d: the Newton step reverses the "
+                        "slip of %d contact patch(es) (forward <-> backward); "
+                        "holding them in stick, the state between the two",
+                        k,
+                        steps,
+                        it,
+                        int(flipped.sum()),
+                    )
+                    res = law.evaluate(u, self.mode, pt_prev, gt_prev)
+                    r, eta = self._residual(u, lam, res)
+                    regime = _regime(res.state, res.pt)
+                    du = self._solve(res, r, k, it, eta)
+            pt_prev, gt_prev, prev_regime = res.pt, res.gt, regime
+            eta_before = eta
+            u, res, r, eta = self._line_search(u, du, lam, eta, pt_prev, gt_prev, law)
+            if self.mode == TANGENT_SECANT and not eta < eta_before:
+                # the secant direction is no descent direction (it drops the
+                # n-t coupling of the slip law): one consistent iteration
+                log.fallbacks += 1
+                logger.info(
+                    "step %d/%d iteration %d: the secant tangent gave no descent; "
+                    "the next iteration uses the consistent tangent",
+                    k,
+                    steps,
+                    it + 1,
+                )
+                res = law.evaluate(u, TANGENT_CONSISTENT, pt_prev, gt_prev)
+        raise AssertionError("unreachable")
+
+    def _guess(self, u, lam, regime):
+        """(contact result, residual) at u under the predicted stick/slip set
+        (predictor.py), or None without a prediction or when it is the set
+        of the true law at u already."""
+        if not self.predictor:
+            return None
+        c = self.p.contact
+        state, sign = predict_state(
+            c, self._pn_committed, self.p.load_stress, lam - self._lam_committed
+        )
+        res = predicted_law(c, state, sign).evaluate(
+            u, self.mode, c.pt_committed, c.gt_committed
+        )
+        guess = _regime(res.state, res.pt)
+        if np.array_equal(guess, regime):
+            return None
+        logger.info(
+            "predicted stick/slip set: %d slip, %d stick, %d open (%d differ "
+            "from the state at the start); first solve with it",
+            np.count_nonzero(res.state == SLIP),
+            np.count_nonzero(res.state == STICK),
+            np.count_nonzero(res.state == OPEN),
+            int(np.count_nonzero(guess != regime)),
+        )
+        return res, self._residual(u, lam, res)[0]
+
+    def _reversals(self, u, du, regime, law, pt_prev, gt_prev, held):
+        """Patches whose slip the full Newton step reverses, or None.
+
+        A patch slipping forward at u and backward at u - du (or the other way
+        round) jumps over its stick band, |g_T - g_T^p| <= (c - f p_N) / k_T,
+        which is narrow (about 1e-6 m with stiff penalties) however long the
+        step.  Next to fracture junctions the next step often reverses it
+        back (the slip tangent has no tangential stiffness, d p_T / d g_T = 0,
+        so nothing in the linearization holds the patch), and the line search
+        then only shortens steps that keep cycling.  The continuous path
+        between the two slip branches passes through stick: those patches are
+        held in stick (force_branches) until Newton converges, then the true law
+        is restored and checked, as for ping-pong.  A patch is held at most
+        REVERSAL_HOLDS times per Newton solve (``held``, counts).  Returns
+        (patches to hold, or None; patches that reverse again after their
+        holds, or None): for the latter the stick/slip set of them and their
+        neighbours is searched (_local_search; a patch with no consistent
+        branch of its own, refined DFN meshes); when the search finds nothing,
+        the step is taken.  Consistent tangent only.
+        """
+        if self.mode != TANGENT_CONSISTENT:
+            return None, None
+        trial = u.copy()
+        trial[self.free] -= du
+        res = law.evaluate(
+            trial, self.mode, pt_prev, gt_prev, scratch=self._scratch_blocks()
+        )
+        new = _regime(res.state, res.pt)
+        mask = ((regime == SLIP) & (new == SLIP_BACKWARD)) | (
+            (regime == SLIP_BACKWARD) & (new == SLIP)
+        )
+        stubborn = mask & (held >= REVERSAL_HOLDS)
+        mask &= held < REVERSAL_HOLDS
+        return (mask if mask.any() else None), (stubborn if stubborn.any() else None)
+
+    def _local_search(self, u, res, r, law, stubborn):
+        """The law with the branches of ``stubborn`` and their neighbours
+        forced to a consistent local set (xfemslip.contact.branches), or None
+        when the search finds none or only the current set."""
+        c = self.p.contact
+        near = local_branches.neighbours(self.c_dofs, self.K_ff, stubborn)
+        first = np.nonzero(stubborn)[0]
+        # open neighbours stay out: the search has no open branch, and its
+        # Woodbury form assumes a closed (stick) block for every member
+        rest = np.nonzero(near & ~stubborn & (res.state != OPEN))[0]
+        idx = np.concatenate([first, rest])[: local_branches.MAX_CLUSTER]
+        mask = np.zeros(c.n, bool)
+        mask[idx] = True
+        stick = force_branches(law, stick_at=mask).evaluate(
+            u, self.mode, law.pt_committed, law.gt_committed
+        )
+        # the tangent of res with the cluster's blocks in stick, formed in
+        # the stick evaluation's array (not a copy of res.blocks: one array
+        # of the padded blocks less, memory.NEWTON_BLOCKS)
+        blocks = stick.blocks
+        np.copyto(blocks, res.blocks, where=~mask[:, None, None])
+        K = self.K_ff + coo_block(self.c_dofs, blocks, self.free.size)
+        branches = local_branches.search(c, self.c_dofs, K, u[self.free], res, r, idx)
+        if branches is None:
+            logger.info("local branch search: no consistent stick/slip set")
+            return None
+        now = local_branches.current_branches(res, idx)
+        if np.array_equal(branches, now):
+            return None
+        logger.info(
+            "local branch search over %d patch(es): %d change branch",
+            idx.size,
+            int(np.count_nonzero(branches != now)),
+        )
+        # a patch of the cluster held in stick by a hold gets its own
+        # cohesion back (a forced slip needs the finite bound)
+        base = dataclasses.replace(
+            law, cohesion=np.where(mask, c.cohesion, law.cohesion)
+        )
+        branches = np.asarray(branches)
+        moving = branches != 0
+        return force_branches(
+            base, stick_at=idx[~moving], slip_at=idx[moving], sign=branches[moving]
+        )
+
+    def _line_search(self, u, du, lam, eta0, pt_prev, gt_prev, law=None):
+        """Backtracking on eta along the Newton direction (Armijo on the norm).
+
+        The full step is tried first and kept whenever it lowers eta, so
+        Newton's quadratic convergence is untouched near the solution.  With a
+        very stiff penalty the full step can overshoot the contact states
+        (open <-> slip ping-pong); halving the step up to LINE_SEARCH_CUTS
+        times restores a decrease.  If none decreases, the best trial is kept.
+        """
+        c = self.p.contact if law is None else law
+        best = None
+        alpha = 1.0
+        for _ in range(LINE_SEARCH_CUTS + 1):
+            trial = u.copy()
+            trial[self.free] -= alpha * du
+            # Only the kept trial's tangent is used: the full step (the one
+            # kept near the solution) gets its own blocks, a shorter one is
+            # evaluated into the scratch blocks and, if kept, once more
+            # below (same result, bit for bit).  A fresh tangent per trial
+            # (up to 6 more per iteration of a stalling Newton solve) is an
+            # array of 8 m (2J)^2 bytes, 10.7 MB on a crowded network.
+            scratch = None if alpha == 1.0 else self._scratch_blocks()
+            res = c.evaluate(trial, self.mode, pt_prev, gt_prev, scratch=scratch)
+            r, eta = self._residual(trial, lam, res)
+            if best is None or eta < best[3]:
+                best = (trial, res, r, eta)
+            if eta <= (1.0 - 1.0e-4 * alpha) * eta0:
+                break
+            alpha *= 0.5
+        if best[1].blocks is None:  # the same evaluation, with its tangent
+            best = (
+                best[0],
+                c.evaluate(best[0], self.mode, pt_prev, gt_prev),
+                *best[2:],
+            )
+        if alpha < 1.0:
+            logger.info(
+                "line search: step length %.3g (eta %.3e -> %.3e)", alpha, eta0, best[3]
+            )
+        return best
+
+    def _scratch_blocks(self) -> np.ndarray:
+        """The (m, 2J, 2J) array that contact evaluations whose tangent is
+        not used write their tangent blocks into (ContactSet.evaluate), one
+        per solver."""
+        if self._scratch is None:
+            c = self.p.contact
+            self._scratch = np.empty((c.n, c.dofs.shape[1], c.dofs.shape[1]))
+        return self._scratch
+
+    def _no_convergence_reason(self, switches):
+        """Why Newton stopped, and what to change."""
+        why = f"no convergence in {self.max_it} iterations"
+        if sum(1 for n in switches[-5:] if n > 0) >= 4:
+            why += "; the contact states keep switching between iterations (ping-pong)"
+            ratio = self.p.penalty_ratio
+            if PENALTY_RATIO_HIGH < ratio <= PENALTY_RATIO_MEASURED:
+                why += (
+                    f", and the penalty is very stiff (kn*h/E up to {ratio:.1e}; "
+                    f"10 to 1e4 is usual): lower kn/kt, or use more load steps"
+                )
+            else:
+                why += "; use more load steps or raise [solver] max_iterations"
+        for index, _ in self.p.floating or []:
+            why += (
+                f"; fractures[{index}] cuts the domain in two and one part is held "
+                "by the fracture alone: when the shear driving that part reaches "
+                "friction x normal force + cohesion x length there is no static "
+                "equilibrium (rigid sliding without bound), and close to it Newton "
+                "may not find one; prescribe a displacement on that part, or raise "
+                "the friction or cohesion"
+            )
+        if self.mode == TANGENT_SECANT:
+            why += (
+                '; or set [solver] tangent = "consistent" (the secant tangent '
+                "converges linearly at best)"
+            )
+        return why
+
+    def _check_floating(self, res, k, it, eta):
+        """A block held only by a fracture with no sticking point slides unbounded."""
+        for index, mask in self.p.floating or []:
+            if mask.any() and not np.any(res.state[mask] == STICK):
+                raise self._fail(
+                    k,
+                    it,
+                    eta,
+                    0,
+                    f"fractures[{index}] cuts the domain in two and one part has no "
+                    "prescribed "
+                    "displacement, so only the fracture holds it; no point of the "
+                    "fracture "
+                    "sticks, so that part slides without bound (no static "
+                    "equilibrium). "
+                    "Prescribe a displacement on that part (e.g. on its edge) or raise "
+                    "the "
+                    "friction or cohesion",
+                    retryable=False,
+                )
+
+    def _solve(self, res, r, k, it, eta):
+        Kc = coo_block(self.c_dofs, res.blocks, self.free.size)
+        try:
+            du = self.linear.solve(Kc, r)
+        except RuntimeError as exc:  # "Factor is exactly singular"
+            raise self._fail(
+                k,
+                it,
+                eta,
+                0,
+                f"the tangent matrix is singular ({exc}); a part "
+                "of the body may be free to move (e.g. a block cut off by a "
+                "fracture with nothing holding it)",
+            ) from None
+        if not np.all(np.isfinite(du)):
+            raise self._fail(k, it, eta, 0, "the linear solve gave non-finite values")
+        return du
+
+    def _penalty_note(self) -> str:
+        """Names a penalty above PENALTY_RATIO_MEASURED and the value to use
+        instead, or ''."""
+        ratio = self.p.penalty_ratio
+        if not ratio > PENALTY_RATIO_MEASURED:
+            return ""
+        c = self.p.contact
+        e_over_h = float(np.max(np.maximum(c.kn, c.kt))) / ratio  # [Pa/m]
+        if not e_over_h > 0.0:  # the ratio overflowed (e.g. E = 1e-300 Pa)
+            return "; the penalty kn*h/E is beyond the float range"
+        kn, kt = (float(np.max(v)) / e_over_h for v in (c.kn, c.kt))
+        top = PENALTY_RATIO_MEASURED
+        return (
+            f"; the penalty is stiffer than the range where Newton was measured to "
+            f"converge (kn*h/E up to {kn:.1e}, kt*h/E up to {kt:.1e}; measured "
+            f"0.1 to {top:.0e}), where the residual stalls at round-off: lower "
+            f"kn/kt to at most {top * e_over_h:.3g} Pa/m ({top:.0e} E/h; the "
+            f"default {AUTO_PENALTY:.0f} E/h = {AUTO_PENALTY * e_over_h:.3g} Pa/m "
+            "moves the slip of the shipped cases by at most 0.04 % of its maximum)"
+        )
+
+    def _fail(self, k, it, eta, flips, why, *, retryable=True):
+        """The ConvergenceError of load step k; ``retryable`` False when a
+        smaller load step cannot cure it (no bisection)."""
+        why += self._penalty_note()
+        return ConvergenceError(
+            self._message(k, why, it, eta, flips),
+            step=k,
+            iteration=it,
+            residual=eta,
+            flips=flips,
+            reason=why,
+            retryable=retryable,
+        )
+
+    def _message(self, k, why, it, eta, flips) -> str:
+        """The one-line message of a ConvergenceError."""
+        return (
+            f"load step {k} did not converge: {why}; iteration {it}, residual eta = "
+            f"{eta:.3e} (tolerance {self.tol:.1e}), {flips} stick/slip switches in "
+            f"the last iteration; {len(self.completed)} converged step(s) kept"
+        )
+
+
+@dataclass
+class _NewtonLog:
+    """What one Newton solve did."""
+
+    iterations: int = 0
+    freezes: int = 0
+    fallbacks: int = 0  # secant iterations replaced by a consistent one
+    reversals: int = 0  # Newton steps that held reversing patches in stick
+    searches: int = 0  # local branch searches (xfemslip.contact.branches)
+    found: int = 0  # of them, those that found a consistent set
+    predicted: int = 0  # 1 if the first solve used the predicted set
+    residuals: list = None
+    switches: list = None
+
+    def __post_init__(self):
+        self.residuals = []
+        self.switches = []
+
+
+def _finite(res: ContactResult) -> bool:
+    return all(
+        np.all(np.isfinite(a)) for a in (res.force, res.gn, res.gt, res.pn, res.pt)
+    )
+
+
+def _cycling(history):
+    """Points whose tangential branch alternated A, B, A, B, ... over the last
+    PINGPONG_PERIODS * 2 iterates (A != B, both closed), or None."""
+    n = 2 * PINGPONG_PERIODS
+    if len(history) < n:
+        return None
+    last = history[-n:]
+    a, b = last[-2], last[-1]
+    mask = (a != b) & (a != OPEN) & (b != OPEN)
+    for i, regime in enumerate(last):
+        mask &= regime == (a if i % 2 == 0 else b)
+    return mask if mask.any() else None

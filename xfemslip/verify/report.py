@@ -1,0 +1,154 @@
+"""Output of ``xfemslip verify``: the table, the CSV file and the plot.
+
+The rows, the window sweep and the missed targets come from
+``xfemslip.verify.problems.run_verification``; nothing here computes an error.
+"""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+import numpy as np
+
+from xfemslip.io.csv import write_rows
+from xfemslip.io.fileset import replace_files
+from xfemslip.verify.problems import (
+    HALF_LENGTH,
+    SLIP_TARGET,
+    TARGET_H,
+    WINDOW_FRICTION,
+    WINDOW_MESH,
+    Report,
+    window_edges,
+)
+
+
+def _pct(x: float) -> str:
+    return "-" if not math.isfinite(x) else f"{100 * x:.3g}"
+
+
+def format_table(report: Report) -> str:
+    """The table printed by ``xfemslip verify``."""
+    head = (
+        f"{'problem':<16} {'mesh':>6} {'dofs':>7} {'slip L2 %':>9} "
+        f"{'K_II err %':>10} {'|K_I|/K %':>9} {'osc t_N %':>9} {'order':>6} "
+        f"{'Newton':>6} {'wall s':>7}  note"
+    )
+    lines = [head, "-" * len(head)]
+    for r in report.rows:
+        order = "-" if not math.isfinite(r.order) else f"{r.order:.2f}"
+        lines.append(
+            f"{r.problem:<16} {'a/' + str(r.a_over_h):>6} {r.dofs:>7} "
+            f"{_pct(r.slip_error):>9} {_pct(r.kii_error):>10} "
+            f"{_pct(r.ki_ratio):>9} {_pct(r.oscillation):>9} {order:>6} "
+            f"{r.newton:>6} {r.wall_s:>7.2f}  {r.note}"
+        )
+    if report.window:
+        (lo, hi), _ = window_edges()
+        bad = [w for w in report.window if w.misclassified]
+        worst = max((w.distance for w in bad), default=0.0)
+        lines += [
+            "",
+            f"slip window (f = {WINDOW_FRICTION}, h = a/{WINDOW_MESH}): exact "
+            f"beta in ({lo:.2f}, {hi:.2f}) deg; {len(report.window)} orientations, "
+            f"{len(bad)} misclassified, farthest {worst:.2f} deg from an edge",
+        ]
+        lines += [
+            f"  beta {w.beta:6.2f}  exact {'slip ' if w.slips_exact else 'stick'}  "
+            f"slipping points {100 * w.slip_share:5.1f} %"
+            + ("  MISCLASSIFIED" if w.misclassified else "")
+            for w in report.window
+        ]
+    lines.append("")
+    if not any(r.a_over_h == 40 for r in report.rows):
+        lines.append("observed-order target not checked: it needs h = a/40 (full run)")
+    if report.failures:
+        lines.append("targets missed:")
+        lines += [f"  - {f}" for f in report.failures]
+    else:
+        lines.append("all targets met")
+    return "\n".join(lines)
+
+
+CSV_FIELDS = (
+    "problem",
+    "a_over_h",
+    "dofs",
+    "slip_error",
+    "kii_error",
+    "ki_ratio",
+    "oscillation",
+    "order",
+    "newton",
+    "wall_s",
+)
+
+
+def write_outputs(report: Report, csv_path: Path | None, plot: Path | None) -> None:
+    """``--csv`` and ``--plot``, written as one set (``replace_files``)."""
+    writes = {}
+    if csv_path is not None:
+        writes[Path(csv_path)] = lambda tmp: write_csv(report, tmp)
+    if plot is not None:
+        fmt = Path(plot).suffix.lower().lstrip(".")
+        writes[Path(plot)] = lambda tmp: write_plot(report, tmp, fmt)
+    replace_files(writes)
+
+
+def write_csv(report: Report, path: Path) -> None:
+    """The table as CSV (one row per problem and mesh) into ``path``."""
+    tip = report.tip or "default"
+    rows = ([getattr(r, k) for k in CSV_FIELDS] + [tip] for r in report.rows)
+    write_rows(path, [*CSV_FIELDS, "tip"], rows)
+
+
+def write_plot(report: Report, path: Path, fmt: str | None = None) -> None:
+    """Error against h and against wall time (``fmt`` png or pdf; default: by
+    the suffix of ``path``)."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    import matplotlib.ticker
+
+    fig, (ax1, ax2) = plt.subplots(1, 2, figsize=(11, 4.5))
+    by = {}
+    for r in report.rows:
+        if r.problem.startswith("stick"):
+            continue
+        by.setdefault(r.problem, []).append(r)
+    for k, (name, seq) in enumerate(by.items()):
+        seq.sort(key=lambda r: r.a_over_h)
+        color = f"C{k % 10}"
+        h = [HALF_LENGTH / r.a_over_h for r in seq]
+        e = [r.slip_error for r in seq]
+        kk = [max(r.kii_error, 1e-6) for r in seq]
+        t = [r.wall_s for r in seq]
+        ax1.loglog(h, e, "o-", color=color, label=f"{name} slip")
+        ax1.loglog(h, kk, "s--", color=color, alpha=0.6, label=f"{name} K_II")
+        ax2.loglog(t, e, "o-", color=color, label=name)
+    if by:
+        h_all = np.array(sorted({HALF_LENGTH / r.a_over_h for r in report.rows}))
+        e_ref = max(
+            r.slip_error
+            for r in report.rows
+            if r.a_over_h == min(r.a_over_h for r in report.rows)
+        )
+        ax1.loglog(h_all, e_ref * (h_all / h_all.max()), "k:", label="order 1")
+    for ax in (ax1, ax2):
+        ax.xaxis.set_minor_formatter(matplotlib.ticker.NullFormatter())
+        ax.axhline(SLIP_TARGET, color="grey", lw=0.8)
+        ax.grid(True, which="both", alpha=0.3)
+        ax.set_ylabel("relative error")
+    ax1.axvline(HALF_LENGTH / TARGET_H, color="grey", lw=0.8)
+    ax1.set_xlabel("h [m] (a = 0.5 m; grey: h = a/20, 1 %)")
+    ax2.set_xlabel("wall time per run [s] (build + solve, in-process)")
+    ax1.set_title("error against mesh size")
+    ax2.set_title("slip error against wall time")
+    ax1.legend(fontsize=6, ncol=2)
+    ax2.legend(fontsize=7)
+    fig.suptitle(f"xfemslip verify (tip = {report.tip or 'default'})")
+    fig.tight_layout()
+    fig.savefig(path, dpi=110, format=fmt)
+    plt.close(fig)
