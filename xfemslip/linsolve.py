@@ -64,9 +64,11 @@ import time
 import numpy as np
 import scipy.sparse as sp
 
+from xfemslip import pardiso
+
 logger = logging.getLogger(__name__)
 
-LINEAR_SOLVERS = ("auto", "superlu", "amg")
+LINEAR_SOLVERS = ("auto", "superlu", "amg", "pardiso")
 
 # "auto" switches from SuperLU to AMG at this many free dofs (measured on the
 # reservoir case, benchmarks/RESULTS.md "Speed and scale"), on meshes whose
@@ -74,6 +76,14 @@ LINEAR_SOLVERS = ("auto", "superlu", "amg")
 # cells up to 146:1 the AMG-preconditioned GMRES did not converge in 300
 # iterations (58k dofs).
 AUTO_AMG_MIN_DOFS = 50_000
+# "auto" takes PARDISO (the mkl extra) from this many free dofs: below it,
+# loading MKL (about 0.2 s) costs more than SuperLU's whole solve.
+AUTO_PARDISO_MIN_DOFS = 20_000
+# Without the mkl extra, a run from this many free dofs says in one line what
+# PARDISO would gain: the measured ratio of this path's linear-solve time
+# to PARDISO's on the reservoir case (docs/performance.md, "Scaling").
+PARDISO_HINT_MIN_DOFS = 200_000
+PARDISO_GAIN = 3.0
 AUTO_AMG_MAX_ASPECT = 4.0
 # ... and whose AMG band (enriched dofs and AMG_BAND_LAYERS neighbours) holds
 # at most this share of the free dofs.  Measured on generated networks of
@@ -176,12 +186,16 @@ def system_facts(K, free, node_xy) -> dict:
 
 
 def choose(method: str, n_free: int, node_xy=None, band_share: float = 0.0) -> str:
-    """The strategy "auto" stands for: "amg" from AUTO_AMG_MIN_DOFS free dofs
-    on meshes with cells up to AUTO_AMG_MAX_ASPECT : 1 whose AMG band (the
-    enriched dofs and AMG_BAND_LAYERS matrix neighbours, system_facts) holds
-    at most AUTO_AMG_MAX_BAND of the free dofs; "superlu" otherwise."""
+    """The strategy "auto" stands for: "pardiso" from AUTO_PARDISO_MIN_DOFS
+    free dofs when the mkl extra is installed; else "amg" from
+    AUTO_AMG_MIN_DOFS free dofs on meshes with cells up to
+    AUTO_AMG_MAX_ASPECT : 1 whose AMG band (the enriched dofs and
+    AMG_BAND_LAYERS matrix neighbours, system_facts) holds at most
+    AUTO_AMG_MAX_BAND of the free dofs; "superlu" otherwise."""
     if method != "auto":
         return method
+    if n_free >= AUTO_PARDISO_MIN_DOFS and pardiso.available():
+        return "pardiso"
     if (
         n_free >= AUTO_AMG_MIN_DOFS
         and band_share <= AUTO_AMG_MAX_BAND
@@ -368,19 +382,40 @@ class LinearSolver:
         modes); without it "auto" means "superlu".
     """
 
-    def __init__(self, K_ff, method="auto", free=None, node_xy=None):
+    def __init__(
+        self, K_ff, method="auto", free=None, node_xy=None, contact_dofs=None
+    ):
         if method not in LINEAR_SOLVERS:
             raise ValueError(f"linear solver must be one of {LINEAR_SOLVERS}")
         self.K = sp.csr_matrix(K_ff)
         n = self.K.shape[0]
         self.free = np.arange(n) if free is None else np.asarray(free)
         self.node_xy = node_xy
+        # free-dof index of each contact block row/column (-1: none), for
+        # solve_contact
+        self.contact_dofs = (
+            np.zeros((0, 0), np.int64) if contact_dofs is None else contact_dofs
+        )
         self.facts = {"n_free": n}
         if method == "auto" and node_xy is not None and n >= AUTO_AMG_MIN_DOFS:
-            self.facts = system_facts(self.K, self.free, node_xy)
+            if not (n >= AUTO_PARDISO_MIN_DOFS and pardiso.available()):
+                self.facts = system_facts(self.K, self.free, node_xy)
         self.method = choose(method, n, node_xy, self.facts.get("band_share", 0.0))
         if self.method == "amg" and node_xy is None:
             raise ValueError("the AMG linear solver needs the node coordinates")
+        if self.method == "pardiso" and not pardiso.available():
+            raise ValueError(
+                "linear_solver 'pardiso' needs MKL PARDISO: "
+                "pip install 'xfemslip[mkl]'"
+            )
+        if method == "auto" and self.method != "pardiso" and n >= PARDISO_HINT_MIN_DOFS:
+            logger.info(
+                "linear solver: %s; with MKL PARDISO (pip install "
+                "'xfemslip[mkl]') the linear solves of a mesh this size take "
+                "about 1/%.0f of the time",
+                self.method,
+                PARDISO_GAIN,
+            )
         self.stats = {
             "method": self.method,
             "factorizations": 0,
@@ -394,7 +429,14 @@ class LinearSolver:
             "fallback_time": 0.0,
             "amg_fallbacks": 0,
             "amg_fallback_time": 0.0,
+            "pardiso_analyses": 0,
+            "pardiso_spd": 0,
+            "pardiso_unsym": 0,
+            "pardiso_fallbacks": 0,
         }
+        self._pardiso = None  # pardiso.PardisoSystems, made on the first solve
+        # (pardiso.FixedPattern, the pattern of the Kc it was made for or None)
+        self._pardiso_pattern = None
         self._lu = None  # (SuperLU object, checked solve, K_c it factors)
         self._amg = None  # V-cycle on the standard dofs
         # the AMG band of "auto"'s facts is the one the AMG path solves on
@@ -425,6 +467,58 @@ class LinearSolver:
             logger.debug("linear solver: %s (%d free dofs)", self.method, n)
 
     # ------------------------------------------------------------------ #
+    def solve_contact(self, blocks, r):
+        """x with (K_ff + sum of the contact blocks) x = r; blocks (m, k, k)
+        on the rows and columns contact_dofs (m, k), or None."""
+        if self.method == "pardiso":
+            start = time.perf_counter()
+            if self._pardiso_pattern is None:
+                self._pardiso_pattern = (
+                    pardiso.FixedPattern.from_blocks(self.K, self.contact_dofs),
+                    None,
+                )
+            pattern = self._pardiso_pattern[0]
+            symmetric = pardiso.symmetric_blocks(blocks)
+            x = self._solve_pardiso(pattern.values(blocks), symmetric, r)
+            if x is not None:
+                self.stats["solves"] += 1
+                self.stats["solve_time"] += time.perf_counter() - start
+                return x
+        from xfemslip.assembly import coo_block
+
+        Kc = None
+        if blocks is not None and np.size(blocks):
+            Kc = coo_block(self.contact_dofs, blocks, self.K.shape[0])
+        return self.solve(Kc, r)
+
+    def _solve_pardiso(self, values, symmetric, r):
+        """The PARDISO solve on the kept pattern, or None after a failure
+        (logged; this and the later systems of the run go to SuperLU)."""
+        t = time.perf_counter()
+        try:
+            if self._pardiso is None:
+                self._pardiso = pardiso.PardisoSystems(
+                    self.K, self._pardiso_pattern[0], LU_BACKWARD_ERROR, self.stats
+                )
+            return self._pardiso.solve(values, symmetric, r)
+        except pardiso.PardisoError as exc:
+            self.stats["pardiso_fallbacks"] += 1
+            logger.warning(
+                "%s after %.2f s; SuperLU solves this and the later systems "
+                "of the run",
+                exc,
+                time.perf_counter() - t,
+            )
+            self._release_pardiso()
+            self.method = "superlu"
+            return None
+
+    def _release_pardiso(self):
+        if self._pardiso is not None:
+            self._pardiso.release()
+        self._pardiso = None
+        self._pardiso_pattern = None
+
     def solve(self, Kc, r):
         """x with (K_ff + Kc) x = r; Kc is (n_free, n_free) sparse or None.
 
@@ -434,12 +528,36 @@ class LinearSolver:
         if Kc is None:
             Kc = sp.csr_matrix(self.K.shape)
         Kc = sp.csr_matrix(Kc)
-        if self.method == "amg":
+        if self.method == "pardiso":
+            x = self._solve_pardiso_matrix(Kc, r)
+        elif self.method == "amg":
             x = self._solve_amg(Kc, r)
         else:
             x = self._solve_superlu(Kc, r)
         self.stats["solves"] += 1
         self.stats["solve_time"] += time.perf_counter() - start
+        return x
+
+    def _solve_pardiso_matrix(self, Kc, r):
+        """solve() with a sparse Kc on PARDISO: its stored entries are the
+        contact entries of a pattern kept while Kc's pattern stays."""
+        Kc.sort_indices()
+        key = (Kc.indptr, Kc.indices)
+        kept = self._pardiso_pattern
+        if kept is None or kept[1] is None or not (
+            np.array_equal(kept[1][0], key[0]) and np.array_equal(kept[1][1], key[1])
+        ):
+            self._release_pardiso()
+            coo = Kc.tocoo()
+            self._pardiso_pattern = (
+                pardiso.FixedPattern(self.K, coo.row, coo.col),
+                (Kc.indptr.copy(), Kc.indices.copy()),
+            )
+        pattern = self._pardiso_pattern[0]
+        symmetric = Kc.nnz == 0 or pardiso.matrix_symmetric(Kc)
+        x = self._solve_pardiso(pattern.values(Kc.data), symmetric, r)
+        if x is None:
+            return self._solve_superlu(Kc, r)
         return x
 
     # ------------------------------------------------------------------ #

@@ -168,9 +168,11 @@ class NewtonSolver:
         self.reduced = -np.ones(n, np.int64)
         self.reduced[self.free] = np.arange(self.free.size)
         self.K_ff = problem.K[self.free][:, self.free].tocsr()
-        self.linear = LinearSolver(self.K_ff, linear_solver, self.free, problem.node_xy)
         c = problem.contact
         self.c_dofs = np.where(c.dofs >= 0, self.reduced[np.maximum(c.dofs, 0)], -1)
+        self.linear = LinearSolver(
+            self.K_ff, linear_solver, self.free, problem.node_xy, self.c_dofs
+        )
         zero = c.evaluate(np.zeros(n), self.mode, c.pt_committed, c.gt_committed)
         self.f_c0 = c.in_situ_force(zero)
         # the contact law at zero jump: what it admits of the in-situ traction
@@ -646,9 +648,8 @@ class NewtonSolver:
                 )
 
     def _solve(self, res, r, k, it, eta):
-        Kc = coo_block(self.c_dofs, res.blocks, self.free.size)
         try:
-            du = self.linear.solve(Kc, r)
+            du = self.linear.solve_contact(res.blocks, r)
         except RuntimeError as exc:  # "Factor is exactly singular"
             raise self._fail(
                 k,

@@ -121,7 +121,8 @@ def test_whole_run_agrees_between_linear_solvers(monkeypatch):
         assert np.max(np.abs(out[method][1] - gt)) <= 1e-9 * np.max(np.abs(gt))
 
 
-def test_auto_choice():
+def test_auto_choice(monkeypatch):
+    monkeypatch.setattr(linsolve.pardiso, "available", lambda: False)
     g = np.linspace(0.0, 1.0, 11)
     square = np.column_stack([np.repeat(g, 11), np.tile(g, 11)])
     stretched = square * [1.0, 5.0]  # cells 0.1 x 0.5

@@ -1,0 +1,360 @@
+"""MKL PARDISO for the Newton systems (K_ff + K_c) du = r (``linear_solver =
+"pardiso"``, the ``mkl`` extra: ``pip install 'xfemslip[mkl]'``, which brings
+pypardiso and with it Intel MKL).
+
+What does not change over a run is done once:
+
+- the sparsity pattern.  K_ff is fixed and the contact tangent K_c only ever
+  has entries inside the blocks of the contact patches on their (fixed) dofs,
+  so every Newton matrix lives on one union pattern (FixedPattern): the
+  position of every contact block entry in the CSR data of that pattern is
+  found once, and each Newton matrix is a copy of K_ff's data plus the block
+  values added at those positions (entries that are zero in one system stay
+  stored, so the pattern never changes).
+- the symbolic analysis (PARDISO phase 11: fill-reducing nested-dissection
+  ordering and symbolic factorization), once per matrix type and run; every
+  Newton iteration, load step and deplete bisection step reuses it and costs
+  a numerical factorization (phase 22) and a solve (phase 33), or only the
+  solve when its matrix equals the one last factored in its mode.
+
+Two modes, one PARDISO handle each so each keeps its own analysis and its
+last factorization: the symmetric positive definite one (mtype 2, Cholesky on
+the upper triangle) whenever the contact blocks are symmetric -- no fracture,
+every patch stuck or open, frictionless contact, the secant tangent -- and the
+real unsymmetric one (UNSYMMETRIC_MTYPE) for the consistent friction tangent,
+whose n-t coupling is on the slipping patches only.  The choice is made per
+Newton system from its blocks.
+
+PARDISO is called directly through ctypes (MKL located by pypardiso), with
+0-based int32 index arrays made once: pypardiso's own ``solve`` copies and
+re-checks the whole matrix on every call.  Every solve is checked like the
+SuperLU path's (xfemslip.linsolve.lu_factor): normwise backward error at most
+LU_BACKWARD_ERROR, one step of iterative refinement if not, and the caller
+falls back to SuperLU (with a log line) when that fails or PARDISO reports an
+error.
+"""
+
+from __future__ import annotations
+
+import ctypes
+import importlib.util
+import logging
+
+import numpy as np
+import scipy.sparse as sp
+
+logger = logging.getLogger(__name__)
+
+MTYPE_SPD = 2  # real symmetric positive definite
+# Real unsymmetric: 1 (structurally symmetric, no pivoting beyond perturbation)
+# or 11 (general, with weighted matching and scaling).  The union pattern is
+# structurally symmetric (K_ff symmetric, contact blocks square on their dofs).
+UNSYMMETRIC_MTYPE = 11
+# Blocks symmetric to this relative round-off go to the SPD mode (the backward
+# error check below then judges the solve against the exact matrix).
+SYMMETRY_RTOL = 1.0e-12
+
+
+def available() -> bool:
+    """Whether the mkl extra (pypardiso) is installed."""
+    return importlib.util.find_spec("pypardiso") is not None
+
+
+class PardisoError(RuntimeError):
+    """PARDISO returned an error code (see the MKL PARDISO documentation)."""
+
+    def __init__(self, phase: int, code: int):
+        super().__init__(f"PARDISO phase {phase} failed with error {code}")
+        self.phase = phase
+        self.code = code
+
+
+_LIB = None
+
+
+def _pardiso_function():
+    """MKL's pardiso entry point with its ctypes signature (as pypardiso
+    declares it: pypardiso knows where pip's MKL puts mkl_rt)."""
+    global _LIB
+    if _LIB is None:
+        import pypardiso
+
+        _LIB = pypardiso.PyPardisoSolver()._mkl_pardiso
+    return _LIB
+
+
+class Handle:
+    """One PARDISO instance: one matrix type, one pattern (0-based CSR,
+    sorted column indices), its analysis and its last factorization.
+
+    Counters: analyses (phase 11), factorizations (phase 22), solves (33)."""
+
+    def __init__(self, mtype: int, indptr, indices):
+        self.fn = _pardiso_function()
+        self.mtype = int(mtype)
+        self.n = int(indptr.size - 1)
+        self.ia = np.ascontiguousarray(indptr, dtype=np.int32)
+        self.ja = np.ascontiguousarray(indices, dtype=np.int32)
+        self.pt = np.zeros(64, dtype=np.int64)
+        self.iparm = np.zeros(64, dtype=np.int32)
+        ip = self.iparm
+        ip[0] = 1  # the values below, not the defaults
+        ip[1] = 2  # METIS nested dissection
+        ip[7] = 0  # refinement steps: the solver's automatic choice
+        ip[9] = 13 if self.mtype == 11 else 8  # pivot perturbation 1e-13 / 1e-8
+        ip[10] = 1 if self.mtype == 11 else 0  # scaling
+        ip[12] = 1 if self.mtype == 11 else 0  # weighted matching
+        ip[17] = -1  # report the factor's nonzeros
+        ip[34] = 1  # 0-based indices
+        self.perm = np.zeros(1, dtype=np.int32)
+        self.analyses = 0
+        self.factorizations = 0
+        self.solves = 0
+        self.factored = None  # the data of the last factored matrix
+
+    def _call(self, phase, data, b=None):
+        n = self.n
+        if b is None:
+            b = np.zeros(n)
+            x = np.zeros(n)
+        else:
+            b = np.ascontiguousarray(b, dtype=np.float64)
+            x = np.zeros(n)
+        err = ctypes.c_int32(0)
+        i32 = ctypes.POINTER(ctypes.c_int32)
+        f64 = ctypes.POINTER(ctypes.c_double)
+        self.fn(
+            self.pt.ctypes.data_as(ctypes.POINTER(ctypes.c_int64)),
+            ctypes.byref(ctypes.c_int32(1)),  # maxfct
+            ctypes.byref(ctypes.c_int32(1)),  # mnum
+            ctypes.byref(ctypes.c_int32(self.mtype)),
+            ctypes.byref(ctypes.c_int32(phase)),
+            ctypes.byref(ctypes.c_int32(n)),
+            data.ctypes.data_as(f64),
+            self.ia.ctypes.data_as(i32),
+            self.ja.ctypes.data_as(i32),
+            self.perm.ctypes.data_as(i32),
+            ctypes.byref(ctypes.c_int32(1)),  # nrhs
+            self.iparm.ctypes.data_as(i32),
+            ctypes.byref(ctypes.c_int32(0)),  # msglvl
+            b.ctypes.data_as(f64),
+            x.ctypes.data_as(f64),
+            ctypes.byref(err),
+        )
+        if err.value != 0:
+            raise PardisoError(phase, err.value)
+        return x
+
+    def factor(self, data):
+        """Numerical factorization of the matrix with values `data` (the
+        analysis first, once)."""
+        data = np.ascontiguousarray(data, dtype=np.float64)
+        if self.analyses == 0:
+            self._call(11, data)
+            self.analyses += 1
+        self.factored = None
+        self._call(22, data)
+        self.factorizations += 1
+        self.factored = data.copy()
+
+    def solve(self, b):
+        """x with A x = b for the last factored A."""
+        x = self._call(33, self.factored, b)
+        self.solves += 1
+        return x
+
+    def is_factored(self, data) -> bool:
+        return self.factored is not None and np.array_equal(self.factored, data)
+
+    @property
+    def factor_nnz(self) -> int:
+        return int(self.iparm[17])
+
+    def release(self):
+        """Free PARDISO's memory for this handle."""
+        if self.analyses:
+            try:
+                self._call(-1, np.zeros(max(self.ja.size, 1)))
+            except PardisoError:
+                pass
+            self.analyses = 0
+            self.factored = None
+
+    def __del__(self):
+        try:
+            self.release()
+        except Exception:  # interpreter shutdown
+            pass
+
+
+class FixedPattern:
+    """K_ff plus contact entries on a pattern fixed for the run.
+
+    K : (n, n) sparse, the bulk stiffness on the free dofs.
+    rows, cols : the row and column (free-dof index, -1: none) of every
+        contact entry, flattened; from_blocks makes them for (m, k, k) blocks.
+
+    ``data(values)`` is the CSR data of K plus the contact entries' values
+    (duplicates summed) on the union pattern (indptr, indices); ``upper``
+    indexes that data for the upper triangle (indptr_upper, indices_upper)
+    the SPD mode factors.
+    """
+
+    def __init__(self, K, rows, cols):
+        K = sp.csr_matrix(K)
+        K.sum_duplicates()
+        K.sort_indices()
+        n = K.shape[0]
+        rows = np.asarray(rows, dtype=np.int64).ravel()
+        cols = np.asarray(cols, dtype=np.int64).ravel()
+        self.valid = (rows >= 0) & (cols >= 0)
+        rows, cols = rows[self.valid], cols[self.valid]
+        ones = sp.csr_matrix((np.ones(K.nnz), K.indices, K.indptr), shape=(n, n))
+        if rows.size:
+            ones = ones + sp.csr_matrix((np.ones(rows.size), (rows, cols)), (n, n))
+        ones.sum_duplicates()
+        ones.sort_indices()
+        self.n = n
+        self.indptr = ones.indptr.astype(np.int32)
+        self.indices = ones.indices.astype(np.int32)
+        row_of = np.repeat(np.arange(n, dtype=np.int64), np.diff(ones.indptr))
+        keys = row_of * n + ones.indices
+        k_rows = np.repeat(np.arange(n, dtype=np.int64), np.diff(K.indptr))
+        k_pos = np.searchsorted(keys, k_rows * n + K.indices)
+        self.contact_pos = np.searchsorted(keys, rows * n + cols)
+        self.base = np.zeros(keys.size)
+        self.base[k_pos] = K.data
+        up = ones.indices >= row_of
+        self.upper = np.nonzero(up)[0]
+        self.indptr_upper = np.concatenate(
+            ([0], np.cumsum(np.bincount(row_of[up], minlength=n)))
+        ).astype(np.int32)
+        self.indices_upper = ones.indices[up].astype(np.int32)
+
+    @classmethod
+    def from_blocks(cls, K, dofs):
+        """The pattern of K and (m, k, k) blocks on the dofs (m, k)."""
+        dofs = np.asarray(dofs, dtype=np.int64)
+        m = dofs.shape[0]
+        dofs = dofs.reshape(m, -1)
+        k = dofs.shape[1]
+        rows = np.broadcast_to(dofs[:, :, None], (m, k, k))
+        cols = np.broadcast_to(dofs[:, None, :], (m, k, k))
+        return cls(K, rows, cols)
+
+    def values(self, entries) -> np.ndarray:
+        """The contact entries' values in the order of contact_pos, from
+        `entries` shaped like the rows/cols given (e.g. the blocks)."""
+        if entries is None or self.contact_pos.size == 0:
+            return np.zeros(self.contact_pos.size)
+        return np.asarray(entries, dtype=np.float64).reshape(-1)[self.valid]
+
+    def data(self, values) -> np.ndarray:
+        out = self.base.copy()
+        if values.size:
+            np.add.at(out, self.contact_pos, values)
+        return out
+
+    def matrix(self, data) -> sp.csr_matrix:
+        """The CSR matrix with values `data` on the union pattern (shares it)."""
+        return sp.csr_matrix(
+            (data, self.indices, self.indptr), shape=(self.n, self.n), copy=False
+        )
+
+
+def symmetric_blocks(blocks) -> bool:
+    """Whether every contact block equals its transpose to SYMMETRY_RTOL."""
+    if blocks is None or np.size(blocks) == 0:
+        return True
+    B = np.asarray(blocks)
+    scale = np.abs(B).max()
+    return bool(np.abs(B - B.transpose(0, 2, 1)).max() <= SYMMETRY_RTOL * scale)
+
+
+def matrix_symmetric(K) -> bool:
+    """Whether the sparse matrix K equals its transpose to SYMMETRY_RTOL."""
+    K = sp.csr_matrix(K)
+    if K.nnz == 0:
+        return True
+    diff = abs(K - K.T)
+    return bool(diff.max() <= SYMMETRY_RTOL * abs(K).max())
+
+
+class PardisoSystems:
+    """The Newton systems of one run on PARDISO: one FixedPattern, one Handle
+    per mode (SPD, unsymmetric), each analysed once.
+
+    solve(values, symmetric, r) returns x, for the contact entries' values
+    (FixedPattern.values) and whether they are symmetric, with backward error
+    at most `max_error` (after one refinement step if needed), or raises
+    PardisoError (a PARDISO error,
+    or a solve that stays above `max_error`: the caller falls back)."""
+
+    def __init__(self, K, pattern: FixedPattern, max_error: float, stats: dict):
+        self.pattern = pattern
+        # K_ff comes from symmetric element matrices; the SPD mode is only
+        # used when it is symmetric to round-off
+        self.spd_possible = matrix_symmetric(K)
+        self.max_error = max_error
+        self.stats = stats
+        self.handles: dict[int, Handle] = {}
+        self._norm = {}  # mtype -> infinity norm of its factored matrix
+
+    def _handle(self, mtype: int) -> Handle:
+        if mtype not in self.handles:
+            p = self.pattern
+            if mtype == MTYPE_SPD:
+                self.handles[mtype] = Handle(mtype, p.indptr_upper, p.indices_upper)
+            else:
+                self.handles[mtype] = Handle(mtype, p.indptr, p.indices)
+        return self.handles[mtype]
+
+    @property
+    def analyses(self) -> int:
+        return sum(h.analyses for h in self.handles.values())
+
+    def release(self):
+        for h in self.handles.values():
+            h.release()
+
+    def solve(self, values, symmetric: bool, r) -> np.ndarray:
+        import time
+
+        from xfemslip.linsolve import backward_error
+
+        p = self.pattern
+        data = p.data(values)
+        A = p.matrix(data)
+        modes = [UNSYMMETRIC_MTYPE]
+        if self.spd_possible and symmetric:
+            modes.insert(0, MTYPE_SPD)
+        last = None
+        for mtype in modes:
+            h = self._handle(mtype)
+            values = data[p.upper] if mtype == MTYPE_SPD else data
+            t = time.perf_counter()
+            try:
+                if not h.is_factored(values):
+                    analysed = h.analyses
+                    h.factor(values)
+                    self._norm[mtype] = float(abs(A).sum(axis=1).max())
+                    self.stats["factorizations"] += 1
+                    self.stats["pardiso_analyses"] += h.analyses - analysed
+                    self.stats["factor_time"] += time.perf_counter() - t
+                x = h.solve(r)
+            except PardisoError as exc:
+                last = exc
+                logger.debug("PARDISO (mtype %d): %s", mtype, exc)
+                continue
+            err = backward_error(A, x, r, self._norm[mtype])
+            if not err <= self.max_error and np.isfinite(err):
+                self.stats["refinements"] += 1
+                x = x + h.solve(r - A @ x)
+                err = backward_error(A, x, r, self._norm[mtype])
+            if err <= self.max_error:
+                self.stats["pardiso_" + ("spd" if mtype == MTYPE_SPD else "unsym")] += 1
+                return x
+            last = PardisoError(33, 0)
+            last.args = (f"PARDISO (mtype {mtype}) backward error {err:.1e}",)
+            logger.debug("%s", last)
+        raise last
