@@ -36,7 +36,13 @@ linear_solver``), each keeping what does not change:
   iterations of the first scipy call, and after each call), and the
   attempt is logged (warning: iterations, seconds lost) and counted in
   stats["amg_fallbacks"], stats["amg_fallback_time"].
-- ``"auto"`` (default): ``"amg"`` from AUTO_AMG_MIN_DOFS free dofs up on
+- ``"pardiso"``: MKL PARDISO (the mkl extra), xfemslip.pardiso: one SPD
+  factorization of K_ff for the run with the contact dofs eliminated last,
+  and a dense LU of their Schur complement per contact tangent.  A PARDISO
+  failure sends the run to SuperLU (warning, stats["pardiso_fallbacks"]).
+- ``"auto"`` (default): ``"pardiso"`` from AUTO_PARDISO_MIN_DOFS free dofs
+  when the mkl extra is installed; otherwise ``"amg"`` from
+  AUTO_AMG_MIN_DOFS free dofs up on
   meshes with cell aspect ratios up to AUTO_AMG_MAX_ASPECT whose AMG band
   (the enriched dofs and AMG_BAND_LAYERS matrix neighbours: what the band LU
   of every Newton system factors) holds at most AUTO_AMG_MAX_BAND of the
@@ -230,8 +236,15 @@ def backward_error(A, x, b, norm_A=None) -> float:
         return np.inf
     if norm_A is None:
         norm_A = abs(A).sum(axis=1).max()
+    return backward_error_of(A @ x - b, x, b, norm_A)
+
+
+def backward_error_of(residual, x, b, norm_A) -> float:
+    """backward_error from the residual A x - b and ||A|| (infinity norms)."""
+    if not np.all(np.isfinite(x)):
+        return np.inf
     den = float(norm_A) * np.abs(x).max(initial=0.0) + np.abs(b).max(initial=0.0)
-    r = np.abs(A @ x - b).max(initial=0.0)
+    r = np.abs(residual).max(initial=0.0)
     return float(r / den) if den > 0.0 else float(r)
 
 
@@ -382,9 +395,7 @@ class LinearSolver:
         modes); without it "auto" means "superlu".
     """
 
-    def __init__(
-        self, K_ff, method="auto", free=None, node_xy=None, contact_dofs=None
-    ):
+    def __init__(self, K_ff, method="auto", free=None, node_xy=None, contact_dofs=None):
         if method not in LINEAR_SOLVERS:
             raise ValueError(f"linear solver must be one of {LINEAR_SOLVERS}")
         self.K = sp.csr_matrix(K_ff)
@@ -405,8 +416,7 @@ class LinearSolver:
             raise ValueError("the AMG linear solver needs the node coordinates")
         if self.method == "pardiso" and not pardiso.available():
             raise ValueError(
-                "linear_solver 'pardiso' needs MKL PARDISO: "
-                "pip install 'xfemslip[mkl]'"
+                "linear_solver 'pardiso' needs MKL PARDISO: pip install 'xfemslip[mkl]'"
             )
         if method == "auto" and self.method != "pardiso" and n >= PARDISO_HINT_MIN_DOFS:
             logger.info(
@@ -432,11 +442,14 @@ class LinearSolver:
             "pardiso_analyses": 0,
             "pardiso_spd": 0,
             "pardiso_unsym": 0,
+            "pardiso_schur": 0,
+            "schur_factorizations": 0,
             "pardiso_fallbacks": 0,
         }
-        self._pardiso = None  # pardiso.PardisoSystems, made on the first solve
-        # (pardiso.FixedPattern, the pattern of the Kc it was made for or None)
-        self._pardiso_pattern = None
+        # pardiso.SchurSystems or PardisoSystems, made on the first solve, and
+        # the pattern of the sparse Kc they were made for (None: the blocks')
+        self._pardiso = None
+        self._pardiso_key = None
         self._lu = None  # (SuperLU object, checked solve, K_c it factors)
         self._amg = None  # V-cycle on the standard dofs
         # the AMG band of "auto"'s facts is the one the AMG path solves on
@@ -472,14 +485,17 @@ class LinearSolver:
         on the rows and columns contact_dofs (m, k), or None."""
         if self.method == "pardiso":
             start = time.perf_counter()
-            if self._pardiso_pattern is None:
-                self._pardiso_pattern = (
-                    pardiso.FixedPattern.from_blocks(self.K, self.contact_dofs),
+            if self._pardiso is None:
+                dofs = np.asarray(self.contact_dofs, dtype=np.int64)
+                dofs = dofs.reshape(dofs.shape[0], -1)
+                k = dofs.shape[1]
+                shape = (dofs.shape[0], k, k)
+                self._make_pardiso(
+                    np.broadcast_to(dofs[:, :, None], shape),
+                    np.broadcast_to(dofs[:, None, :], shape),
                     None,
                 )
-            pattern = self._pardiso_pattern[0]
-            symmetric = pardiso.symmetric_blocks(blocks)
-            x = self._solve_pardiso(pattern.values(blocks), symmetric, r)
+            x = self._solve_pardiso(blocks, pardiso.symmetric_blocks(blocks), r)
             if x is not None:
                 self.stats["solves"] += 1
                 self.stats["solve_time"] += time.perf_counter() - start
@@ -491,21 +507,25 @@ class LinearSolver:
             Kc = coo_block(self.contact_dofs, blocks, self.K.shape[0])
         return self.solve(Kc, r)
 
-    def _solve_pardiso(self, values, symmetric, r):
+    def _make_pardiso(self, rows, cols, key):
+        """The PARDISO systems for contact entries at (rows, cols); `key`: the
+        pattern of the sparse Kc they are made for (None: the blocks')."""
+        self._release_pardiso()
+        self._pardiso = pardiso.make_systems(
+            self.K, rows, cols, LU_BACKWARD_ERROR, self.stats
+        )
+        self._pardiso_key = key
+
+    def _solve_pardiso(self, entries, symmetric, r):
         """The PARDISO solve on the kept pattern, or None after a failure
         (logged; this and the later systems of the run go to SuperLU)."""
         t = time.perf_counter()
         try:
-            if self._pardiso is None:
-                self._pardiso = pardiso.PardisoSystems(
-                    self.K, self._pardiso_pattern[0], LU_BACKWARD_ERROR, self.stats
-                )
-            return self._pardiso.solve(values, symmetric, r)
+            return self._pardiso.solve(self._pardiso.values(entries), symmetric, r)
         except pardiso.PardisoError as exc:
             self.stats["pardiso_fallbacks"] += 1
             logger.warning(
-                "%s after %.2f s; SuperLU solves this and the later systems "
-                "of the run",
+                "%s after %.2f s; SuperLU solves this and the later systems of the run",
                 exc,
                 time.perf_counter() - t,
             )
@@ -517,7 +537,7 @@ class LinearSolver:
         if self._pardiso is not None:
             self._pardiso.release()
         self._pardiso = None
-        self._pardiso_pattern = None
+        self._pardiso_key = None
 
     def solve(self, Kc, r):
         """x with (K_ff + Kc) x = r; Kc is (n_free, n_free) sparse or None.
@@ -540,22 +560,19 @@ class LinearSolver:
 
     def _solve_pardiso_matrix(self, Kc, r):
         """solve() with a sparse Kc on PARDISO: its stored entries are the
-        contact entries of a pattern kept while Kc's pattern stays."""
+        contact entries of systems kept while Kc's pattern stays."""
         Kc.sort_indices()
-        key = (Kc.indptr, Kc.indices)
-        kept = self._pardiso_pattern
-        if kept is None or kept[1] is None or not (
-            np.array_equal(kept[1][0], key[0]) and np.array_equal(kept[1][1], key[1])
+        key = self._pardiso_key
+        if (
+            self._pardiso is None
+            or key is None
+            or not np.array_equal(key[0], Kc.indptr)
+            or not np.array_equal(key[1], Kc.indices)
         ):
-            self._release_pardiso()
             coo = Kc.tocoo()
-            self._pardiso_pattern = (
-                pardiso.FixedPattern(self.K, coo.row, coo.col),
-                (Kc.indptr.copy(), Kc.indices.copy()),
-            )
-        pattern = self._pardiso_pattern[0]
+            self._make_pardiso(coo.row, coo.col, (Kc.indptr.copy(), Kc.indices.copy()))
         symmetric = Kc.nnz == 0 or pardiso.matrix_symmetric(Kc)
-        x = self._solve_pardiso(pattern.values(Kc.data), symmetric, r)
+        x = self._solve_pardiso(Kc.data, symmetric, r)
         if x is None:
             return self._solve_superlu(Kc, r)
         return x

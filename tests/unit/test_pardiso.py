@@ -97,34 +97,47 @@ def test_symmetry_tests():
 
 
 @needs_mkl
+@pytest.mark.parametrize("mode", ["schur", "pattern"])
 @pytest.mark.parametrize(
     ("friction", "slips"), [(0.1, True), (10.0, False)], ids=["sliding", "stuck"]
 )
-def test_newton_systems_match_superlu(friction, slips):
+def test_newton_systems_match_superlu(friction, slips, mode, monkeypatch):
     """The Newton systems of a 3-step run solved by one PARDISO LinearSolver
     as a run does: backward error <= LU_BACKWARD_ERROR against the exact
-    matrix and agreement with spsolve to 1e-8.  Sliding: the consistent
-    tangent is unsymmetric (unsymmetric mode); stuck: SPD mode only, one
-    factorization for the whole run (the matrix never changes)."""
+    matrix and agreement with spsolve to 1e-8.
+
+    schur (the default for a few contact dofs): one SPD factorization of
+    K_ff for the whole run, one dense LU per change of the contact tangent.
+    pattern (SCHUR_MAX_DOFS = 0): sliding systems are unsymmetric (mtype 11),
+    stuck ones SPD only, one factorization for the whole run."""
+    if mode == "pattern":
+        monkeypatch.setattr(pardiso, "SCHUR_MAX_DOFS", 0)
     newton, seq = _newton_systems(friction=friction)
     ls = LinearSolver(newton.K_ff, "pardiso", newton.free, None, newton.c_dofs)
-    asym = []
+    asym, changes, last = [], 0, None
     for blocks, r, _ in seq:
         A = (newton.K_ff + coo_block(newton.c_dofs, blocks, newton.free.size)).tocsc()
         asym.append(abs(A - A.T).max() / abs(A).max())
+        changes += last is None or not np.array_equal(blocks, last)
+        last = blocks
         x = ls.solve_contact(blocks, r)
         assert backward_error(A, x, r) <= LU_BACKWARD_ERROR
         x_ref = spla.spsolve(A, r)
         assert np.linalg.norm(x - x_ref) <= 1e-8 * np.linalg.norm(x_ref)
     st = ls.stats
     assert st["method"] == "pardiso" and st["pardiso_fallbacks"] == 0
+    assert (max(asym) > 1e-6) == slips  # the slip tangent is not symmetric
+    if mode == "schur":
+        assert st["pardiso_schur"] == len(seq)
+        assert st["pardiso_analyses"] == 1 and st["factorizations"] == 1
+        # a dense LU for each system whose tangent differs from the last one
+        assert st["schur_factorizations"] == changes
+        return
     assert st["pardiso_spd"] + st["pardiso_unsym"] == len(seq)
     if slips:
-        assert max(asym) > 1e-6
         assert st["pardiso_unsym"] >= 1
         assert st["pardiso_analyses"] == 1 + (st["pardiso_spd"] > 0)
     else:
-        assert max(asym) <= 1e-12
         assert st["pardiso_unsym"] == 0 and st["pardiso_spd"] == len(seq)
         assert st["pardiso_analyses"] == 1
         assert st["factorizations"] == 1
@@ -162,27 +175,27 @@ def test_sparse_contact_tangent_through_solve():
 
 @needs_mkl
 def test_analysis_once_per_run_across_steps(monkeypatch):
-    """A 4-step sliding run: PARDISO's phase 11 is called once per matrix type
-    used (at most 2), whatever the number of Newton systems; phase 22 once per
-    distinct matrix."""
+    """A 4-step sliding run: PARDISO's phase 11 and 22 are called once for the
+    run, whatever the number of Newton systems (the Schur mode); each new
+    contact tangent costs a dense LU of the Schur complement."""
     phases = []
     call = pardiso.Handle._call
 
-    def counting(self, phase, data, b=None):
+    def counting(self, phase, data, b=None, x=None):
         phases.append((self.mtype, phase))
-        return call(self, phase, data, b)
+        return call(self, phase, data, b, x)
 
     monkeypatch.setattr(pardiso.Handle, "_call", counting)
     model = build_model(loads_case(_text(20, steps=4), CASE))
     newton = NewtonSolver(model.problem, 1e-10, 30, "consistent", "pardiso")
     steps = newton.run(4)
     analyses = [p for p in phases if p[1] == 11]
-    mtypes = {p[0] for p in phases if p[1] == 33}
-    assert len(analyses) == len(mtypes) <= 2
+    assert len(analyses) == 1  # the Schur mode: one SPD handle
     assert sum(s.iterations for s in steps) >= 4
     assert newton.linear.stats["solves"] >= 4
-    n22 = sum(p[1] == 22 for p in phases)
-    assert n22 == newton.linear.stats["factorizations"] <= newton.linear.stats["solves"]
+    assert sum(p[1] == 22 for p in phases) == newton.linear.stats["factorizations"] == 1
+    st = newton.linear.stats
+    assert 1 <= st["schur_factorizations"] <= st["solves"]
 
 
 @needs_mkl
@@ -264,3 +277,28 @@ def test_case_refuses_pardiso_when_not_installed(monkeypatch):
     assert "solver.linear_solver" in msg and "pip install 'xfemslip[mkl]'" in msg
     monkeypatch.setattr(pardiso, "available", lambda: True)
     assert loads_case(text, "case.toml").solver.linear_solver == "pardiso"
+
+
+@needs_mkl
+def test_schur_complement_of_the_bulk_matrix():
+    """PARDISO's dense Schur complement on the contact dofs equals
+    K_cc - K_ci K_ii^-1 K_ic computed with SuperLU."""
+    newton, _ = _newton_systems(n=12, steps=1)
+    K = newton.K_ff.tocsr()
+    dofs = newton.c_dofs
+    k = dofs.shape[1]
+    shape = (dofs.shape[0], k, k)
+    rows = np.broadcast_to(dofs[:, :, None], shape)
+    cols = np.broadcast_to(dofs[:, None, :], shape)
+    stats = dict.fromkeys(("factorizations", "pardiso_analyses"), 0)
+    stats.update(schur_factorizations=0, factor_time=0.0)
+    systems = pardiso.SchurSystems(K, rows, cols, LU_BACKWARD_ERROR, stats)
+    c = systems.c
+    assert c.size == np.unique(dofs[dofs >= 0]).size
+    systems._factor(np.zeros(systems.flat.size))
+    i = np.setdiff1d(np.arange(K.shape[0]), c)
+    K_ic = K[i][:, c].toarray()
+    ref = K[c][:, c].toarray() - K_ic.T @ spla.splu(K[i][:, i].tocsc()).solve(K_ic)
+    S = systems.handle.schur_matrix
+    np.testing.assert_allclose(S, ref, rtol=0, atol=1e-11 * abs(ref).max())
+    systems.release()
