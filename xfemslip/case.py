@@ -217,7 +217,7 @@ SOLVER_OPTIONS: tuple[Option, ...] = (
         "auto",
         "linear solver of the Newton systems: 'superlu' (sparse LU, factorization "
         "kept), 'amg' (pyamg-preconditioned GMRES), 'pardiso' (MKL PARDISO, "
-        "pip install 'xfemslip[mkl]') or 'auto' (pardiso from 20,000 free dofs "
+        "pip install 'xfemslip[mkl]') or 'auto' (pardiso from 50,000 free dofs "
         "when installed, else amg from 50,000 free dofs on cells up to 4:1)",
         ("auto", "superlu", "amg", "pardiso"),
     ),

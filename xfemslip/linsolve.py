@@ -83,8 +83,11 @@ LINEAR_SOLVERS = ("auto", "superlu", "amg", "pardiso")
 # iterations (58k dofs).
 AUTO_AMG_MIN_DOFS = 50_000
 # "auto" takes PARDISO (the mkl extra) from this many free dofs: below it,
-# loading MKL (about 0.2 s) costs more than SuperLU's whole solve.
-AUTO_PARDISO_MIN_DOFS = 20_000
+# loading MKL (0.3-0.5 s) costs more than SuperLU's whole solve.  Whole
+# `xfemslip run` of the reservoir case (benchmarks/scaling.py, docs/
+# performance.md "Scaling"): 2.03 s with PARDISO against 1.45 s by default
+# (SuperLU) at 22k dofs, 2.82 against 3.28 s (AMG) at 83k.
+AUTO_PARDISO_MIN_DOFS = 50_000
 # Without the mkl extra, a run from this many free dofs says in one line what
 # PARDISO would gain: the measured ratio of this path's linear-solve time
 # to PARDISO's on the reservoir case (docs/performance.md, "Scaling").

@@ -248,7 +248,7 @@ def test_auto_takes_pardiso_when_installed(monkeypatch):
     assert linsolve.choose("auto", n - 1, square) == "superlu"
     assert linsolve.choose("superlu", n, square) == "superlu"
     monkeypatch.setattr(pardiso, "available", lambda: False)
-    assert linsolve.choose("auto", n, square) == "superlu"
+    assert linsolve.choose("auto", n - 1, square) == "superlu"
     assert linsolve.choose("auto", linsolve.AUTO_AMG_MIN_DOFS, square) == "amg"
 
 
