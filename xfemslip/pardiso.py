@@ -195,7 +195,9 @@ class Handle:
 
     def forward(self, b):
         """With schur rows: b_s - A_si A_ii^-1 b_i (phase 331 only)."""
-        return self._call(331, self.factored, b)[self.schur]
+        y = self._call(331, self.factored, b)[self.schur]
+        self.solves += 1
+        return y
 
     def solve(self, b):
         """x with A x = b for the last factored A."""
@@ -512,7 +514,7 @@ class SchurSystems:
     def _solve(self, b):
         import scipy.linalg as sla
 
-        x, rhs = self.handle.solve_interior(b)
+        rhs = self.handle.forward(b)
         xc = sla.lu_solve(self._lu[0], rhs, check_finite=False)
         b2 = b - self.K_c.T @ xc
         x, _ = self.handle.solve_interior(b2)
