@@ -493,7 +493,8 @@ class LinearSolver:
             start = time.perf_counter()
             if self._pardiso is None:
                 dofs = np.asarray(self.contact_dofs, dtype=np.int64)
-                dofs = dofs.reshape(dofs.shape[0], -1)
+                if dofs.ndim != 2:  # (m, k): m = 0 without a fracture
+                    dofs = dofs.reshape(len(dofs), -1)
                 k = dofs.shape[1]
                 shape = (dofs.shape[0], k, k)
                 self._make_pardiso(

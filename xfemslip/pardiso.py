@@ -278,7 +278,8 @@ class FixedPattern:
         """The pattern of K and (m, k, k) blocks on the dofs (m, k)."""
         dofs = np.asarray(dofs, dtype=np.int64)
         m = dofs.shape[0]
-        dofs = dofs.reshape(m, -1)
+        if dofs.ndim != 2:
+            dofs = dofs.reshape(m, -1)
         k = dofs.shape[1]
         rows = np.broadcast_to(dofs[:, :, None], (m, k, k))
         cols = np.broadcast_to(dofs[:, None, :], (m, k, k))

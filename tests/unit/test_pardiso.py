@@ -160,6 +160,22 @@ def test_no_fracture_is_spd_and_back_solves():
 
 
 @needs_mkl
+def test_whole_run_without_fracture():
+    """A run without a contact set (no blocks at all) through PARDISO gives
+    SuperLU's displacement; the SPD mode, one factorization."""
+    u = {}
+    for method in ("superlu", "pardiso"):
+        model = build_model(loads_case(_text(16, fracture=False), CASE))
+        newton = NewtonSolver(model.problem, 1e-10, 30, "consistent", method)
+        u[method] = newton.run(1)[-1].u
+    st = newton.linear.stats
+    assert st["pardiso_spd"] >= 1 and st["factorizations"] == 1
+    ref = np.abs(u["superlu"]).max()
+    assert ref > 0.0
+    assert np.abs(u["pardiso"] - u["superlu"]).max() <= 1e-9 * ref
+
+
+@needs_mkl
 def test_sparse_contact_tangent_through_solve():
     """solve(Kc, r) with a sparse Kc (the general interface) on PARDISO: a
     symmetric and an unsymmetric Kc on the same pattern share the pattern."""
