@@ -47,10 +47,10 @@ import h5py
 import numpy as np
 from xfem_process import timed_run
 
-from xfemslip.reference import closed_form as cf
-from xfemslip.verify import problems as V
 from xfemslip.case.fractures import TIP_KINDS
 from xfemslip.errors import XfemslipError
+from xfemslip.reference import closed_form as cf
+from xfemslip.verify import problems as V
 
 AOH = (4, 8, 16, 32, 64)
 PENALTIES = (1.0, 1e1, 1e2, 1e3, 1e4, 1e5, 1e6)

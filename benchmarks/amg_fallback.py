@@ -26,8 +26,8 @@ from xfemslip.reference.peer import case_text as xfem_case
 
 
 def one(spec, method: str, stall_stop: bool) -> dict:
-    from xfemslip.solve import linear as linsolve
     from xfemslip.simulation import build_model
+    from xfemslip.solve import linear as linsolve
     from xfemslip.solve.newton import NewtonSolver
 
     linsolve.AMG_STALL_STOP = stall_stop

@@ -64,10 +64,10 @@ def case_text(mesh: int, count: int, tip: str, steps: int, source="dfn") -> str:
 
 def record(text: str, max_systems: int):
     """Build, run with SuperLU; the Newton systems (Kc, r) and model facts."""
-    from xfemslip.solve import linear as linsolve
     from xfemslip.case import loads_case
     from xfemslip.errors import ConvergenceError
     from xfemslip.simulation import build_model, newton_solver
+    from xfemslip.solve import linear as linsolve
 
     spec = loads_case(text, "auto_choice.toml")
     t0 = time.process_time()

@@ -31,6 +31,8 @@ import numpy as np
 
 from xfemslip.reference import closed_form as cf
 from xfemslip.verify import problems as V
+
+
 def run(folder: Path, n, psi=30.0, friction=0.1, penalty=100.0, patch=None):
     """Solve; return (relative L2 slip error or max|slip|, oscillation, iterations).
 

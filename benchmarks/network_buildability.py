@@ -64,11 +64,11 @@ _source_first(sys.argv)
 import numpy as np  # noqa: E402
 import tomli_w  # noqa: E402
 
-from xfemslip.geometry import fracture as geometry  # noqa: E402
 from xfemslip.case import loads_case  # noqa: E402
-from xfemslip.geometry.dfn import intersecting_pairs  # noqa: E402
 from xfemslip.errors import CaseError, GeometryError  # noqa: E402
 from xfemslip.fem.mesh import build_mesh  # noqa: E402
+from xfemslip.geometry import fracture as geometry  # noqa: E402
+from xfemslip.geometry.dfn import intersecting_pairs  # noqa: E402
 from xfemslip.simulation import check_geometry  # noqa: E402
 
 ROOT = Path(__file__).resolve().parents[1]

@@ -15,8 +15,8 @@ import argparse
 import statistics
 import time
 
-from xfemslip.fem.assembly import assemble_bulk
 from xfemslip.case import load_case
+from xfemslip.fem.assembly import assemble_bulk
 from xfemslip.simulation import build_model
 
 

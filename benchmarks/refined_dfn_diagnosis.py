@@ -20,11 +20,11 @@ import sys
 import numpy as np
 import scipy.sparse.linalg as spla
 
-from xfemslip.solve import newton as S
-from xfemslip.fem.assembly import coo_block
 from xfemslip.case import load_case
 from xfemslip.conventions import SLIP
+from xfemslip.fem.assembly import coo_block
 from xfemslip.simulation import build_model, newton_solver
+from xfemslip.solve import newton as S
 
 spec = load_case(sys.argv[1])
 m = build_model(spec)

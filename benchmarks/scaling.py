@@ -1,26 +1,31 @@
 #!/usr/bin/env python3
 """Scaling of the reservoir case (cases/reservoir_depletion.toml with [mesh]
-elements = [n, n]) against the floor: ONE factorize-and-solve of the uncracked
-system on the same mesh, measured in the same run.
+elements = [n, n]) against the floors, whole processes, in the same run.
 
-    python benchmarks/scaling.py --sizes 50 100 200 400 --solvers superlu amg \
-        --runs 3 --json a.json
-    python benchmarks/scaling.py --sizes 700 1000 --solvers amg --runs 1 --json b.json
-    python benchmarks/scaling.py --merge a.json b.json --plot benchmarks/scaling.png
+    MKL_NUM_THREADS=2 OPENBLAS_NUM_THREADS=1 NUMBA_NUM_THREADS=2 \\
+    python benchmarks/scaling.py --sizes 50 100 200 400 --runs 3 --json a.json
+    python benchmarks/scaling.py --sizes 700 1000 --runs 1 --json b.json
+    python benchmarks/scaling.py --merge a.json b.json --plot scaling.png
 
-A solver name with the suffix "/nopred" (e.g. superlu/nopred) runs Newton
-without the stick/slip predictor (xfemslip/contact/predictor.py), against the same
-floor as the plain solver.
+Per size, each in its own process (python -c ..., wall time from the parent
+from start to exit, CPU time and peak memory (ru_maxrss) of that child alone,
+os.wait4):
 
-Every measurement runs in its own subprocess so that the peak memory
-(resource.getrusage maxrss) belongs to it alone.  For each size and linear
-solver: the cracked run (build = mesh, fractures, enrichment, assembly, contact;
-Newton = every load step, every linear solve) and the floor (the same mesh
-without the fracture: assembly, then one solve of K u = F with the same linear
-solver).  Times are the median of --runs runs (each a fresh process, the
-configurations interleaved run by run); memory is the largest maxrss of those
-runs.  Output files are not written.  Set OPENBLAS_NUM_THREADS=1 on a shared
-machine (see benchmarks/RESULTS.md).
+- default: ``xfemslip run`` of the cracked case as installed without the mkl
+  extra (pypardiso hidden from the child: sys.modules["pypardiso"] = None),
+  linear_solver "auto"; results written (h5 + vtu) as a user's run does;
+- pardiso: the same run with the extra installed ("auto" takes PARDISO);
+- floor PARDISO: the uncracked case's model built by xfemslip (mesh,
+  assembly), then ONE factorize-and-solve of K_ff u = F by pypardiso in SPD
+  mode (mtype 2, upper triangle), imports included;
+- floor SuperLU: the same with scipy's SuperLU (minimum degree on A^T + A,
+  symmetric mode), up to --superlu-max n.
+
+Times are medians of --runs runs, the configurations alternated within each
+run (run 1 of every configuration and size, then run 2, ...); memory is the
+largest of the runs.  A warm-up run of each configuration at the smallest
+size compiles and caches the Numba kernels first.  The thread counts of the
+children are those of this process's environment (say which in the report).
 """
 
 from __future__ import annotations
@@ -32,163 +37,171 @@ import re
 import statistics
 import subprocess
 import sys
+import tempfile
+import threading
 import time
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
 CASE = ROOT / "cases" / "reservoir_depletion.toml"
+CONFIGS = ("default", "pardiso", "floor_pardiso", "floor_superlu")
 
 
-def case_text(n: int, cracked: bool) -> str:
+def case_text(n: int, cracked: bool, out: str) -> str:
     text = CASE.read_text()
     text = re.sub(r"elements = \[\d+, \d+\]", f"elements = [{n}, {n}]", text)
+    text = re.sub(r'directory = ".*"', f'directory = "{out}"', text)
     if not cracked:
         text = re.sub(r"\[\[fractures\]\].*?(?=\n\[loading\])", "", text, flags=re.S)
     return text
 
 
-def one(n: int, solver: str, cracked: bool) -> dict:
-    """Measure in this process; returns a dict (printed as JSON)."""
-    import resource
+RUN = """
+import sys
+{hide}
+from xfemslip.cli import main
+sys.argv = ["xfemslip", "run", "-q", "--overwrite", {case!r}]
+main()
+"""
 
-    import numpy as np
+FLOOR = """
+import json, sys, time
+t0 = time.perf_counter()
+import numpy as np, scipy.sparse as sp
+from xfemslip.case import load_case
+from xfemslip.simulation import build_model
+model = build_model(load_case({case!r}))
+p = model.problem
+free = np.ones(p.n_dofs, bool); free[p.fixed] = False
+K = p.K[free][:, free].tocsr()
+F = np.asarray(p.F_unit)[free]
+t1 = time.perf_counter()
+if {solver!r} == "pardiso":
+    import pypardiso
+    s = pypardiso.PyPardisoSolver(mtype=2)
+    A = sp.triu(K, format="csr"); A.sort_indices()
+    x = s.solve(A, F)
+else:
+    from scipy.sparse.linalg import splu
+    lu = splu(K.tocsc(), permc_spec="MMD_AT_PLUS_A", diag_pivot_thresh=0.0,
+              options={{"SymmetricMode": True}})
+    x = lu.solve(F)
+t2 = time.perf_counter()
+r = np.abs(K @ x - F).max() / np.abs(F).max()
+print(json.dumps(dict(dofs=int(K.shape[0]), build=t1 - t0, solve=t2 - t1,
+                      residual=float(r))))
+"""
 
-    from xfemslip.case import loads_case
-    from xfemslip.simulation import build_model
-    from xfemslip.solve.newton import NewtonSolver
 
-    solver, _, flag = solver.partition("/")
-    spec = loads_case(case_text(n, cracked), CASE)
-    t0, c0 = time.perf_counter(), time.process_time()
-    model = build_model(spec)
-    t1, c1 = time.perf_counter(), time.process_time()
-    newton = NewtonSolver(
-        model.problem,
-        spec.solver.tolerance,
-        spec.solver.max_iterations,
-        spec.solver.tangent,
-        solver,
-        predictor=flag != "nopred",
-    )
-    t2, c2 = time.perf_counter(), time.process_time()
-    out = {"n": n, "solver": solver + (f"/{flag}" if flag else ""), "cracked": cracked}
+def child(n: int, config: str, work: Path, timeout: float) -> dict:
+    cracked = not config.startswith("floor")
+    case = work / f"{config}_{n}.toml"
+    case.write_text(case_text(n, cracked, str(work / f"out_{config}_{n}")))
     if cracked:
-        newton.run(spec.loading.steps)
-        res = newton.completed[-1]
-        out["iterations"] = [r.iterations for r in newton.completed]
-        out["predicted"] = [r.predicted for r in newton.completed]
-        out["max_slip"] = float(np.max(np.abs(res.contact.gt)))
-        out["contact_dofs"] = int(np.unique(newton.c_dofs[newton.c_dofs >= 0]).size)
+        hide = 'sys.modules["pypardiso"] = None' if config == "default" else ""
+        code = RUN.format(hide=hide, case=str(case))
     else:
-        p = model.problem
-        u = np.zeros(p.n_dofs)
-        u[p.fixed] = p.fixed_values
-        rhs = (p.F_unit - p.K @ u)[newton.free]
-        x = newton.linear.solve(None, rhs)
-        err = np.linalg.norm(newton.K_ff @ x - rhs) / np.linalg.norm(rhs)
-        out["residual"] = float(err)
-    t3, c3 = time.perf_counter(), time.process_time()
-    st = newton.linear.stats
-    out.update(
-        dofs=int(model.problem.n_dofs),
-        method=st["method"],
-        build=t1 - t0,
-        setup=t2 - t1,
-        solve=t3 - t2,
-        total=t3 - t0,
-        build_cpu=c1 - c0,
-        solve_cpu=c3 - c2,
-        factorizations=st["factorizations"],
-        factor_time=st["factor_time"],
-        amg_setup=st["setup_time"],
-        krylov_iterations=st["krylov_iterations"],
-        maxrss_mib=resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0,
-    )
-    return out
-
-
-def run_once(n, solver, cracked, timeout):
-    cmd = [sys.executable, __file__, "--one", str(n), solver]
-    cmd += ["cracked" if cracked else "floor"]
-    base = {"n": n, "solver": solver, "cracked": cracked}
-    try:
-        proc = subprocess.run(
-            cmd, capture_output=True, text=True, timeout=timeout, env=os.environ
+        code = FLOOR.format(case=str(case), solver=config.split("_")[1])
+    log = work / "child.log"
+    start = time.perf_counter()
+    with open(log, "w") as fh:
+        proc = subprocess.Popen(
+            [sys.executable, "-c", code], stdout=fh, stderr=subprocess.STDOUT, cwd=work
         )
-    except subprocess.TimeoutExpired:
-        return dict(base, error=f"timeout ({timeout:.0f} s)")
+        timer = threading.Timer(timeout, proc.kill)
+        timer.start()
+        # wait4: the exit status and the resource usage of this child alone
+        _, status, usage = os.wait4(proc.pid, 0)
+        timer.cancel()
+    wall = time.perf_counter() - start
+    proc.returncode = os.waitstatus_to_exitcode(status)
+    out = log.read_text()
     if proc.returncode != 0:
-        tail = proc.stderr.strip().splitlines()[-1:] or [f"exit {proc.returncode}"]
-        return dict(base, error=tail[0][:80])
-    return json.loads(proc.stdout.strip().splitlines()[-1])
+        return {"error": out.strip().splitlines()[-1:] or ["killed"]}
+    row = {
+        "wall": wall,
+        "cpu": usage.ru_utime + usage.ru_stime,
+        "maxrss_mib": usage.ru_maxrss / 1024.0,
+    }
+    if not cracked:
+        row.update(json.loads(out.strip().splitlines()[-1]))
+    else:
+        import h5py
+
+        with h5py.File(work / f"out_{config}_{n}" / "result.h5", "r") as f:
+            row["dofs"] = int(f.attrs["n_dofs"])
+            row["newton_its"] = int(f.attrs["newton_iterations"])
+    return row
 
 
-def measure(n, configs, runs, timeout):
-    """Median of `runs` runs of each (solver, cracked) config; the configs are
-    interleaved run by run so that a change of machine load hits all alike."""
-    rows = {c: [] for c in configs}
-    for _ in range(runs):
-        for c in configs:
-            if rows[c] and "error" in rows[c][-1]:
-                continue
-            rows[c].append(run_once(n, *c, timeout))
+def measure(sizes, runs, superlu_max, timeout, log):
+    configs = {
+        n: [c for c in CONFIGS if c != "floor_superlu" or n <= superlu_max]
+        for n in sizes
+    }
+    samples = {(n, c): [] for n in sizes for c in configs[n]}
+    with tempfile.TemporaryDirectory() as tmp:
+        work = Path(tmp)
+        for c in CONFIGS:  # warm-up: Numba's cache, the OS file cache
+            child(min(sizes), c, work, timeout)
+        for k in range(runs):
+            for n in sizes:
+                for c in configs[n]:
+                    row = child(n, c, work, timeout)
+                    samples[(n, c)].append(row)
+                    log(f"run {k + 1} n={n} {c}: {row}")
     out = []
-    for c in configs:
-        ok = [r for r in rows[c] if "error" not in r]
+    for (n, c), rows in samples.items():
+        ok = [r for r in rows if "error" not in r]
         if not ok:
-            out.append(rows[c][-1])
+            out.append({"n": n, "config": c, "error": str(rows[0]["error"])})
             continue
-        med = dict(ok[0])
-        keys = ("build", "setup", "solve", "total", "factor_time", "amg_setup")
-        for key in keys + ("build_cpu", "solve_cpu"):
-            med[key] = statistics.median(r[key] for r in ok)
-        med["maxrss_mib"] = max(r["maxrss_mib"] for r in ok)
-        med["runs"] = len(ok)
-        out.append(med)
+        entry = {"n": n, "config": c, "runs": len(ok), "dofs": ok[0]["dofs"]}
+        for key in ("wall", "cpu", "build", "solve", "newton_its"):
+            if key in ok[0]:
+                entry[key] = statistics.median(r[key] for r in ok)
+        entry["maxrss_mib"] = max(r["maxrss_mib"] for r in ok)
+        out.append(entry)
     return out
 
 
 def table(results) -> str:
-    """Markdown table; ratios on CPU time (robust to a shared machine), wall
-    times in parentheses."""
+    by = {(r["n"], r["config"]): r for r in results}
+    sizes = sorted({r["n"] for r in results})
     lines = [
-        "| n x n | dofs | linear solver | build [s] | Newton [s] | Newton its | "
-        "factorizations / Krylov its | peak RSS [MiB] | floor [s] | "
-        "floor RSS [MiB] | Newton / floor | Newton / SuperLU floor | "
-        "(build + Newton) / (build + floor) |",
-        "| " + " | ".join(["---"] * 13) + " |",
+        "| n x n | dofs | default [s] | pardiso [s] | floor PARDISO [s] | "
+        "floor SuperLU [s] | default / floor P | pardiso / floor P | "
+        "default / floor S | CPU default / pardiso / floor P [s] | "
+        "peak RSS default / pardiso / floor P [MiB] |",
+        "| --- " * 11 + "|",
     ]
-    floors = {(r["n"], r["solver"]): r for r in results if not r["cracked"]}
-    for r in results:
-        if not r["cracked"]:
-            continue
-        f = floors.get((r["n"], r["solver"].partition("/")[0]), {})
-        f_lu = floors.get((r["n"], "superlu"), {})
-        if "error" in r:
-            lines.append(f"| {r['n']} | | {r['solver']} | {r['error']} |" + " |" * 9)
-            continue
-        fl = f.get("solve_cpu")
-        ratio = f"{r['solve_cpu'] / fl:.2f}" if fl else "-"
-        ratio_lu = (
-            f"{r['solve_cpu'] / f_lu['solve_cpu']:.2f}"
-            if f_lu.get("solve_cpu")
-            else "-"
-        )
-        whole = (
-            f"{(r['build_cpu'] + r['solve_cpu']) / (f['build_cpu'] + fl):.2f}"
-            if fl
-            else "-"
-        )
-        floor = f"{fl:.2f} ({f['solve']:.2f})" if fl else f.get("error", "-")
-        floor_rss = f"{f['maxrss_mib']:.0f}" if fl else "-"
-        flag = r["solver"].partition("/")[2]  # "nopred": without the predictor
-        method = r["method"] + (f"/{flag}" if flag else "")
+
+    def g(n, c, key, fmt="{:.2f}"):
+        r = by.get((n, c))
+        if r is None or key not in r:
+            return "-" if r is None or "error" not in r else r["error"][:20]
+        return fmt.format(r[key])
+
+    def ratio(n, a, b):
+        ra, rb = by.get((n, a)), by.get((n, b))
+        if not ra or not rb or "wall" not in ra or "wall" not in rb:
+            return "-"
+        return f"{ra['wall'] / rb['wall']:.2f}"
+
+    for n in sizes:
+        dofs = next(r["dofs"] for r in results if r["n"] == n and "dofs" in r)
         lines.append(
-            f"| {r['n']} | {r['dofs']:,} | {method} | {r['build_cpu']:.2f} | "
-            f"{r['solve_cpu']:.2f} ({r['solve']:.2f}) | {sum(r['iterations'])} | "
-            f"{r['factorizations']} / {r['krylov_iterations']} | "
-            f"{r['maxrss_mib']:.0f} | {floor} | {floor_rss} | {ratio} | {ratio_lu} | "
-            f"{whole} |"
+            f"| {n} | {dofs:,} | {g(n, 'default', 'wall')} | "
+            f"{g(n, 'pardiso', 'wall')} | {g(n, 'floor_pardiso', 'wall')} | "
+            f"{g(n, 'floor_superlu', 'wall')} | "
+            f"{ratio(n, 'default', 'floor_pardiso')} | "
+            f"{ratio(n, 'pardiso', 'floor_pardiso')} | "
+            f"{ratio(n, 'default', 'floor_superlu')} | "
+            f"{g(n, 'default', 'cpu', '{:.1f}')} / {g(n, 'pardiso', 'cpu', '{:.1f}')}"
+            f" / {g(n, 'floor_pardiso', 'cpu', '{:.1f}')} | "
+            f"{g(n, 'default', 'maxrss_mib', '{:.0f}')} / "
+            f"{g(n, 'pardiso', 'maxrss_mib', '{:.0f}')} / "
+            f"{g(n, 'floor_pardiso', 'maxrss_mib', '{:.0f}')} |"
         )
     return "\n".join(lines)
 
@@ -199,81 +212,68 @@ def plot(results, path):
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    fig, ax = plt.subplots(figsize=(5.0, 3.6), dpi=90)
-    styles = {True: "-o", False: "--s"}
-    for solver in sorted({r["solver"] for r in results}):
-        for cracked in (True, False):
-            rows = [
-                r
-                for r in results
-                if r["solver"] == solver
-                and r["cracked"] == cracked
-                and "error" not in r
-            ]
-            if not rows:
-                continue
-            label = f"{solver}: " + ("Newton solve" if cracked else "floor (1 solve)")
+    fig, ax = plt.subplots(figsize=(6.5, 4.5))
+    labels = {
+        "default": "xfemslip run, default install",
+        "pardiso": "xfemslip run, mkl extra (PARDISO)",
+        "floor_pardiso": "floor: PARDISO SPD factor + solve, uncracked",
+        "floor_superlu": "floor: SuperLU factor + solve, uncracked",
+    }
+    for c in CONFIGS:
+        rows = sorted(
+            (r for r in results if r["config"] == c and "wall" in r),
+            key=lambda r: r["dofs"],
+        )
+        if rows:
             ax.loglog(
                 [r["dofs"] for r in rows],
-                [r["solve_cpu"] for r in rows],
-                styles[cracked],
-                label=label,
+                [r["wall"] for r in rows],
+                "o-" if c in ("default", "pardiso") else "s--",
+                label=labels[c],
             )
     ax.set_xlabel("dofs")
-    ax.set_ylabel("CPU time [s]")
+    ax.set_ylabel("whole process wall time [s]")
+    ax.set_title("Reservoir case, 50 x 50 to 1000 x 1000")
     ax.grid(True, which="both", alpha=0.3)
-    ax.legend(fontsize=7)
+    ax.legend(fontsize=8)
     fig.tight_layout()
-    fig.savefig(path)
+    Path(path).parent.mkdir(parents=True, exist_ok=True)
+    fig.savefig(path, dpi=120)
 
 
 def main() -> int:
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--sizes", type=int, nargs="+", default=[50, 100, 200])
-    ap.add_argument("--solvers", nargs="+", default=["auto", "superlu"])
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("--sizes", type=int, nargs="+", default=[50, 100, 200, 400])
     ap.add_argument("--runs", type=int, default=3)
-    ap.add_argument("--timeout", type=float, default=3600.0)
-    ap.add_argument("--json", type=Path, help="append the results to this file")
-    ap.add_argument("--plot", type=Path, help="write a log-log plot (PNG)")
-    ap.add_argument(
-        "--merge",
-        type=Path,
-        nargs="+",
-        help="measure nothing: table (and --plot) of these --json files",
-    )
-    ap.add_argument("--one", nargs=3, help=argparse.SUPPRESS)
-    args = ap.parse_args()
-    if args.one:
-        n, solver, kind = args.one
-        print(json.dumps(one(int(n), solver, kind == "cracked")))
-        return 0
-    if args.merge:
-        results = [r for path in args.merge for r in json.loads(path.read_text())]
-        results.sort(key=lambda r: (r["n"], r["solver"], not r["cracked"]))
-        print(table(results))
-        if args.plot:
-            plot(results, args.plot)
-        return 0
-    results = []
-    if args.json and args.json.exists():
-        results = json.loads(args.json.read_text())
-    for n in args.sizes:
-        # one floor per linear solver ("x/nopred" shares the floor of "x")
-        bases = dict.fromkeys(s.partition("/")[0] for s in args.solvers)
-        configs = [(s, False) for s in bases] + [(s, True) for s in args.solvers]
-        for r in measure(n, configs, args.runs, args.timeout):
-            key = (r["n"], r["solver"], r["cracked"])
-            results = [x for x in results if (x["n"], x["solver"], x["cracked"]) != key]
-            results.append(r)
-            print(json.dumps(r), flush=True)
-        if args.json:
-            args.json.write_text(json.dumps(results, indent=1))
-    results.sort(key=lambda r: (r["n"], r["solver"], not r["cracked"]))
+    ap.add_argument("--superlu-max", type=int, default=700)
+    ap.add_argument("--timeout", type=float, default=900.0)
+    ap.add_argument("--json", help="write the results here")
+    ap.add_argument("--merge", nargs="+", help="JSON files to merge (no runs)")
+    ap.add_argument("--plot", help="write a log-log plot here")
+    a = ap.parse_args()
+    if a.merge:
+        results = [r for f in a.merge for r in json.loads(Path(f).read_text())]
+    else:
+        threads = {
+            k: os.environ.get(k, "unset")
+            for k in ("MKL_NUM_THREADS", "OPENBLAS_NUM_THREADS", "NUMBA_NUM_THREADS")
+        }
+        print(f"threads: {threads}; load: {os.getloadavg()}", flush=True)
+        results = measure(
+            a.sizes,
+            a.runs,
+            a.superlu_max,
+            a.timeout,
+            lambda s: print(s, file=sys.stderr, flush=True),
+        )
+        print(f"load after: {os.getloadavg()}", flush=True)
+    if a.json:
+        Path(a.json).write_text(json.dumps(results, indent=1))
     print(table(results))
-    if args.plot:
-        plot(results, args.plot)
+    if a.plot:
+        plot(results, a.plot)
     return 0
 
 
 if __name__ == "__main__":
-    sys.exit(main())
+    raise SystemExit(main())

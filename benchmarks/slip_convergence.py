@@ -47,11 +47,11 @@ from pathlib import Path
 import numpy as np
 
 from xfemslip import kernels
-from xfemslip.reference import peer as oc
-from xfemslip.fem import quadrature as Q
 from xfemslip.case import loads_case
-from xfemslip.reference.closed_form import relative_l2, slip_profile
+from xfemslip.fem import quadrature as Q
 from xfemslip.post.fields import fracture_fields
+from xfemslip.reference import peer as oc
+from xfemslip.reference.closed_form import relative_l2, slip_profile
 from xfemslip.simulation import build_model, newton_solver
 
 HALF = 200.0  # [m] half-width of the box
@@ -227,6 +227,7 @@ def study_box(hs, element, half):
 
 def study_exact(aohs):
     from xfemslip.verify import problems as V
+
     prob = next(p for p in V.PROBLEMS if p.name == "inclined-30")
     print("| radius | " + " | ".join(f"a/{n}" for n in aohs) + " |")
     print("| --- | " + " | ".join("---" for _ in aohs) + " |")

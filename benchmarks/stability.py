@@ -37,7 +37,6 @@ from tests.support.matrix import (  # noqa: E402
     solve,
     window_reference,
 )
-
 from xfemslip.case import loads_case  # noqa: E402
 from xfemslip.errors import XfemslipError  # noqa: E402
 from xfemslip.simulation import build_model  # noqa: E402
@@ -315,10 +314,7 @@ def main() -> int:
             doc = doc[: doc.index(BEGIN)] + text + doc[doc.index(END) + len(END) :]
         else:
             doc = (
-                doc.rstrip("\n")
-                + "\n\n## Numerical stability matrix\n\n"
-                + text
-                + "\n"
+                doc.rstrip("\n") + "\n\n## Numerical stability matrix\n\n" + text + "\n"
             )
         path.write_text(doc)
     return 0

@@ -115,6 +115,27 @@ def test_numba_kernels_match_golden(case, tmp_path, monkeypatch):
     _assert_matches_golden(case, out)
 
 
+@pytest.mark.parametrize("method", ["superlu", "pardiso"])
+@pytest.mark.parametrize("case", CASES, ids=IDS)
+def test_linear_solvers_match_golden(case, method, tmp_path):
+    """The same goldens through each direct linear solver, forced in the
+    case's [solver] table ("auto" gives these small cases SuperLU)."""
+    import dataclasses
+
+    from xfemslip.case import load_case
+    from xfemslip.simulation import run_case
+
+    if method == "pardiso":
+        pytest.importorskip("pypardiso")
+    spec = load_case(case)
+    spec = dataclasses.replace(
+        spec, solver=dataclasses.replace(spec.solver, linear_solver=method)
+    )
+    out = tmp_path / "out"
+    run_case(spec, out)
+    _assert_matches_golden(case, out)
+
+
 def _assert_matches_golden(case, out):
     got, want = key_scalars(out), read_golden(case)
     assert set(got) == set(want)

@@ -26,6 +26,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
+from xfemslip.case import options
 from xfemslip.case.boundary import read_boundary
 from xfemslip.case.files import MAX_NAME_BYTES, parse_toml, path_problem, read_text
 from xfemslip.case.fractures import read_fractures
@@ -149,6 +150,13 @@ def _read_solver(root: Table) -> SolverSpec | None:
             values[option.name] = table.number(
                 option.name, option.default, option.allowed
             )
+    if values["linear_solver"] == "pardiso" and not options.pardiso_installed():
+        table.error(
+            "linear_solver",
+            "'pardiso' needs MKL PARDISO, which is not installed: "
+            "pip install 'xfemslip[mkl]'",
+        )
+        return None
     if any(v is None for v in values.values()):
         return None
     return SolverSpec(**values)

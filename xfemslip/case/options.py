@@ -8,8 +8,20 @@ default, meaning and allowed values serve the validation
 
 from __future__ import annotations
 
+import importlib.util
+
 from xfemslip.case.specs import CONTACT_PATCH_CELLS
 from xfemslip.case.tables import Option, Range
+
+# the package that linear_solver = "pardiso" needs (the mkl extra); the
+# solver (xfemslip.solve.pardiso) asks the same question through this
+PARDISO_PACKAGE = "pypardiso"
+
+
+def pardiso_installed() -> bool:
+    """Whether MKL PARDISO (the mkl extra: pypardiso) is installed."""
+    return importlib.util.find_spec(PARDISO_PACKAGE) is not None
+
 
 # The constants of [domain]/[mesh], [[fractures]], [boundary] and the CSV files
 # live beside their readers (grid.py, fractures.py, boundary.py, files.py).
@@ -73,9 +85,10 @@ SOLVER_OPTIONS: tuple[Option, ...] = (
         str,
         "auto",
         "linear solver of the Newton systems: 'superlu' (sparse LU, factorization "
-        "kept), 'amg' (pyamg-preconditioned GMRES) or 'auto' (amg from 50,000 "
-        "free dofs on cells up to 4:1)",
-        ("auto", "superlu", "amg"),
+        "kept), 'amg' (pyamg-preconditioned GMRES), 'pardiso' (MKL PARDISO, "
+        "pip install 'xfemslip[mkl]') or 'auto' (pardiso from 50,000 free dofs "
+        "when installed, else amg from 50,000 free dofs on cells up to 4:1)",
+        ("auto", "superlu", "amg", "pardiso"),
     ),
     Option(
         "kernels",

@@ -113,7 +113,7 @@ class SolverSpec:
     tangent: str = "consistent"  # "consistent" | "secant" (paper eq. 28)
     contact_patch: float = CONTACT_PATCH_CELLS  # patch length [cells]; 0 = pointwise
     max_step_cuts: int = 5  # bisections of a failing load step
-    linear_solver: str = "auto"  # "auto" | "superlu" | "amg" (xfemslip.solve.linear)
+    linear_solver: str = "auto"  # "auto" | "superlu" | "amg" | "pardiso" (solve.linear)
     kernels: str = "auto"  # "auto" | "numba" | "numpy" (xfemslip.kernels)
     UNITS: ClassVar[dict[str, str]] = {
         "tolerance": "-",

@@ -5,9 +5,13 @@ Modules:
 
 - ``newton``: ``NewtonSolver`` and ``Problem``: load steps, bisection, Newton
   iterations;
-- ``linear``: ``LinearSolver``: direct and AMG solves of the Newton systems.
+- ``linear``: ``LinearSolver``: direct and AMG solves of the Newton systems,
+  and the automatic choice among them;
+- ``pardiso``: the MKL PARDISO path (the mkl extra): one SPD factorization
+  with the Schur complement on the contact dofs, or a fixed pattern;
+- ``backward``: the backward error every solve is checked against.
 
 The subpackage imports nothing itself: import the module you need (``from
 xfemslip.solve.newton import ...``)."""
 
-__all__ = ["linear", "newton"]
+__all__ = ["backward", "linear", "newton", "pardiso"]

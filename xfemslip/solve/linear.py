@@ -36,7 +36,13 @@ linear_solver``), each keeping what does not change:
   iterations of the first scipy call, and after each call), and the
   attempt is logged (warning: iterations, seconds lost) and counted in
   stats["amg_fallbacks"], stats["amg_fallback_time"].
-- ``"auto"`` (default): ``"amg"`` from AUTO_AMG_MIN_DOFS free dofs up on
+- ``"pardiso"``: MKL PARDISO (the mkl extra), xfemslip.solve.pardiso: one SPD
+  factorization of K_ff for the run with the contact dofs eliminated last,
+  and a dense LU of their Schur complement per contact tangent.  A PARDISO
+  failure sends the run to SuperLU (warning, stats["pardiso_fallbacks"]).
+- ``"auto"`` (default): ``"pardiso"`` from AUTO_PARDISO_MIN_DOFS free dofs
+  when the mkl extra is installed; otherwise ``"amg"`` from
+  AUTO_AMG_MIN_DOFS free dofs up on
   meshes with cell aspect ratios up to AUTO_AMG_MAX_ASPECT whose AMG band
   (the enriched dofs and AMG_BAND_LAYERS matrix neighbours: what the band LU
   of every Newton system factors) holds at most AUTO_AMG_MAX_BAND of the
@@ -64,9 +70,13 @@ import time
 import numpy as np
 import scipy.sparse as sp
 
+from xfemslip.fem.assembly import coo_block
+from xfemslip.solve import pardiso
+from xfemslip.solve.backward import backward_error
+
 logger = logging.getLogger(__name__)
 
-LINEAR_SOLVERS = ("auto", "superlu", "amg")
+LINEAR_SOLVERS = ("auto", "superlu", "amg", "pardiso")
 
 # "auto" switches from SuperLU to AMG at this many free dofs (measured on the
 # reservoir case, benchmarks/RESULTS.md "Speed and scale"), on meshes whose
@@ -74,6 +84,20 @@ LINEAR_SOLVERS = ("auto", "superlu", "amg")
 # cells up to 146:1 the AMG-preconditioned GMRES did not converge in 300
 # iterations (58k dofs).
 AUTO_AMG_MIN_DOFS = 50_000
+# "auto" takes PARDISO (the mkl extra) from this many free dofs: below it,
+# loading MKL (0.3-0.5 s) costs more than SuperLU's whole solve.  Whole
+# `xfemslip run` of the reservoir case (benchmarks/scaling.py, docs/
+# performance.md "Scaling"): 2.03 s with PARDISO against 1.45 s by default
+# (SuperLU) at 22k dofs, 2.82 against 3.28 s (AMG) at 83k.
+AUTO_PARDISO_MIN_DOFS = 50_000
+# Without the mkl extra, a run from this many free dofs says in one line what
+# PARDISO would gain: the measured range of the ratio of the AMG path's
+# linear-solve time to PARDISO's, whole runs at 323k-519k free dofs
+# (docs/performance.md, "Load steps after the first"): 1.7 on the reservoir
+# case's single step, 4.3 on the plate's 5 steps, 5.2 on the depleting
+# reservoir's 10.
+PARDISO_HINT_MIN_DOFS = 200_000
+PARDISO_GAIN = (1.7, 5.2)
 AUTO_AMG_MAX_ASPECT = 4.0
 # ... and whose AMG band (enriched dofs and AMG_BAND_LAYERS neighbours) holds
 # at most this share of the free dofs.  Measured on generated networks of
@@ -176,12 +200,16 @@ def system_facts(K, free, node_xy) -> dict:
 
 
 def choose(method: str, n_free: int, node_xy=None, band_share: float = 0.0) -> str:
-    """The strategy "auto" stands for: "amg" from AUTO_AMG_MIN_DOFS free dofs
-    on meshes with cells up to AUTO_AMG_MAX_ASPECT : 1 whose AMG band (the
-    enriched dofs and AMG_BAND_LAYERS matrix neighbours, system_facts) holds
-    at most AUTO_AMG_MAX_BAND of the free dofs; "superlu" otherwise."""
+    """The strategy "auto" stands for: "pardiso" from AUTO_PARDISO_MIN_DOFS
+    free dofs when the mkl extra is installed; else "amg" from
+    AUTO_AMG_MIN_DOFS free dofs on meshes with cells up to
+    AUTO_AMG_MAX_ASPECT : 1 whose AMG band (the enriched dofs and
+    AMG_BAND_LAYERS matrix neighbours, system_facts) holds at most
+    AUTO_AMG_MAX_BAND of the free dofs; "superlu" otherwise."""
     if method != "auto":
         return method
+    if n_free >= AUTO_PARDISO_MIN_DOFS and pardiso.available():
+        return "pardiso"
     if (
         n_free >= AUTO_AMG_MIN_DOFS
         and band_share <= AUTO_AMG_MAX_BAND
@@ -207,18 +235,6 @@ def _splu(A, settings):
     from scipy.sparse.linalg import splu
 
     return splu(A, **settings)
-
-
-def backward_error(A, x, b, norm_A=None) -> float:
-    """Normwise backward error ||A x - b|| / (||A|| ||x|| + ||b||), infinity
-    norms (0 for x = b = 0, inf for a non-finite x)."""
-    if not np.all(np.isfinite(x)):
-        return np.inf
-    if norm_A is None:
-        norm_A = abs(A).sum(axis=1).max()
-    den = float(norm_A) * np.abs(x).max(initial=0.0) + np.abs(b).max(initial=0.0)
-    r = np.abs(A @ x - b).max(initial=0.0)
-    return float(r / den) if den > 0.0 else float(r)
 
 
 def lu_factor(A, stats=None):
@@ -368,19 +384,37 @@ class LinearSolver:
         modes); without it "auto" means "superlu".
     """
 
-    def __init__(self, K_ff, method="auto", free=None, node_xy=None):
+    def __init__(self, K_ff, method="auto", free=None, node_xy=None, contact_dofs=None):
         if method not in LINEAR_SOLVERS:
             raise ValueError(f"linear solver must be one of {LINEAR_SOLVERS}")
         self.K = sp.csr_matrix(K_ff)
         n = self.K.shape[0]
         self.free = np.arange(n) if free is None else np.asarray(free)
         self.node_xy = node_xy
+        # free-dof index of each contact block row/column (-1: none), for
+        # solve_contact
+        self.contact_dofs = (
+            np.zeros((0, 0), np.int64) if contact_dofs is None else contact_dofs
+        )
         self.facts = {"n_free": n}
         if method == "auto" and node_xy is not None and n >= AUTO_AMG_MIN_DOFS:
-            self.facts = system_facts(self.K, self.free, node_xy)
+            if not (n >= AUTO_PARDISO_MIN_DOFS and pardiso.available()):
+                self.facts = system_facts(self.K, self.free, node_xy)
         self.method = choose(method, n, node_xy, self.facts.get("band_share", 0.0))
         if self.method == "amg" and node_xy is None:
             raise ValueError("the AMG linear solver needs the node coordinates")
+        if self.method == "pardiso" and not pardiso.available():
+            raise ValueError(
+                "linear_solver 'pardiso' needs MKL PARDISO: pip install 'xfemslip[mkl]'"
+            )
+        if method == "auto" and self.method != "pardiso" and n >= PARDISO_HINT_MIN_DOFS:
+            logger.info(
+                "linear solver: %s; with MKL PARDISO (pip install "
+                "'xfemslip[mkl]') the linear solves of meshes this size took "
+                "1/%.1f to 1/%.1f of the time",
+                self.method,
+                *PARDISO_GAIN,
+            )
         self.stats = {
             "method": self.method,
             "factorizations": 0,
@@ -394,7 +428,17 @@ class LinearSolver:
             "fallback_time": 0.0,
             "amg_fallbacks": 0,
             "amg_fallback_time": 0.0,
+            "pardiso_analyses": 0,
+            "pardiso_spd": 0,
+            "pardiso_unsym": 0,
+            "pardiso_schur": 0,
+            "schur_factorizations": 0,
+            "pardiso_fallbacks": 0,
         }
+        # pardiso.SchurSystems or PardisoSystems, made on the first solve, and
+        # the pattern of the sparse Kc they were made for (None: the blocks')
+        self._pardiso = None
+        self._pardiso_key = None
         self._lu = None  # (SuperLU object, checked solve, K_c it factors)
         self._amg = None  # V-cycle on the standard dofs
         # the AMG band of "auto"'s facts is the one the AMG path solves on
@@ -425,6 +469,64 @@ class LinearSolver:
             logger.debug("linear solver: %s (%d free dofs)", self.method, n)
 
     # ------------------------------------------------------------------ #
+    def solve_contact(self, blocks, r):
+        """x with (K_ff + sum of the contact blocks) x = r; blocks (m, k, k)
+        on the rows and columns contact_dofs (m, k), or None."""
+        if self.method == "pardiso":
+            start = time.perf_counter()
+            if self._pardiso is None:
+                dofs = np.asarray(self.contact_dofs, dtype=np.int64)
+                if dofs.ndim != 2:  # (m, k): m = 0 without a fracture
+                    dofs = dofs.reshape(len(dofs), -1)
+                k = dofs.shape[1]
+                shape = (dofs.shape[0], k, k)
+                self._make_pardiso(
+                    np.broadcast_to(dofs[:, :, None], shape),
+                    np.broadcast_to(dofs[:, None, :], shape),
+                    None,
+                )
+            x = self._solve_pardiso(blocks, pardiso.symmetric_blocks(blocks), r)
+            if x is not None:
+                self.stats["solves"] += 1
+                self.stats["solve_time"] += time.perf_counter() - start
+                return x
+        Kc = None
+        if blocks is not None and np.size(blocks):
+            Kc = coo_block(self.contact_dofs, blocks, self.K.shape[0])
+        return self.solve(Kc, r)
+
+    def _make_pardiso(self, rows, cols, key):
+        """The PARDISO systems for contact entries at (rows, cols); `key`: the
+        pattern of the sparse Kc they are made for (None: the blocks')."""
+        self._release_pardiso()
+        self._pardiso = pardiso.make_systems(
+            self.K, rows, cols, LU_BACKWARD_ERROR, self.stats
+        )
+        self._pardiso_key = key
+
+    def _solve_pardiso(self, entries, symmetric, r):
+        """The PARDISO solve on the kept pattern, or None after a failure
+        (logged; this and the later systems of the run go to SuperLU)."""
+        t = time.perf_counter()
+        try:
+            return self._pardiso.solve(self._pardiso.values(entries), symmetric, r)
+        except pardiso.PardisoError as exc:
+            self.stats["pardiso_fallbacks"] += 1
+            logger.warning(
+                "%s after %.2f s; SuperLU solves this and the later systems of the run",
+                exc,
+                time.perf_counter() - t,
+            )
+            self._release_pardiso()
+            self.method = "superlu"
+            return None
+
+    def _release_pardiso(self):
+        if self._pardiso is not None:
+            self._pardiso.release()
+        self._pardiso = None
+        self._pardiso_key = None
+
     def solve(self, Kc, r):
         """x with (K_ff + Kc) x = r; Kc is (n_free, n_free) sparse or None.
 
@@ -434,12 +536,33 @@ class LinearSolver:
         if Kc is None:
             Kc = sp.csr_matrix(self.K.shape)
         Kc = sp.csr_matrix(Kc)
-        if self.method == "amg":
+        if self.method == "pardiso":
+            x = self._solve_pardiso_matrix(Kc, r)
+        elif self.method == "amg":
             x = self._solve_amg(Kc, r)
         else:
             x = self._solve_superlu(Kc, r)
         self.stats["solves"] += 1
         self.stats["solve_time"] += time.perf_counter() - start
+        return x
+
+    def _solve_pardiso_matrix(self, Kc, r):
+        """solve() with a sparse Kc on PARDISO: its stored entries are the
+        contact entries of systems kept while Kc's pattern stays."""
+        Kc.sort_indices()
+        key = self._pardiso_key
+        if (
+            self._pardiso is None
+            or key is None
+            or not np.array_equal(key[0], Kc.indptr)
+            or not np.array_equal(key[1], Kc.indices)
+        ):
+            coo = Kc.tocoo()
+            self._make_pardiso(coo.row, coo.col, (Kc.indptr.copy(), Kc.indices.copy()))
+        symmetric = Kc.nnz == 0 or pardiso.matrix_symmetric(Kc)
+        x = self._solve_pardiso(Kc.data, symmetric, r)
+        if x is None:
+            return self._solve_superlu(Kc, r)
         return x
 
     # ------------------------------------------------------------------ #

@@ -26,6 +26,7 @@ from __future__ import annotations
 import dataclasses
 import logging
 import math
+import time
 from dataclasses import dataclass
 
 import numpy as np
@@ -176,9 +177,11 @@ class NewtonSolver:
         self.reduced = -np.ones(n, np.int64)
         self.reduced[self.free] = np.arange(self.free.size)
         self.K_ff = problem.K[self.free][:, self.free].tocsr()
-        self.linear = LinearSolver(self.K_ff, linear_solver, self.free, problem.node_xy)
         c = problem.contact
         self.c_dofs = np.where(c.dofs >= 0, self.reduced[np.maximum(c.dofs, 0)], -1)
+        self.linear = LinearSolver(
+            self.K_ff, linear_solver, self.free, problem.node_xy, self.c_dofs
+        )
         # tangent blocks of the contact evaluations whose tangent is never
         # used (_scratch_blocks)
         self._scratch = None
@@ -243,6 +246,8 @@ class NewtonSolver:
         and the next one tries twice the size; a failed one is retried from
         the last committed state at half the size.
         """
+        start = time.perf_counter()
+        solve_start = self.linear.stats["solve_time"]
         units = 1 << self.max_cuts
         done, size = 0, units
         cuts = substeps = iterations = freezes = predicted = reversals = 0
@@ -296,6 +301,7 @@ class NewtonSolver:
                 substeps,
                 cuts,
             )
+        self._log_step_time(k, steps, start, solve_start)
         self.completed.append(
             StepResult(
                 k,
@@ -317,6 +323,26 @@ class NewtonSolver:
             )
         )
         return u
+
+    def _log_step_time(self, k, steps, start, solve_start):
+        """Debug line: the step's wall time and its linear solves' time, and
+        their ratio to the first step's (whose solve holds the factorization
+        the later steps reuse)."""
+        wall = time.perf_counter() - start
+        solve = self.linear.stats["solve_time"] - solve_start
+        if not self.completed:
+            self._first_step_time = (wall, solve)
+        first_wall, first_solve = self._first_step_time
+        logger.debug(
+            "step %d/%d: %.3f s (%.2f of step 1), linear solves %.3f s "
+            "(%.2f of step 1's)",
+            k,
+            steps,
+            wall,
+            wall / first_wall if first_wall > 0 else 1.0,
+            solve,
+            solve / first_solve if first_solve > 0 else 1.0,
+        )
 
     def _after_cuts(self, err, cuts, fraction):
         """The error of the last attempt, saying that bisection did not help."""
@@ -699,9 +725,8 @@ class NewtonSolver:
                 )
 
     def _solve(self, res, r, k, it, eta):
-        Kc = coo_block(self.c_dofs, res.blocks, self.free.size)
         try:
-            du = self.linear.solve(Kc, r)
+            du = self.linear.solve_contact(res.blocks, r)
         except RuntimeError as exc:  # "Factor is exactly singular"
             raise self._fail(
                 k,

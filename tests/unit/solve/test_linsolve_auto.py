@@ -23,6 +23,13 @@ CASE = ROOT / "cases" / "reservoir_depletion.toml"
 pytest.importorskip("pyamg")
 
 
+@pytest.fixture(autouse=True)
+def _without_mkl(monkeypatch):
+    """The rule of an install without the mkl extra (with it, "auto" takes
+    PARDISO from AUTO_PARDISO_MIN_DOFS on: test_pardiso.py)."""
+    monkeypatch.setattr(linsolve.pardiso, "available", lambda: False)
+
+
 def _grid(n, sx=1.0, sy=1.0):
     g = np.linspace(0.0, 1.0, n + 1)
     return np.column_stack([np.repeat(g, n + 1) * sx, np.tile(g, n + 1) * sy])
