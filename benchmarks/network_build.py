@@ -9,7 +9,7 @@ The networks are random but reproducible (seed 6): straight fractures of
 0.08-0.25 m in the unit square, uniform orientations, so they cross and end
 near one another; ends within half a cell of another fracture are snapped (T).
 Each size is built once to compile the kernels, then timed --runs times; the
-median goes to benchmarks/RESULTS.md with the machine and its load.
+median goes to docs/performance.md with the machine and its load.
 """
 
 from __future__ import annotations

@@ -37,7 +37,7 @@ Networks:
   (30 fractures, two sets, power-law lengths 0.12-0.4 m, 50 x 50 cells on
   the unit square), with its own count and with ``count = 100``.
 
-Not a test: it prints the table for benchmarks/RESULTS.md.
+Not a test: it prints the table of docs/networks.md, *Random networks*.
 """
 
 from __future__ import annotations

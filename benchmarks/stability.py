@@ -2,8 +2,8 @@
 
 Writes a table (case, converged, Newton iterations, stick/slip switches,
 load-step cuts / ping-pong freezes, max |slip|, result vs reference) into its
-own section of benchmarks/RESULTS.md (between the stability markers) and
-prints it.  The case builders and references are tests/support/matrix.py.
+section of docs/performance.md (between the stability markers, replaced
+in place) and prints it; --no-write only prints.  The case builders and references are tests/support/matrix.py.
 
 Usage (from the project root):  python benchmarks/stability.py [--quick]
 --quick skips the 1-degree angle sweep and the 1000-step runs.
@@ -308,7 +308,7 @@ def main() -> int:
     )
     print(text)
     if not args.no_write:
-        path = ROOT / "benchmarks" / "RESULTS.md"
+        path = ROOT / "docs" / "performance.md"
         doc = path.read_text()
         if BEGIN in doc:
             doc = doc[: doc.index(BEGIN)] + text + doc[doc.index(END) + len(END) :]

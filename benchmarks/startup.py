@@ -2,7 +2,8 @@
 """Whole-process wall time of `xfemslip run` on a shipped case: first run after
 install (empty Numba and bytecode caches: a case on the Numba kernels compiles
 them) and warm runs (caches filled).  Medians of several runs; results go to
-benchmarks/RESULTS.md by hand together with the machine they were measured on.
+docs/performance.md (*Start-up*) by hand, with the machine they were
+measured on.
 `XFEMSLIP_KERNELS=numba python benchmarks/startup.py` forces the Numba kernels
 (a small case gets the NumPy ones: xfemslip.kernels.choose).
 
@@ -12,7 +13,7 @@ A cold run gets a fresh, empty NUMBA_CACHE_DIR; warm runs share one that a
 first run has filled.  The same holds for Python's bytecode cache
 (PYTHONPYCACHEPREFIX, one per cold run, one shared by the warm runs):
 without it, an environment with PYTHONDONTWRITEBYTECODE=1 (as on the machine
-of benchmarks/RESULTS.md) compiles xfemslip's 39 modules from source in
+of docs/performance.md) compiles every xfemslip module from source in
 every run, 0.05-0.07 s that an installed package does not pay.
 """
 

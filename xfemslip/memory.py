@@ -22,8 +22,12 @@ The peak resident memory of a run is modelled from the sizes that set it
   CSC copy (MATRIX_BYTES per non-zero) and, with SuperLU, LU_FACTORS sparse
   LU factorizations (the kept one while the next is built), whose fill grows
   like nnz * log2(n_dofs) with a fill-reducing ordering (LU_BYTES per
-  non-zero and per log2); with AMG (linsolve.choose), its hierarchy and set-up
-  (AMG_BYTES per non-zero) and the GMRES basis (AMG_RESTART + 1 vectors).
+  non-zero and per log2); with MKL PARDISO (the mkl extra), one factorization
+  (PARDISO_BYTES per non-zero and per log2, measured on the reservoir case
+  from 324k to 2.0M dofs) and the dense Schur complement of the contact dofs
+  with its LU (16 B per entry, up to SCHUR_MAX_DOFS of them); with AMG
+  (linsolve.choose), its hierarchy and set-up (AMG_BYTES per non-zero) and
+  the GMRES basis (AMG_RESTART + 1 vectors).
   A run whose AMG solve fails over to SuperLU may need more than estimated;
 - ``contact tangents``, during the Newton iterations: the contact tangent
   blocks of every patch, padded to the widest (8 B per entry), NEWTON_BLOCKS
@@ -95,6 +99,10 @@ NUMPY_QP_FUNCTION_BYTES = 56.0
 MATRIX_BYTES = 48.0
 LU_BYTES = 5.0  # per stiffness non-zero and per log2(n_dofs), one factor [B]
 LU_FACTORS = 2  # factorizations held at once
+# MKL PARDISO's factorization, per stiffness non-zero and per log2(n_dofs):
+# whole runs of the reservoir case peaked at 1043 / 2987 / 5892 MB at 324k /
+# 986k / 2.0M dofs (benchmarks/scaling.py), 5.2-5.6 B after the other terms [B]
+PARDISO_BYTES = 6.0
 AMG_BYTES = 40.0  # per stiffness non-zero: hierarchy and its set-up [B]
 NEWTON_BLOCKS = 3  # contact tangent-block arrays held at once (+1 on NumPy)
 NNZ_PER_ENTRY = 0.56  # CSR non-zeros per COO entry (shared nodes summed)
@@ -132,7 +140,8 @@ class Footprint:
     block: float = 0.0  # dofs of the widest patch's tangent block (2 J)
     contact_entries: float = 0.0  # non-empty entries of the tangent blocks
     points: float = 0.0  # contact integration points
-    amg: bool = False  # the linear solver is AMG-preconditioned GMRES
+    linear: str = "superlu"  # the linear solver "auto" resolves to
+    contact_dofs: float = 0.0  # distinct dofs of the contact patches
 
 
 def estimate_terms(fp: Footprint) -> dict[str, float]:
@@ -143,11 +152,18 @@ def estimate_terms(fp: Footprint) -> dict[str, float]:
     triplets = TRIPLET_BYTES * fp.entries + ENRICHED_TRIPLET_BYTES * fp.enriched_entries
     assembly = fp.enriched_cells * (8 + 2 * fp.slots) ** 2 * 8.0
     assembly += max(gradients, triplets)  # one after the other
-    if fp.amg:
+    if fp.linear == "amg":
         from xfemslip.solve.linear import AMG_RESTART
 
         solver = fp.nnz * (MATRIX_BYTES + AMG_BYTES)
         solver += (AMG_RESTART + 1) * 8.0 * fp.n_dofs
+    elif fp.linear == "pardiso":
+        from xfemslip.solve.pardiso import SCHUR_MAX_DOFS
+
+        log_n = math.log2(max(fp.n_dofs, 2))
+        solver = fp.nnz * (MATRIX_BYTES + PARDISO_BYTES * log_n)
+        if fp.contact_dofs <= SCHUR_MAX_DOFS:
+            solver += 16.0 * fp.contact_dofs**2
     else:
         log_n = math.log2(max(fp.n_dofs, 2))
         solver = fp.nnz * (MATRIX_BYTES + LU_FACTORS * LU_BYTES * log_n)
@@ -206,7 +222,7 @@ def case_footprint(spec) -> Footprint:
         n_cells=n_cells,
         n_dofs=n_dofs,
         # the band of the enriched dofs is not known yet: AMG if large enough
-        amg=_amg(spec, spec.mesh.x, spec.mesh.y, n_dofs, 0.0),
+        linear=_linear(spec, spec.mesh.x, spec.mesh.y, n_dofs, 0.0),
         nnz=NNZ_PER_ENTRY * entries + 20.0 * (n_dofs - 2 * n_nodes),
         steps=spec.loading.steps,
         entries=entries,
@@ -214,6 +230,8 @@ def case_footprint(spec) -> Footprint:
         patches=patches,
         block=16.0,
         contact_entries=256.0 * patches,
+        # the jumps are interpolated from the enriched dofs alone
+        contact_dofs=float(n_dofs - 2 * n_nodes),
         points=4 * pieces,
     )
 
@@ -261,7 +279,7 @@ def enriched_footprint(spec, mesh, fractures, cand) -> Footprint:
         n_nodes=mesh.n_nodes,
         n_cells=mesh.n_cells,
         n_dofs=n_dofs,
-        amg=_amg(spec, mesh.x, mesh.y, n_dofs, _band_share(mesh, cand, n_dofs)),
+        linear=_linear(spec, mesh.x, mesh.y, n_dofs, _band_share(mesh, cand, n_dofs)),
         nnz=NNZ_PER_ENTRY * entries,
         steps=spec.loading.steps,
         # the points are estimated up to 20 % low (QP_CELL ...): near the
@@ -276,6 +294,7 @@ def enriched_footprint(spec, mesh, fractures, cand) -> Footprint:
         patches=patches,
         block=2.0 * S,
         # a patch's block holds the slots of about one cut cell
+        contact_dofs=2.0 * cand.node.size,
         contact_entries=patches * float(np.mean((2.0 * slots[enr]) ** 2))
         if enr.any()
         else 0.0,
@@ -297,7 +316,7 @@ def model_footprint(model) -> Footprint:
         n_nodes=model.mesh.n_nodes,
         n_cells=model.mesh.n_cells,
         n_dofs=p.n_dofs,
-        amg=_amg(model.spec, model.mesh.x, model.mesh.y, p.n_dofs, p),
+        linear=_linear(model.spec, model.mesh.x, model.mesh.y, p.n_dofs, p),
         nnz=float(model.problem.K.nnz),
         steps=model.spec.loading.steps,
         numba=contact.kernels == "numba",
@@ -310,6 +329,7 @@ def model_footprint(model) -> Footprint:
         patches=float(contact.dofs.shape[0]),
         block=float(contact.dofs.shape[1]),
         contact_entries=float(np.sum(dofs.astype(float) ** 2)),
+        contact_dofs=float(np.unique(contact.dofs[contact.dofs >= 0]).size),
         points=float(model.ip.n),
     )
 
@@ -367,16 +387,18 @@ def configure_allocator() -> bool:
     return True
 
 
-def _amg(spec, x, y, n_dofs, band) -> bool:
-    """Whether the linear solver will be AMG (linsolve.choose) for a mesh
-    with grid lines x, y and about n_dofs free dofs; band: the share of them
-    in the AMG band, or the Problem to take it from (only computed where
-    the other conditions hold)."""
+def _linear(spec, x, y, n_dofs, band) -> str:
+    """The linear solver (linsolve.choose) for a mesh with grid lines x, y
+    and about n_dofs free dofs; band: the share of them in the AMG band, or
+    the Problem to take it from (only computed where the other conditions
+    hold)."""
     from xfemslip.solve import linear as linsolve
 
     method = spec.solver.linear_solver
-    if method != "auto" or n_dofs < linsolve.AUTO_AMG_MIN_DOFS:
-        return method == "amg"
+    if method != "auto":
+        return method
+    if n_dofs < min(linsolve.AUTO_AMG_MIN_DOFS, linsolve.AUTO_PARDISO_MIN_DOFS):
+        return "superlu"
     # the grid lines as node coordinates (cell_aspect_ratio reads those)
     lines = np.zeros((x.size + y.size, 2))
     lines[: x.size, 0], lines[x.size :, 1] = x, y
@@ -385,7 +407,7 @@ def _amg(spec, x, y, n_dofs, band) -> bool:
         enr = np.arange(band.n_dofs) >= 2 * band.node_xy.shape[0]
         mask = linsolve.band_mask(band.K, enr, linsolve.AMG_BAND_LAYERS)
         band = float(mask.sum()) / band.n_dofs
-    return linsolve.choose(method, n_dofs, lines, band) == "amg"
+    return linsolve.choose(method, n_dofs, lines, band)
 
 
 def _band_share(mesh, cand, n_dofs) -> float:

@@ -1,9 +1,9 @@
 """The numerical stress matrix, fast subset (the whole matrix is
-``benchmarks/stability.py``; its table is in ``benchmarks/RESULTS.md``).
+``benchmarks/stability.py``; its table is in ``docs/performance.md``).
 
 Every case converges and matches its independent reference, or fails with a
 ConvergenceError that says why and what to change.  Never NaN or inf.
-Measured numbers are in the docstrings of the tests and in RESULTS.md.
+Measured numbers are in the docstrings of the tests and in docs/performance.md.
 """
 
 from __future__ import annotations

@@ -25,6 +25,7 @@ from xfemslip.memory import (
     MATRIX_BYTES,
     MMAP_THRESHOLD,
     NEWTON_BLOCKS,
+    PARDISO_BYTES,
     TRIM_THRESHOLD,
     TRIPLET_BYTES,
     Footprint,
@@ -93,6 +94,16 @@ def test_terms_follow_their_sizes():
     )
     wider = estimate_terms(replace(contact, block=40))["contact tangents"]
     assert wider == pytest.approx(4 * tangents)
+    # PARDISO: one factorization and the dense Schur complement of the
+    # contact dofs with its LU (16 B per entry) while it is used
+    pardiso = replace(fp, linear="pardiso", contact_dofs=1000.0)
+    assert estimate_terms(pardiso)["solver"] == pytest.approx(
+        4e5 * (MATRIX_BYTES + PARDISO_BYTES * math.log2(20_000)) + 16.0 * 1000**2
+    )
+    many = replace(pardiso, contact_dofs=1e5)  # fixed-pattern mode: no dense block
+    assert estimate_terms(many)["solver"] == pytest.approx(
+        4e5 * (MATRIX_BYTES + PARDISO_BYTES * math.log2(20_000))
+    )
     wide = replace(fp, enriched_cells=100, slots=10, entries=5e5, numba=True)
     assert estimate_terms(wide)["assembly"] == pytest.approx(
         100 * 28**2 * 8 + TRIPLET_BYTES * 5e5
@@ -152,7 +163,15 @@ def test_crowded_network_refused_below_its_peak(tmp_path, monkeypatch):
     case = tmp_path / "dense.toml"
     case.write_text(
         sweep_member(
-            index=0, **{"network.generate.count": 200, "mesh.elements": [100, 100]}
+            index=0,
+            **{
+                "network.generate.count": 200,
+                "mesh.elements": [100, 100],
+                # AMG's smaller solver term lets the case pass the first
+                # check (from the fracture lengths), so the second one, from
+                # the enriched nodes, is what refuses it
+                "solver.linear_solver": "amg",
+            },
         )
     )
     out = tmp_path / "out"

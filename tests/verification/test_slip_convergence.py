@@ -14,7 +14,7 @@ The slip error had stalled at order ~0.5 on the growth-1.3 mesh: the coarse,
 elongated far-field cells (about 0.3 r long at distance r, whatever h) were
 too stiff in bending (plain Q4 parasitic shear), and the crack slipped
 uniformly too little.  Intact cells now carry condensed incompatible modes
-(kernels.bulk.rectangle_stiffness).  Measured (benchmarks/RESULTS.md, "Slip
+(kernels.bulk.rectangle_stiffness).  Measured (docs/performance.md, "Slip
 convergence on the OpenGeoSys peer problem"), relative L2 slip error:
 
 ===============================  =======  =======  ========

@@ -30,7 +30,7 @@ class MaterialSpec:
 
 # Penalty stiffness when a fracture omits kn / kt: k = AUTO_PENALTY * E / h with
 # h the local cell size (sqrt of the area of the cut cell).  Measured on the
-# inclined crack (benchmarks/RESULTS.md, "Penalty"): below ~1e3 the stuck faces'
+# inclined crack (docs/case-format.md, "Automatic penalty"): below ~1e3 the stuck faces'
 # elastic penalty slip is the larger error (2e-4 of the free slip at 100, 3e-2
 # at 1), from 1e3 up it sits at the discretisation floor (5e-5); the slip error
 # (0.42 % at a/20) and the Newton iterations (2 per step on the plate case up
@@ -41,7 +41,8 @@ AUTO_PENALTY = 1.0e3
 # penalty law acts on the jump averaged over each patch (contact.ContactSet).
 # Measured on the inclined crack at h = a/20: normal-traction oscillation (max
 # deviation / mean) 23 % pointwise (0), 1.2 % with 1-cell patches, 0.3 % with
-# 1.5-cell patches, slip error unchanged (benchmarks/RESULTS.md).
+# 1.5-cell patches, slip error unchanged (docs/verification.md, "Contact
+# tractions: patches against points").
 CONTACT_PATCH_CELLS = 1.5
 
 

@@ -238,8 +238,8 @@ def build_enriched_cells(mesh, fractures, cand: Candidates) -> EnrichedCells:
     enrichment functions of each (fracture, tip or arm) group evaluated once
     on the quadrature points and sub-triangle vertices of all the cells the
     group reaches (the functions are point-wise, so the values are those of a
-    cell-by-cell evaluation; measured in benchmarks/RESULTS.md, "Network
-    speed").  The fracture side of a point is that of its sub-cell's centroid.
+    cell-by-cell evaluation; measured in docs/performance.md, "Fracture
+    networks").  The fracture side of a point is that of its sub-cell's centroid.
     """
     tol = GEOMETRY_TOL * mesh.h_min
     cand_fnode = _candidate_node_values(fractures, mesh, cand, tol)

@@ -79,7 +79,7 @@ logger = logging.getLogger(__name__)
 LINEAR_SOLVERS = ("auto", "superlu", "amg", "pardiso")
 
 # "auto" switches from SuperLU to AMG at this many free dofs (measured on the
-# reservoir case, benchmarks/RESULTS.md "Speed and scale"), on meshes whose
+# reservoir case, docs/performance.md "Scaling"), on meshes whose
 # cells are no more elongated than AUTO_AMG_MAX_ASPECT: on a graded mesh with
 # cells up to 146:1 the AMG-preconditioned GMRES did not converge in 300
 # iterations (58k dofs).
@@ -101,8 +101,8 @@ PARDISO_GAIN = (1.7, 5.2)
 AUTO_AMG_MAX_ASPECT = 4.0
 # ... and whose AMG band (enriched dofs and AMG_BAND_LAYERS neighbours) holds
 # at most this share of the free dofs.  Measured on generated networks of
-# 1-100 fractures, 80k-375k dofs (benchmarks/auto_choice.py, RESULTS.md "auto
-# solver choice (issue 7, session 4)"): the band LU of every Newton system
+# 1-100 fractures, 80k-375k dofs (benchmarks/auto_choice.py, docs/
+# performance.md "Automatic linear solver choice"): the band LU of every Newton system
 # grows with the band, and AMG's CPU time on the same Newton systems, 0.54 to
 # 0.82 of SuperLU's with bands of 12-64 %, was 0.92-0.93 with 67 % and 79 %;
 # the one run with a larger band that fell back to SuperLU (a singular band
@@ -125,7 +125,7 @@ AMG_MAX_ITERATIONS = 150
 AMG_BAND_LAYERS = 3
 # Stop the AMG path's GMRES after a restart cycle whose residual, extrapolated
 # at its mean rate, would not reach KRYLOV_RTOL within AMG_MAX_ITERATIONS
-# (benchmarks/RESULTS.md, "auto solver choice (issue 7, session 4)").
+# (docs/performance.md, "Automatic linear solver choice").
 AMG_STALL_STOP = True
 # ... checked every STALL_CHECK iterations within the first restart cycle.
 STALL_CHECK = 20
@@ -134,8 +134,8 @@ STALL_CHECK = 20
 # when the slip tangent's values are not: minimum degree on A^T + A in symmetric
 # mode, diagonal pivots only (measured: 2x faster than the default COLAMD
 # at 82k dofs, 0.19 vs 0.31 s at 21k).  Pivot threshold 0: the diagonal pivot
-# is always taken, so the fill is that of the symmetric ordering; with the
-# threshold 0.1 of session 2 the row exchanges for the non-symmetric friction
+# is always taken, so the fill is that of the symmetric ordering; with a
+# threshold of 0.1 the row exchanges for the non-symmetric friction
 # coupling raised the fill of the 100 x 100 reservoir matrix from 3.6M to 6.2M
 # entries and the factorization from 0.15 to 0.37 s (relative residual
 # 2e-11 either way).  A solve whose residual is poor is redone with COLAMD and
@@ -150,16 +150,16 @@ LU_SAFE = {"permc_spec": "COLAMD", "diag_pivot_thresh": 1.0}
 # 1967; Higham 2002, Accuracy and Stability of Numerical Algorithms, ch. 7; in the
 # infinity norm)  ||A x - b|| / (||A|| ||x|| + ||b||)  is at most
 # LU_BACKWARD_ERROR, after one step of iterative refinement with the kept
-# factors if needed; otherwise it is redone with LU_SAFE.  Until session 4
-# the test was the relative residual ||A x - b|| / ||b|| <= 1e-8, which an
-# exact-to-round-off solve of an ill-conditioned system can fail: with branch
+# factors if needed; otherwise it is redone with LU_SAFE.  Not the relative
+# residual ||A x - b|| / ||b|| (e.g. <= 1e-8), which an exact-to-round-off
+# solve of an ill-conditioned system can fail: with branch
 # tips on a 30-fracture network the fast LU's relative residual on the bulk
 # matrix (b = 1) is already 3.5e-10 at 50 x 50 cells (16k dofs) and 6.6e-10
 # at 100 x 100 (45k), 1/15 of that threshold, while the backward error is
 # 8e-19; the COLAMD fallback a failed test triggers solves no better
 # (residual 1.4e-9) and costs 1.4 s at 16k dofs (17M fill entries) and over
 # 90 s at 45k, where the fast factorization takes 0.22 and 0.57 s
-# (benchmarks/RESULTS.md, "Network speed").
+# (docs/performance.md, "Fracture networks").
 LU_BACKWARD_ERROR = 1.0e-10
 
 
