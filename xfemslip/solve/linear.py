@@ -50,10 +50,12 @@ linear_solver``), each keeping what does not change:
   otherwise.  All three inputs are known before the first solve
   (system_facts); the choice is logged at debug level.
 
-Why not a low-rank (Woodbury) update or a Schur complement on the contact
-dofs: both cost one back-solve per contact dof, and on the reservoir case at
-200 x 200 (82k dofs, 518 contact dofs) one back-solve is 1/40 of a
-factorization, so the update would cost about 13 factorizations.
+Why SuperLU refactors instead of a low-rank (Woodbury) update or a Schur
+complement on the contact dofs: through SuperLU both cost one back-solve per
+contact dof, and on the reservoir case at 200 x 200 (82k dofs, 518 contact
+dofs) one back-solve is 1/40 of a factorization, so the update would cost
+about 13 factorizations.  PARDISO forms the Schur complement inside its one
+factorization (pardiso.py), which is what makes that path cheap.
 
 The friction tangent is not symmetric while slipping, hence GMRES (not CG)
 whenever a contact tangent is present.  Iterative solves stop at a relative
