@@ -50,7 +50,8 @@ def jump_rows(self, i):
 
 
 def compliance(self, blocks, B):
-    A = (self.K_ff + coo_block(self.c_dofs, blocks, self.free.size)).tocsc()
+    K_c = coo_block(self.c_dofs, blocks, self.free.size, self.p.contact.kernels)
+    A = (self.K_ff + K_c).tocsc()
     return B @ spla.splu(A).solve(B.T.copy())
 
 

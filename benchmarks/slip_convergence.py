@@ -134,8 +134,9 @@ def q4_rectangle_stiffness(hx, hy, D):
 
 
 def use_element(element: str) -> None:
-    if element == "q4":
-        kernels.rectangle_stiffness = q4_rectangle_stiffness
+    if element == "q4":  # in both backends: the case may choose either
+        for backend in ("numba", "numpy"):
+            kernels.backend(backend).rectangle_stiffness = q4_rectangle_stiffness
 
 
 def pct(x):
@@ -227,6 +228,7 @@ def study_box(hs, element, half):
 
 def study_exact(aohs):
     from xfemslip.verify import problems as V
+
     prob = next(p for p in V.PROBLEMS if p.name == "inclined-30")
     print("| radius | " + " | ".join(f"a/{n}" for n in aohs) + " |")
     print("| --- | " + " | ".join("---" for _ in aohs) + " |")

@@ -574,7 +574,7 @@ class NewtonSolver:
         # of the padded blocks less, memory.NEWTON_BLOCKS)
         blocks = stick.blocks
         np.copyto(blocks, res.blocks, where=~mask[:, None, None])
-        K = self.K_ff + coo_block(self.c_dofs, blocks, self.free.size)
+        K = self.K_ff + coo_block(self.c_dofs, blocks, self.free.size, c.kernels)
         branches = local_branches.search(c, self.c_dofs, K, u[self.free], res, r, idx)
         if branches is None:
             logger.info("local branch search: no consistent stick/slip set")
@@ -699,7 +699,7 @@ class NewtonSolver:
                 )
 
     def _solve(self, res, r, k, it, eta):
-        Kc = coo_block(self.c_dofs, res.blocks, self.free.size)
+        Kc = coo_block(self.c_dofs, res.blocks, self.free.size, res.contact.kernels)
         try:
             du = self.linear.solve(Kc, r)
         except RuntimeError as exc:  # "Factor is exactly singular"

@@ -64,7 +64,7 @@ def _load_stage(spec):
     fractures = build_fractures(mesh, spec.fractures, box)
     cand = find_candidates(mesh, fractures)
     ec = build_enriched_cells(mesh, fractures, cand)
-    bulk = assemble_bulk(mesh, D, cand, ec)
+    bulk = assemble_bulk(mesh, D, cand, ec, backend="numba")
     F = traction_load(
         mesh, spec.boundary, spec.loading, ec, cand, bulk.dofmap, fractures
     )
