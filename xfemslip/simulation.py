@@ -36,7 +36,7 @@ from xfemslip.fem.poro import (
     make_contact_effective,
 )
 from xfemslip.fem.quadrature import InterfacePoints, interface_points
-from xfemslip.geometry.fracture import build_fractures
+from xfemslip.geometry.junctions import build_fractures
 from xfemslip.io.results import run_folder, write_results
 from xfemslip.memory import check_memory, enriched_footprint, model_footprint
 from xfemslip.post.fields import first_non_finite, step_fields, vis_mesh

@@ -12,7 +12,8 @@ from xfemslip.fem.enrichment import (
     find_candidates,
 )
 from xfemslip.fem.mesh import build_mesh
-from xfemslip.geometry.fracture import GEOMETRY_TOL, build_fractures
+from xfemslip.geometry.fracture import GEOMETRY_TOL
+from xfemslip.geometry.junctions import build_fractures
 
 
 def _network(n=24):
