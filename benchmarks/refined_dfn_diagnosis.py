@@ -21,6 +21,7 @@ import numpy as np
 import scipy.sparse.linalg as spla
 
 from xfemslip.solve import newton as S
+from xfemslip.solve import remedies
 from xfemslip.fem.assembly import coo_block
 from xfemslip.case import load_case
 from xfemslip.conventions import SLIP
@@ -127,7 +128,7 @@ def ls(self, u, du, lam, eta0, pt_prev, gt_prev, law=None):
         trial = u.copy()
         trial[self.free] -= du
         r1 = law_.evaluate(trial, self.mode, pt_prev, gt_prev)
-        ch = np.nonzero(S._regime(r0.state, r0.pt) != S._regime(r1.state, r1.pt))[0]
+        ch = np.nonzero(remedies.regimes(r0.state, r0.pt) != remedies.regimes(r1.state, r1.pt))[0]
         print(
             f"line search raised eta {eta0:.3e} -> {out[3]:.3e}; patches "
             f"reversed by the full step: {list(ch)}",
