@@ -382,7 +382,7 @@ def _jump_operators(mesh, fractures, ip, ec, cand, dofmap):
     Every enrichment of the point's cell enters with its jump across the
     point's fracture, [[F]] N_a = (F(x+) - F(x-)) N_a, F evaluated with the
     sides of x+/- = x +/- eps n: the own Heaviside gives 2 R N_a (eq. 14), the
-    own B1 gives 2 sqrt(r) (n_d . n) N_a (branch.b1_jump), B2..B4 nothing; a
+    own B1 gives 2 sqrt(r) (n_d . n) N_a (xfemslip.fem.branch), B2..B4 nothing; a
     junction function of another fracture (Daux et al. 2000) jumps across
     this fracture next to the junction and is continuous elsewhere.
     """

@@ -51,18 +51,6 @@ class Cut:
     far: float  # value of J beyond the line (0 at T and X; outer side at V)
 
 
-@dataclass(frozen=True)
-class Junction:
-    """Where two fractures meet (positions in the fracture list)."""
-
-    kind: str  # "X" (both continue), "T" (secondary ends on main), "V" (shared end)
-    point: np.ndarray  # (2,) [m]
-    main: int
-    secondary: int
-    s_main: float  # arc length of the junction on the main [m]
-    s_secondary: float  # arc length of the junction on the secondary [m]
-
-
 def _check_fractures_per_cell(mesh, polylines, names, tol) -> None:
     """Refuse more than MAX_FRACTURES_PER_CELL fractures in one cell
     (GeometryError naming the cell and the first fractures in it)."""

@@ -479,7 +479,6 @@ class NewtonSolver:
             if self.mode == TANGENT_SECANT and not eta < eta_before:
                 # the secant direction is no descent direction (it drops the
                 # n-t coupling of the slip law): one consistent iteration
-                log.fallbacks += 1
                 logger.info(
                     "step %d/%d iteration %d: the secant tangent gave no descent; "
                     "the next iteration uses the consistent tangent",
@@ -684,7 +683,6 @@ class _NewtonLog:
 
     iterations: int = 0
     freezes: int = 0
-    fallbacks: int = 0  # secant iterations replaced by a consistent one
     reversals: int = 0  # Newton steps that held reversing patches in stick
     searches: int = 0  # local branch searches (xfemslip.contact.branches)
     found: int = 0  # of them, those that found a consistent set

@@ -237,3 +237,16 @@ def test_a_small_run_never_imports_numba(tmp_path):
 
     with h5py.File(tmp_path / "out" / "result.h5") as f:
         assert f.attrs["kernels"] == "numpy"
+
+
+def test_both_backends_provide_every_kernel():
+    """A model's backend name gives a namespace with every kernel the package
+    calls (KERNELS); "auto" is a choice (kernels.choose), not a backend."""
+    for name in ("numba", "numpy"):
+        namespace = kernels.backend(name)
+        missing = [
+            k for k in kernels.KERNELS if not callable(getattr(namespace, k, None))
+        ]
+        assert missing == [], (name, missing)
+    with pytest.raises(ValueError, match="unknown kernel backend 'auto'"):
+        kernels.backend("auto")
