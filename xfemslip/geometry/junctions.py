@@ -3,7 +3,10 @@ ends onto nearby fractures, the cuts of each arm's Heaviside, and
 ``build_fractures``, which builds all fractures of a case with them.
 
 The rules are stated above JUNCTION_SNAP_CELLS; the single fracture (its
-clipping, level sets, cell pieces and tips) is in ``fracture``.
+clipping, level sets, cell pieces and tips) is in ``fracture``.  The module
+stays whole (about 650 lines): the snapping is one algorithm whose helpers
+each serve one of those rules, and build_fractures applies its result;
+split, the rules would be stated in one file and enforced in another.
 """
 
 from __future__ import annotations
