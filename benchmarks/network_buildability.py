@@ -68,6 +68,7 @@ from xfemslip.case import loads_case  # noqa: E402
 from xfemslip.errors import CaseError, GeometryError  # noqa: E402
 from xfemslip.fem.mesh import build_mesh  # noqa: E402
 from xfemslip.geometry import fracture as geometry  # noqa: E402
+from xfemslip.geometry import junctions  # noqa: E402
 from xfemslip.geometry.dfn import intersecting_pairs  # noqa: E402
 from xfemslip.simulation import check_geometry  # noqa: E402
 
@@ -120,12 +121,12 @@ def snapped(spec):
     tol = geometry.GEOMETRY_TOL * h
     polylines, free = [], []
     for f in spec.fractures:
-        pts, _ = geometry._clip_to_domain(np.asarray(f.points, float), box, tol, "")
+        pts, _ = geometry.clip_to_domain(np.asarray(f.points, float), box, tol, "")
         polylines.append(pts.copy())
-        free.append([not geometry._on_boundary(p, box, tol) for p in pts[[0, -1]]])
+        free.append([not geometry.on_boundary(p, box, tol) for p in pts[[0, -1]]])
     names = [f"fractures[{f.index}]" for f in spec.fractures]
     drawn = np.array(polylines)
-    found = geometry.find_junctions(polylines, free, names, h, tol)
+    found = junctions.find_junctions(polylines, free, names, h, tol)
     return drawn, np.array(polylines), found, h
 
 

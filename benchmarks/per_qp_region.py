@@ -42,7 +42,7 @@ def former_vs_current(model, runs: int) -> None:
     mesh, ec, D = model.mesh, model.ec, model.D
 
     def former():
-        return kernels.enriched_cell_matrices(
+        return kernels.backend(model.kernels).enriched_cell_matrices(
             np.ascontiguousarray(mesh.bounds[ec.cells]),
             ec.qp_offsets,
             ec.qp_xy,
@@ -55,7 +55,7 @@ def former_vs_current(model, runs: int) -> None:
         )
 
     def current():
-        return _enriched_matrices(mesh, ec, D, None)
+        return _enriched_matrices(mesh, ec, D, None, backend=model.kernels)
 
     a, b = former(), current()
     same = all(np.array_equal(x, y) for x, y in zip(a, b, strict=True))
@@ -90,16 +90,16 @@ def main() -> int:
     cand = find_candidates(mesh, model.fractures)
     rows = {
         "one material (default path)": lambda: assemble_bulk(
-            mesh, model.D, cand, ec, ip
+            mesh, model.D, cand, ec, ip, backend=model.kernels
         ),
         "reservoir, enriched cells by cell": lambda: assemble_bulk(
-            mesh, mats.D, cand, ec, ip, mats.cell
+            mesh, mats.D, cand, ec, ip, mats.cell, backend=model.kernels
         ),
         "reservoir, enriched cells per QP": lambda: assemble_bulk(
-            mesh, mats.D, cand, ec, ip, mats.cell, mats.qp
+            mesh, mats.D, cand, ec, ip, mats.cell, mats.qp, backend=model.kernels
         ),
         "Biot body load (per QP in enriched cells)": lambda: body_load(
-            mesh, model.bulk, model.pore, ec
+            mesh, model.bulk, model.pore, ec, model.kernels
         ),
     }
     if args.default_only:

@@ -25,6 +25,7 @@ from xfemslip.conventions import SLIP
 from xfemslip.fem.assembly import coo_block
 from xfemslip.simulation import build_model, newton_solver
 from xfemslip.solve import newton as S
+from xfemslip.solve import remedies
 
 spec = load_case(sys.argv[1])
 m = build_model(spec)
@@ -50,7 +51,8 @@ def jump_rows(self, i):
 
 
 def compliance(self, blocks, B):
-    A = (self.K_ff + coo_block(self.c_dofs, blocks, self.free.size)).tocsc()
+    K_c = coo_block(self.c_dofs, blocks, self.free.size, self.p.contact.kernels)
+    A = (self.K_ff + K_c).tocsc()
     return B @ spla.splu(A).solve(B.T.copy())
 
 
@@ -126,7 +128,9 @@ def ls(self, u, du, lam, eta0, pt_prev, gt_prev, law=None):
         trial = u.copy()
         trial[self.free] -= du
         r1 = law_.evaluate(trial, self.mode, pt_prev, gt_prev)
-        ch = np.nonzero(S._regime(r0.state, r0.pt) != S._regime(r1.state, r1.pt))[0]
+        ch = np.nonzero(
+            remedies.regimes(r0.state, r0.pt) != remedies.regimes(r1.state, r1.pt)
+        )[0]
         print(
             f"line search raised eta {eta0:.3e} -> {out[3]:.3e}; patches "
             f"reversed by the full step: {list(ch)}",

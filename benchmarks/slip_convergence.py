@@ -134,8 +134,9 @@ def q4_rectangle_stiffness(hx, hy, D):
 
 
 def use_element(element: str) -> None:
-    if element == "q4":
-        kernels.rectangle_stiffness = q4_rectangle_stiffness
+    if element == "q4":  # in both backends: the case may choose either
+        for backend in ("numba", "numpy"):
+            kernels.backend(backend).rectangle_stiffness = q4_rectangle_stiffness
 
 
 def pct(x):

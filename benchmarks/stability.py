@@ -3,7 +3,8 @@
 Writes a table (case, converged, Newton iterations, stick/slip switches,
 load-step cuts / ping-pong freezes, max |slip|, result vs reference) into its
 section of docs/performance.md (between the stability markers, replaced
-in place) and prints it; --no-write only prints.  The case builders and references are tests/support/matrix.py.
+in place) and prints it; --no-write only prints.  The case builders and
+references are tests/support/matrix.py.
 
 Usage (from the project root):  python benchmarks/stability.py [--quick]
 --quick skips the 1-degree angle sweep and the 1000-step runs.

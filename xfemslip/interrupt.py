@@ -117,11 +117,6 @@ def deferring() -> bool:
     return _State.depth > 0
 
 
-def clear() -> None:
-    """Forget a recorded signal (its exception has been reported)."""
-    _State.pending = None
-
-
 @contextlib.contextmanager
 def deferred() -> Iterator[None]:
     """Record SIGINT/SIGTERM instead of raising them inside the block; raise a

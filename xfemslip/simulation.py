@@ -36,7 +36,7 @@ from xfemslip.fem.poro import (
     make_contact_effective,
 )
 from xfemslip.fem.quadrature import InterfacePoints, interface_points
-from xfemslip.geometry.fracture import build_fractures
+from xfemslip.geometry.junctions import build_fractures
 from xfemslip.io.results import run_folder, write_results
 from xfemslip.memory import check_memory, enriched_footprint, model_footprint
 from xfemslip.post.fields import first_non_finite, step_fields, vis_mesh
@@ -59,6 +59,7 @@ class Model:
     ip: InterfacePoints
     contact: ContactSet
     problem: Problem
+    kernels: str  # kernel backend ("numba" | "numpy", kernels.choose)
     materials: Materials | None = None  # per-cell constants ([reservoir])
     pore: PorePressure | None = None  # [pore_pressure]
 
@@ -107,14 +108,20 @@ def build_model(spec) -> Model:
     check_memory(spec, enriched_footprint(spec, mesh, fractures, cand))
     ec = build_enriched_cells(mesh, fractures, cand)
     kernel_backend = kernels.choose(spec.solver.kernels, kernel_work(ec))
-    kernels.use(kernel_backend)
     ip = interface_points(fractures, mesh.h_min)
     materials = build_materials(spec, mesh, ec, fractures)
     if spec.reservoir is None:
-        bulk = assemble_bulk(mesh, D, cand, ec, ip)
+        bulk = assemble_bulk(mesh, D, cand, ec, ip, backend=kernel_backend)
     else:
         bulk = assemble_bulk(
-            mesh, materials.D, cand, ec, ip, materials.cell, materials.qp
+            mesh,
+            materials.D,
+            cand,
+            ec,
+            ip,
+            materials.cell,
+            materials.qp,
+            backend=kernel_backend,
         )
     pore = build_pore_pressure(spec, materials, ec, ip, mesh.h_min)
     contact = build_contact(
@@ -127,8 +134,8 @@ def build_model(spec) -> Model:
         spec.loading.initial_stress,
         mat.E,
         spec.solver.contact_patch,
+        kernels=kernel_backend,
     )
-    contact.kernels = kernel_backend
     with _naming_the_file(spec):
         bc = hold_enriched(dirichlet(mesh, spec.boundary), cand, bulk.dofmap)
     F = traction_load(
@@ -136,7 +143,11 @@ def build_model(spec) -> Model:
     )
     if pore is not None:  # Biot body load and fracture fluid load (xfemslip.fem.poro)
         make_contact_effective(contact, pore)
-        F = F + body_load(mesh, bulk, pore, ec) + fracture_load(contact, ip, pore)
+        F = (
+            F
+            + body_load(mesh, bulk, pore, ec, kernel_backend)
+            + fracture_load(contact, ip, pore)
+        )
     problem = Problem(
         K=bulk.K,
         F_unit=F,
@@ -173,6 +184,7 @@ def build_model(spec) -> Model:
         ip=ip,
         contact=contact,
         problem=problem,
+        kernels=kernel_backend,
         materials=materials,
         pore=pore,
     )
@@ -374,7 +386,7 @@ def collect_result(model: Model, results, *, converged, wall):
         "tangent": spec.solver.tangent,
         "contact_patch_cells": float(spec.solver.contact_patch),
         "n_dofs": int(model.problem.n_dofs),
-        "kernels": model.contact.kernels,
+        "kernels": model.kernels,
         "status_codes": STATE_CODES,
     }
     attrs["run_id"] = run_id(attrs, model.mesh.nodes, model.mesh.cells, fields)

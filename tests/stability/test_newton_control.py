@@ -33,7 +33,8 @@ from tests.support.matrix import (
 )
 from xfemslip.contact.branches import force_branches
 from xfemslip.errors import ConvergenceError
-from xfemslip.solve.newton import _cycling
+from xfemslip.solve import remedies
+from xfemslip.solve.remedies import ping_pong
 
 pytestmark = pytest.mark.verification
 
@@ -123,11 +124,11 @@ def test_exhausted_bisection_says_what_was_tried():
 def test_cycling_detection_and_frozen_law():
     A, B, O_ = STICK, SLIP, 0
     seq = [np.array([A, A, O_, B]), np.array([B, A, A, B])] * 3
-    mask = _cycling(seq)
+    mask = ping_pong(seq)
     assert mask.tolist() == [True, False, False, False]
-    assert _cycling(seq[1:]) is None  # five iterates: not yet three periods
+    assert ping_pong(seq[1:]) is None  # five iterates: not yet three periods
     # open <-> closed is left to the normal law (never frozen)
-    assert _cycling([np.array([A]), np.array([O_])] * 3) is None
+    assert ping_pong([np.array([A]), np.array([O_])] * 3) is None
 
 
 def test_frozen_points_stick_but_may_open():
@@ -161,11 +162,11 @@ def test_ping_pong_remedy_accepts_only_the_true_law(monkeypatch):
     true Coulomb law (measured on 20 x 20: 1 freeze, 3 iterations against 2).
     With the default (three periods) no case of the stress matrix froze."""
     text = reservoir_text(n=20, angle=45.0, friction=0.1)
-    monkeypatch.setattr(solver_module, "PINGPONG_PERIODS", 1)
+    monkeypatch.setattr(remedies, "PINGPONG_PERIODS", 1)
     # without the stick/slip predictor, which lands on the slip set in one
     # solve and so leaves nothing to freeze
     frozen = solve(text, RESERVOIR, predictor=False)
-    monkeypatch.setattr(solver_module, "PINGPONG_MAX_FREEZES", 0)
+    monkeypatch.setattr(remedies, "PINGPONG_MAX_FREEZES", 0)
     free = solve(text, RESERVOIR, predictor=False)
     assert frozen.converged and free.converged
     assert frozen.freezes >= 1 and free.freezes == 0

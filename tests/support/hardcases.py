@@ -175,7 +175,7 @@ def estimates(path) -> list[float]:
     from xfemslip.case import load_case
     from xfemslip.fem.enrichment import find_candidates
     from xfemslip.fem.mesh import build_mesh
-    from xfemslip.geometry.fracture import build_fractures
+    from xfemslip.geometry.junctions import build_fractures
     from xfemslip.simulation import build_model
 
     spec = load_case(path)

@@ -183,7 +183,7 @@ def _initial_stress_force(model, stress):
     rows = np.arange(ec.cells.size)
     cell_of_qp = np.repeat(rows, np.diff(ec.qp_offsets))
     area = np.bincount(cell_of_qp, weights=ec.qp_w, minlength=rows.size)
-    Bbar = enriched_part_bbar(mesh, ec, rows, ec.qp_w)  # (nc, 3, 8 + 2S)
+    Bbar = enriched_part_bbar(mesh, ec, rows, ec.qp_w, model.kernels)  # (nc, 3, 8+2S)
     fe = area[:, None] * (sxx * Bbar[:, 0] + syy * Bbar[:, 1] + sxy * Bbar[:, 2])
     dofs = bulk.enr_dofs
     keep = dofs >= 0

@@ -328,7 +328,7 @@ def test_random_network_with_crossings_converges_with_friction_everywhere():
     2 f |p_N| / k_T; the Newton step used to jump over it back and forth
     (this realization failed even after 5 load-step cuts).  Patches whose
     slip the step reverses are held in stick until convergence
-    (NewtonSolver._reversals).  Measured: 4 iterations (1 hold) with the
+    (remedies.slip_reversals).  Measured: 4 iterations (1 hold) with the
     stick/slip predictor, 9 (4 holds, the per-patch limit reached) without.
     Independent check: the two Newton paths reach the same answer, the
     discrete problem having one solution here (slip to 1e-9 of its maximum,

@@ -112,8 +112,8 @@ class ContactSet:
     state_committed: np.ndarray = field(default=None)  # (m,) int8
     gt_committed: np.ndarray = field(default=None)
     pt_committed: np.ndarray = field(default=None)
-    # kernel backend of the model ("numba" | "numpy"; None: the active one)
-    kernels: str | None = None
+    # kernel backend of the model ("numba" | "numpy", kernels.choose)
+    kernels: str = field(kw_only=True)
 
     @property
     def n(self) -> int:
@@ -176,7 +176,7 @@ class ContactSet:
         )
 
     def tangent_matrix(self, result: ContactResult):
-        return coo_block(self.dofs, result.blocks, self.n_dofs)
+        return coo_block(self.dofs, result.blocks, self.n_dofs, self.kernels)
 
     def in_situ_force(self, zero: ContactResult) -> np.ndarray:
         """Contact force (n_dofs,) [N/m] of the in-situ traction sigma0 . n
@@ -382,7 +382,7 @@ def _jump_operators(mesh, fractures, ip, ec, cand, dofmap):
     Every enrichment of the point's cell enters with its jump across the
     point's fracture, [[F]] N_a = (F(x+) - F(x-)) N_a, F evaluated with the
     sides of x+/- = x +/- eps n: the own Heaviside gives 2 R N_a (eq. 14), the
-    own B1 gives 2 sqrt(r) (n_d . n) N_a (branch.b1_jump), B2..B4 nothing; a
+    own B1 gives 2 sqrt(r) (n_d . n) N_a (xfemslip.fem.branch), B2..B4 nothing; a
     junction function of another fracture (Daux et al. 2000) jumps across
     this fracture next to the junction and is continuous elsewhere.
     """
@@ -432,7 +432,17 @@ def _or_nan(value):
 
 
 def build_contact(
-    mesh, fractures, ip, ec, cand, dofmap, initial_stress, E=None, patch_cells=None
+    mesh,
+    fractures,
+    ip,
+    ec,
+    cand,
+    dofmap,
+    initial_stress,
+    E=None,
+    patch_cells=None,
+    *,
+    kernels: str,
 ) -> ContactSet:
     """Interface operators from the interface points and the enriched cells.
 
@@ -443,6 +453,8 @@ def build_contact(
     kn / kt (AUTO_PENALTY * E / h, h = sqrt of the area of the patch's cells).
     patch_cells : length of a contact patch in local cell sizes (0: pointwise;
     None: CONTACT_PATCH_CELLS).
+    kernels : the model's kernel backend ("numba" | "numpy"), which
+    evaluates the contact law.
     """
     coef, dofs = _jump_operators(mesh, fractures, ip, ec, cand, dofmap)
     if patch_cells is None:
@@ -489,6 +501,7 @@ def build_contact(
         point_coef=coef,
         point_normal=np.ascontiguousarray(ip.normal),
         point_tangent=np.ascontiguousarray(ip.tangent),
+        kernels=kernels,
         **par,
     )
     cs.slip_committed = slip0

@@ -41,10 +41,11 @@ def std_cell_dofs(cells: np.ndarray) -> np.ndarray:
     return np.stack([2 * cells, 2 * cells + 1], axis=2).reshape(cells.shape[0], 8)
 
 
-def _rect_stiffness_shared(hx, hy, D, material=None):
+def _rect_stiffness_shared(hx, hy, D, material, backend):
     """Stiffness (m, 8, 8) computed once per distinct (rectangle size, material).
 
-    D : (3, 3), or (k, 3, 3) with ``material`` (m,) the index of each cell's D.
+    D : (3, 3), or (k, 3, 3) with ``material`` (m,) the index of each cell's D
+    (None: D[0] everywhere); backend : the model's kernel backend.
     """
     D = np.asarray(D, float).reshape(-1, 3, 3)
     if material is None:
@@ -55,7 +56,7 @@ def _rect_stiffness_shared(hx, hy, D, material=None):
     for k in range(D.shape[0]):
         rows = np.nonzero(uniq[:, 2] == k)[0]
         if rows.size:
-            K_u[rows] = kernels.rectangle_stiffness(
+            K_u[rows] = kernels.backend(backend).rectangle_stiffness(
                 np.ascontiguousarray(uniq[rows, 0]),
                 np.ascontiguousarray(uniq[rows, 1]),
                 np.ascontiguousarray(D[k]),
@@ -63,7 +64,7 @@ def _rect_stiffness_shared(hx, hy, D, material=None):
     return K_u, inverse.ravel()
 
 
-def _part_matrices(mesh, ec, rows, qp_w, D):
+def _part_matrices(mesh, ec, rows, qp_w, D, backend):
     """K_e, Bbar of the enriched cells ``rows`` (indices into ec.cells; None =
     all) integrated with the weights qp_w (nq,) [m^2] in place of ec.qp_w (0
     on the QPs left out; every row keeps some weight)."""
@@ -79,7 +80,7 @@ def _part_matrices(mesh, ec, rows, qp_w, D):
             ec.slot_node[rows],
             ec.slot_fnode[rows],
         )
-    return kernels.enriched_cell_matrices(
+    return kernels.backend(backend).enriched_cell_matrices(
         np.ascontiguousarray(mesh.bounds[cells]),
         off,
         np.ascontiguousarray(ec.qp_xy[idx]),
@@ -92,15 +93,15 @@ def _part_matrices(mesh, ec, rows, qp_w, D):
     )
 
 
-def enriched_part_bbar(mesh, ec, rows, qp_w) -> np.ndarray:
+def enriched_part_bbar(mesh, ec, rows, qp_w, backend) -> np.ndarray:
     """(len(rows), 3, 8+2S) average strain operator [1/m] of the enriched cells
     ``rows`` over the QPs with weight qp_w > 0 (xfemslip.fem.poro's Biot load)."""
     if len(rows) == 0:
         return np.zeros((0, 3, 8 + 2 * ec.slot_node.shape[1]))
-    return _part_matrices(mesh, ec, rows, qp_w, np.eye(3))[1]
+    return _part_matrices(mesh, ec, rows, qp_w, np.eye(3), backend)[1]
 
 
-def _enriched_matrices(mesh, ec, D, material, qp_material=None):
+def _enriched_matrices(mesh, ec, D, material, qp_material=None, *, backend):
     """K_e, Bbar of the enriched cells, each with its own material's D.
 
     material : (nc,) material index of each cell, or None (D[0] everywhere);
@@ -112,20 +113,20 @@ def _enriched_matrices(mesh, ec, D, material, qp_material=None):
     """
     D = np.asarray(D, float).reshape(-1, 3, 3)
     if qp_material is not None:
-        K, Bbar = _part_matrices(mesh, ec, None, ec.qp_w, D[0])
+        K, Bbar = _part_matrices(mesh, ec, None, ec.qp_w, D[0], backend)
         cell_of_qp = np.repeat(np.arange(ec.cells.size), np.diff(ec.qp_offsets))
         for k in range(1, D.shape[0]):
             rows = np.unique(cell_of_qp[qp_material == k])
             if rows.size:
                 w = np.where(qp_material == k, ec.qp_w, 0.0)
-                K[rows] += _part_matrices(mesh, ec, rows, w, D[k] - D[0])[0]
+                K[rows] += _part_matrices(mesh, ec, rows, w, D[k] - D[0], backend)[0]
         return K, Bbar
     out = None
     for k in range(D.shape[0]):
         mine = np.ones(ec.cells.size, bool) if material is None else material == k
         if not mine.any():
             continue
-        K_k, B_k = _part_matrices(mesh, ec, None, ec.qp_w, D[k])
+        K_k, B_k = _part_matrices(mesh, ec, None, ec.qp_w, D[k], backend)
         if out is None:
             out = (K_k, B_k)
         else:
@@ -141,12 +142,15 @@ def assemble_bulk(
     ip=None,
     cell_material=None,
     qp_material=None,
+    *,
+    backend: str,
 ) -> BulkSystem:
     """Assemble the bulk stiffness and choose the kept enrichments (sliver rule).
 
     D : (3, 3) [Pa] for one material, or (k, 3, 3) with ``cell_material``
     (n_cells,) int64 the material index of every cell (xfemslip.fem.poro) and,
     optionally, ``qp_material`` (nq,) int64 that of every enriched-cell QP.
+    backend : the model's kernel backend ("numba" | "numpy", kernels.choose).
     """
     is_enr = np.zeros(mesh.n_cells, bool)
     is_enr[ec.cells] = True
@@ -154,7 +158,7 @@ def assemble_bulk(
     b = mesh.bounds[std_cells]
     mat_std = None if cell_material is None else cell_material[std_cells]
     K_u, which = _rect_stiffness_shared(
-        b[:, 1] - b[:, 0], b[:, 3] - b[:, 2], D, mat_std
+        b[:, 1] - b[:, 0], b[:, 3] - b[:, 2], D, mat_std, backend
     )
     std_dofs = std_cell_dofs(mesh.cells[std_cells])
 
@@ -165,6 +169,7 @@ def assemble_bulk(
             D,
             None if cell_material is None else cell_material[ec.cells],
             qp_material,
+            backend=backend,
         )
     else:
         K_e = np.zeros((0, 8, 8))
@@ -190,7 +195,7 @@ def assemble_bulk(
     # standard cells (every dof >= 0), then the enriched cells' entries
     # without their empty slots (kernels.block_triplets: same order as
     # expanding the padded blocks and masking, so the same CSR to the bit)
-    enr_rows, enr_cols, enr_vals = _triplets(enr_dofs, K_e)
+    enr_rows, enr_cols, enr_vals = _triplets(enr_dofs, K_e, backend)
     rows = [np.repeat(std_dofs, 8, axis=1).ravel(), enr_rows]
     cols = [np.tile(std_dofs, (1, 8)).ravel(), enr_cols]
     vals = [K_u[which].ravel(), enr_vals]
@@ -214,18 +219,21 @@ def assemble_bulk(
     )
 
 
-def _triplets(dofs, blocks):
+def _triplets(dofs, blocks, backend):
     """Rows, columns and values of the entries of per-item blocks (m, k, k)
     whose dofs (m, k) are both >= 0 (kernels.block_triplets)."""
-    return kernels.block_triplets(
+    return kernels.backend(backend).block_triplets(
         np.ascontiguousarray(dofs, dtype=np.int64),
         np.ascontiguousarray(blocks, dtype=np.float64),
     )
 
 
-def coo_block(dofs: np.ndarray, blocks: np.ndarray, n: int) -> sp.csr_matrix:
-    """Sum of per-item blocks (m, k, k) on dofs (m, k) (-1 ignored) as CSR (n, n)."""
-    r, c, v = _triplets(dofs, blocks)
+def coo_block(
+    dofs: np.ndarray, blocks: np.ndarray, n: int, backend: str
+) -> sp.csr_matrix:
+    """Sum of per-item blocks (m, k, k) on dofs (m, k) (-1 ignored) as CSR (n, n),
+    gathered by the kernel ``backend``."""
+    r, c, v = _triplets(dofs, blocks, backend)
     return sp.coo_matrix((v, (r, c)), shape=(n, n)).tocsr()
 
 

@@ -59,9 +59,3 @@ def branch_functions(tip, pts, side=None, tol=0.0):
     nd = np.array([-d[1], d[0]])
     grad = (gx[..., None] * d + gy[..., None] * nd) * scale
     return F, grad
-
-
-def b1_jump(tip, pts):
-    """[[B1]] (+ side minus - side) of the scaled B1 at points on the fracture."""
-    r = np.linalg.norm(np.atleast_2d(pts) - tip.point, axis=1)
-    return 2.0 * np.sqrt(r) * tip.sign / np.sqrt(tip.cell_size)

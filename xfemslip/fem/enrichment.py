@@ -135,18 +135,6 @@ def find_candidates(mesh, fractures) -> Candidates:
     return Candidates(*(np.ascontiguousarray(arr[:, i]) for i in range(4)))
 
 
-def candidate_values(fractures, cand, k, pts, side, tol, probe=None):
-    """F (n,) and grad F (n, 2) of candidate k at points with fracture side (n,).
-
-    probe : (n, 2) points deciding the side of junction lines (default pts).
-    """
-    F, grad = group_values(
-        fractures, cand.fracture[k], cand.tip[k], pts, side, tol, probe
-    )
-    j = 0 if cand.func[k] == HEAVISIDE else cand.func[k] - 1
-    return F[:, j], grad[:, j]
-
-
 def group_values(fractures, fi, tip, pts, side, tol, probe=None):
     """All functions of one (fracture, tip) group: (n, 1) Heaviside or (n, 4) branch.
 

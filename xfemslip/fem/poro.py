@@ -282,14 +282,15 @@ def _face_mean(spec, ip, eps) -> np.ndarray:
     return 0.5 * (plus.astype(float) + minus)
 
 
-def body_load(mesh, bulk, pore: PorePressure, ec) -> np.ndarray:
+def body_load(mesh, bulk, pore: PorePressure, ec, backend: str) -> np.ndarray:
     """F_body of eq. (1) at load factor 1, (n_dofs,) [N/m].
 
     Intact rectangle: int dN_a/dx dOmega = x_a hy / 2, int dN_a/dy = y_a hx / 2
     (x_a, y_a = -/+1 the corner signs).  Enriched cell (``ec``, same order as
     ``bulk.enriched_cells``): sum_q w_q B_q^T m alpha dp(x_q) = alpha dp A_c
     Bbar_c^T m, Bbar_c the average strain operator over the part of the cell
-    whose QPs lie where the pressure changes (its area A_c).
+    whose QPs lie where the pressure changes (its area A_c), computed by the
+    model's kernel ``backend``.
     """
     F = np.zeros(bulk.dofmap.n_dofs)
     q = pore.biot * pore.change * pore.cell_changes  # (n_cells,) [Pa]
@@ -308,7 +309,7 @@ def body_load(mesh, bulk, pore: PorePressure, ec) -> np.ndarray:
         cell_of_qp = np.repeat(np.arange(ec.cells.size), np.diff(ec.qp_offsets))
         area = np.bincount(cell_of_qp, weights=w, minlength=ec.cells.size)
         rows = np.nonzero(area > 0.0)[0]
-        Bbar = enriched_part_bbar(mesh, ec, rows, w)
+        Bbar = enriched_part_bbar(mesh, ec, rows, w, backend)
         # Bbar^T m = rows exx + eyy of the average operator
         fe = (pore.biot * pore.change * area[rows])[:, None] * (Bbar[:, 0] + Bbar[:, 1])
         dofs = bulk.enr_dofs[rows]

@@ -2,8 +2,11 @@
 
 Modules:
 
-- ``fracture``: Fracture (polylines clipped to the domain), level sets, cell
-  pieces, tips and junctions; ``build_fractures``;
+- ``fracture``: one Fracture (a polyline clipped to the domain and brought
+  to the mesh's resolution), level sets, cell pieces, tips; ``build_fracture``;
+- ``junctions``: where fractures meet (X, T/Y, V), the snapping of ends onto
+  nearby fractures, the cuts of each arm's Heaviside; ``build_fractures``,
+  all fractures of a case;
 - ``polyline``: polyline simplification and the first self-meeting of a
   polyline or polygon;
 - ``regions``: reservoir regions (boxes or a polygon) and which cells they
@@ -14,4 +17,4 @@ Modules:
 The subpackage imports nothing itself: import the module you need (``from
 xfemslip.geometry.fracture import ...``)."""
 
-__all__ = ["dfn", "fracture", "polyline", "regions"]
+__all__ = ["dfn", "fracture", "junctions", "polyline", "regions"]

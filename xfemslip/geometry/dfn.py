@@ -167,15 +167,6 @@ def power_law_ppf(u: np.ndarray, exponent: float, lmin: float, lmax: float):
     return (lmin**a + u * (lmax**a - lmin**a)) ** (1.0 / a)
 
 
-def power_law_cdf(x, exponent: float, lmin: float, lmax: float):
-    """CDF of pdf ~ l^-exponent on [lmin, lmax] (for tests and docs)."""
-    x = np.clip(np.asarray(x, dtype=float), lmin, lmax)
-    a = 1.0 - exponent
-    if abs(a) < 1e-12:
-        return np.log(x / lmin) / math.log(lmax / lmin)
-    return (x**a - lmin**a) / (lmax**a - lmin**a)
-
-
 def sample_lengths(rng: np.random.Generator, law: LengthLaw, n: int) -> np.ndarray:
     """(n,) lengths [m] drawn from ``law``."""
     if law.kind == "constant":

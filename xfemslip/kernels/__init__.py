@@ -9,9 +9,10 @@
   compilation of the first run after install).
 
 ``choose`` picks one per model from the work it has to do (``[solver]
-kernels = "auto"``); ``use`` makes it the backend of the module-level names
-(``kernels.contact_response(...)``), which resolve on every access, so
-importing this package imports neither backend.
+kernels = "auto"``); the model keeps the name and passes it to every caller
+of a kernel, which calls ``backend(name).contact_response(...)``.  There is
+no process-wide backend: two models in one process may use different ones.
+Importing this package imports neither backend.
 """
 
 from __future__ import annotations
@@ -45,30 +46,16 @@ AUTO_NUMPY_MAX_WORK = 2.5e8
 # XFEMSLIP_KERNELS=numba|numpy overrides "auto" (the test suite runs both).
 ENV_OVERRIDE = "XFEMSLIP_KERNELS"
 
-_active = "numba"
 # each backend's namespace, imported on first use
 _MODULES = {"numba": "xfemslip.kernels.jit", "numpy": "xfemslip.kernels.vectorized"}
 
 
-def backend(name: str | None = None):
-    """The kernel namespace of backend ``name`` (None: the active one)."""
-    name = _active if name is None else name
+def backend(name: str):
+    """The kernel namespace of backend ``name`` ("numba" | "numpy"): a module
+    with the functions named in KERNELS."""
     if name not in _MODULES:
         raise ValueError(f"unknown kernel backend {name!r}; expected numba or numpy")
     return importlib.import_module(_MODULES[name])
-
-
-def active() -> str:
-    return _active
-
-
-def use(name: str) -> str:
-    """Make ``name`` ("numba" | "numpy") the backend of the module-level
-    kernel names; returns the previous one."""
-    global _active
-    backend(name)  # validates
-    previous, _active = _active, name
-    return previous
 
 
 def choose(requested: str, work: float) -> str:
@@ -84,18 +71,9 @@ def choose(requested: str, work: float) -> str:
     return "numpy" if work <= AUTO_NUMPY_MAX_WORK else "numba"
 
 
-def __getattr__(name):
-    if name in KERNELS:
-        return getattr(backend(), name)
-    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
-
-
 __all__ = [
     "BACKENDS",
-    "active",
     "backend",
     "choose",
     "numba_settings",
-    "use",
-    *KERNELS,
 ]

@@ -8,7 +8,6 @@ sign tests and max(0, .).
 import os
 
 NUMBA_CACHE = os.environ.get("XFEMSLIP_NUMBA_CACHE", "1") != "0"
-NUMBA_FASTMATH = False
 
 # |Delta g_T| below this (m) has no usable secant; the elastic k_T is used
 # (both backends).

@@ -386,7 +386,15 @@ class LinearSolver:
         modes); without it "auto" means "superlu".
     """
 
-    def __init__(self, K_ff, method="auto", free=None, node_xy=None, contact_dofs=None):
+    def __init__(
+        self,
+        K_ff,
+        method="auto",
+        free=None,
+        node_xy=None,
+        contact_dofs=None,
+        kernels="numpy",
+    ):
         if method not in LINEAR_SOLVERS:
             raise ValueError(f"linear solver must be one of {LINEAR_SOLVERS}")
         self.K = sp.csr_matrix(K_ff)
@@ -398,6 +406,8 @@ class LinearSolver:
         self.contact_dofs = (
             np.zeros((0, 0), np.int64) if contact_dofs is None else contact_dofs
         )
+        # the kernel backend that gathers the contact blocks (the model's)
+        self.kernels = kernels
         self.facts = {"n_free": n}
         if method == "auto" and node_xy is not None and n >= AUTO_AMG_MIN_DOFS:
             if not (n >= AUTO_PARDISO_MIN_DOFS and pardiso.available()):
@@ -494,7 +504,7 @@ class LinearSolver:
                 return x
         Kc = None
         if blocks is not None and np.size(blocks):
-            Kc = coo_block(self.contact_dofs, blocks, self.K.shape[0])
+            Kc = coo_block(self.contact_dofs, blocks, self.K.shape[0], self.kernels)
         return self.solve(Kc, r)
 
     def _make_pardiso(self, rows, cols, key):

@@ -19,6 +19,15 @@ consistent tangent the first solve of a step uses a predicted stick/slip set
 solve, when it is wrong Newton goes on from there under the true law.  The linear
 systems go to xfemslip.solve.linear (SuperLU with the factorization kept, or
 AMG-preconditioned GMRES), which handles the non-symmetric case.
+
+The remedies for a stick/slip set that does not settle (ping-pong freezes,
+slip-reversal holds, the local branch search) are in xfemslip.solve.remedies.
+What stays here, about 700 lines, is one piece: NewtonSolver's load
+stepping with bisection, the Newton loop that applies the remedies and
+restores the true law, the line search and the failure messages share the
+solver's state (free dofs, reduced stiffness, committed history, linear
+solver) from one iteration to the next; cut apart they would pass that
+state back and forth without making either half readable on its own.
 """
 
 from __future__ import annotations
@@ -33,21 +42,19 @@ import numpy as np
 import scipy.sparse as sp
 
 from xfemslip.case.specs import AUTO_PENALTY
-from xfemslip.contact import branches as local_branches
 from xfemslip.contact.branches import force_branches
 from xfemslip.contact.interface import ContactResult, ContactSet
 from xfemslip.contact.predictor import predict_state, predicted_law
 from xfemslip.conventions import (
     OPEN,
     SLIP,
-    SLIP_BACKWARD,
     STICK,
     TANGENT_CONSISTENT,
     TANGENT_SECANT,
     TANGENTS,
 )
 from xfemslip.errors import ConvergenceError
-from xfemslip.fem.assembly import coo_block
+from xfemslip.solve import remedies
 from xfemslip.solve.linear import LinearSolver
 
 logger = logging.getLogger(__name__)
@@ -63,29 +70,6 @@ PENALTY_RATIO_HIGH = 1.0e5
 PENALTY_RATIO_MEASURED = 1.0e6
 # Step halvings tried by the line search before keeping the best trial.
 LINE_SEARCH_CUTS = 6
-# Ping-pong remedy: a contact point whose branch of the law (stick, slip +t,
-# slip -t) alternates A, B, A, B, A, B over six successive iterates is
-# cycling.  It is then frozen in STICK (force_branches) until Newton
-# converges; the true law is then restored and Newton continues from there,
-# so an accepted step always satisfies the true law.  At most
-# PINGPONG_MAX_FREEZES freezes per attempt; after that the attempt fails and
-# the load step is bisected.
-PINGPONG_MAX_FREEZES = 2
-# Periods A, B of the alternation that count as cycling (3: six iterates).
-PINGPONG_PERIODS = 3
-# Slip-reversal remedy (NewtonSolver._reversals): times a patch may be held
-# in stick within one Newton solve.  Once (a patch that reverses again after
-# the release is let through) left 5 of the 20 allow-DFN seeds failing with
-# the predictor on; without a limit a patch can be held and released
-# forever (seed 1, predictor off); 2 and 3 converge on all 20 seeds both
-# ways (benchmarks/RESULTS.md, "Newton on fracture networks").
-REVERSAL_HOLDS = 2
-# Local branch searches (xfemslip.contact.branches) per Newton solve: a patch
-# that reverses its slip again after REVERSAL_HOLDS holds has no consistent
-# branch while its neighbours keep theirs (refined DFN realizations:
-# docs/performance.md, "Fracture networks", refined meshes); the
-# stick/slip set of it and its neighbours is then searched.
-LOCAL_SEARCHES = 2
 # Load-step bisection: a load step that does not converge is cut in halves, at
 # most this many times by default ([solver] max_step_cuts), so the smallest
 # sub-step is 1/2**5 = 1/32 of the step.  Every converged sub-step commits the
@@ -132,18 +116,11 @@ class StepResult:
     # sub-steps whose first Newton solve used the predicted stick/slip set
     predicted: int = 0
     # Newton steps re-solved with slip-reversing patches held in stick (each
-    # one extra linear solve; NewtonSolver._reversals), all sub-steps
+    # one extra linear solve; remedies.slip_reversals), all sub-steps
     reversals: int = 0
     # local branch searches that found a consistent stick/slip set for a
     # patch reversing after its holds and its neighbours (all sub-steps)
     searches: int = 0
-
-
-def _regime(state, pt):
-    """Branch of the contact law at each point: open, stick, slip forward (+t),
-    slip backward.  A switch between any two changes the tangent, so it is what
-    the log and the ConvergenceError count as a stick/slip switch."""
-    return np.where(state == SLIP, np.where(pt >= 0.0, SLIP, SLIP_BACKWARD), state)
 
 
 class NewtonSolver:
@@ -180,7 +157,12 @@ class NewtonSolver:
         c = problem.contact
         self.c_dofs = np.where(c.dofs >= 0, self.reduced[np.maximum(c.dofs, 0)], -1)
         self.linear = LinearSolver(
-            self.K_ff, linear_solver, self.free, problem.node_xy, self.c_dofs
+            self.K_ff,
+            linear_solver,
+            self.free,
+            problem.node_xy,
+            self.c_dofs,
+            kernels=c.kernels,
         )
         # tangent blocks of the contact evaluations whose tangent is never
         # used (_scratch_blocks)
@@ -371,17 +353,17 @@ class NewtonSolver:
         u = u.copy()
         u[self.p.fixed] = lam * self.p.fixed_values
         pt_prev, gt_prev = c.pt_committed.copy(), c.gt_committed.copy()
-        prev_regime = _regime(c.state_committed, c.pt_committed)
+        prev_regime = remedies.regimes(c.state_committed, c.pt_committed)
         log = _NewtonLog()
         history = []  # regimes of the iterates under the current law
         law = c  # the contact law evaluated: c, or c with frozen points
         frozen = None
-        held = np.zeros(c.n, np.int64)  # times each patch was held (_reversals)
+        held = np.zeros(c.n, np.int64)  # times each patch was held (slip_reversals)
         forced = False  # law forces the branches of a local search
         res = law.evaluate(u, self.mode, pt_prev, gt_prev)
         r, eta = self._residual(u, lam, res)
         for it in range(self.max_it + 1):
-            regime = _regime(res.state, res.pt)
+            regime = remedies.regimes(res.state, res.pt)
             flips = int(np.count_nonzero(regime != prev_regime))
             log.residuals.append(eta)
             log.switches.append(flips)
@@ -415,7 +397,7 @@ class NewtonSolver:
                 law, frozen, forced, history = c, None, False, []
                 res = law.evaluate(u, self.mode, pt_prev, gt_prev)
                 r, eta = self._residual(u, lam, res)
-                regime = _regime(res.state, res.pt)
+                regime = remedies.regimes(res.state, res.pt)
                 history.append(regime)
             if eta <= self.tol:
                 self._check_floating(res, k, it, eta)
@@ -429,8 +411,8 @@ class NewtonSolver:
                 raise self._fail(
                     k, it, eta, flips, self._no_convergence_reason(log.switches)
                 )
-            cycling = _cycling(history)
-            if cycling is not None and log.freezes < PINGPONG_MAX_FREEZES:
+            cycling = remedies.ping_pong(history)
+            if cycling is not None and log.freezes < remedies.PINGPONG_MAX_FREEZES:
                 frozen = cycling if frozen is None else (frozen | cycling)
                 law = force_branches(c, stick_at=frozen)
                 log.freezes += 1
@@ -443,7 +425,7 @@ class NewtonSolver:
                     it,
                     int(cycling.sum()),
                     log.freezes,
-                    PINGPONG_MAX_FREEZES,
+                    remedies.PINGPONG_MAX_FREEZES,
                 )
                 history = []
                 res = law.evaluate(u, self.mode, pt_prev, gt_prev)
@@ -455,16 +437,36 @@ class NewtonSolver:
                 guess = None  # its tangent blocks are not needed any more
             else:
                 du = self._solve(res, r, k, it, eta)
-                flipped, stubborn = self._reversals(
-                    u, du, regime, law, pt_prev, gt_prev, held
+                flipped, stubborn = remedies.slip_reversals(
+                    law,
+                    u,
+                    du,
+                    self.free,
+                    self.mode,
+                    regime,
+                    pt_prev,
+                    gt_prev,
+                    held,
+                    self._scratch_blocks,
                 )
                 if (
                     flipped is None
                     and stubborn is not None
-                    and log.searches < LOCAL_SEARCHES
+                    and log.searches < remedies.LOCAL_SEARCHES
                 ):
                     log.searches += 1
-                    searched = self._local_search(u, res, r, law, stubborn)
+                    searched = remedies.local_search(
+                        c,
+                        law,
+                        u,
+                        res,
+                        r,
+                        stubborn,
+                        self.c_dofs,
+                        self.K_ff,
+                        self.free,
+                        self.mode,
+                    )
                     if searched is not None:
                         law, forced = searched, True
                         log.found += 1
@@ -477,11 +479,11 @@ class NewtonSolver:
                             steps,
                             it,
                             int(stubborn.sum()),
-                            REVERSAL_HOLDS,
+                            remedies.REVERSAL_HOLDS,
                         )
                         res = law.evaluate(u, self.mode, pt_prev, gt_prev)
                         r, eta = self._residual(u, lam, res)
-                        regime = _regime(res.state, res.pt)
+                        regime = remedies.regimes(res.state, res.pt)
                         du = self._solve(res, r, k, it, eta)
                 if flipped is not None:
                     held += flipped
@@ -499,7 +501,7 @@ class NewtonSolver:
                     )
                     res = law.evaluate(u, self.mode, pt_prev, gt_prev)
                     r, eta = self._residual(u, lam, res)
-                    regime = _regime(res.state, res.pt)
+                    regime = remedies.regimes(res.state, res.pt)
                     du = self._solve(res, r, k, it, eta)
             pt_prev, gt_prev, prev_regime = res.pt, res.gt, regime
             eta_before = eta
@@ -507,7 +509,6 @@ class NewtonSolver:
             if self.mode == TANGENT_SECANT and not eta < eta_before:
                 # the secant direction is no descent direction (it drops the
                 # n-t coupling of the slip law): one consistent iteration
-                log.fallbacks += 1
                 logger.info(
                     "step %d/%d iteration %d: the secant tangent gave no descent; "
                     "the next iteration uses the consistent tangent",
@@ -531,7 +532,7 @@ class NewtonSolver:
         res = predicted_law(c, state, sign).evaluate(
             u, self.mode, c.pt_committed, c.gt_committed
         )
-        guess = _regime(res.state, res.pt)
+        guess = remedies.regimes(res.state, res.pt)
         if np.array_equal(guess, regime):
             return None
         logger.info(
@@ -543,86 +544,6 @@ class NewtonSolver:
             int(np.count_nonzero(guess != regime)),
         )
         return res, self._residual(u, lam, res)[0]
-
-    def _reversals(self, u, du, regime, law, pt_prev, gt_prev, held):
-        """Patches whose slip the full Newton step reverses, or None.
-
-        A patch slipping forward at u and backward at u - du (or the other way
-        round) jumps over its stick band, |g_T - g_T^p| <= (c - f p_N) / k_T,
-        which is narrow (about 1e-6 m with stiff penalties) however long the
-        step.  Next to fracture junctions the next step often reverses it
-        back (the slip tangent has no tangential stiffness, d p_T / d g_T = 0,
-        so nothing in the linearization holds the patch), and the line search
-        then only shortens steps that keep cycling.  The continuous path
-        between the two slip branches passes through stick: those patches are
-        held in stick (force_branches) until Newton converges, then the true law
-        is restored and checked, as for ping-pong.  A patch is held at most
-        REVERSAL_HOLDS times per Newton solve (``held``, counts).  Returns
-        (patches to hold, or None; patches that reverse again after their
-        holds, or None): for the latter the stick/slip set of them and their
-        neighbours is searched (_local_search; a patch with no consistent
-        branch of its own, refined DFN meshes); when the search finds nothing,
-        the step is taken.  Consistent tangent only.
-        """
-        if self.mode != TANGENT_CONSISTENT:
-            return None, None
-        trial = u.copy()
-        trial[self.free] -= du
-        res = law.evaluate(
-            trial, self.mode, pt_prev, gt_prev, scratch=self._scratch_blocks()
-        )
-        new = _regime(res.state, res.pt)
-        mask = ((regime == SLIP) & (new == SLIP_BACKWARD)) | (
-            (regime == SLIP_BACKWARD) & (new == SLIP)
-        )
-        stubborn = mask & (held >= REVERSAL_HOLDS)
-        mask &= held < REVERSAL_HOLDS
-        return (mask if mask.any() else None), (stubborn if stubborn.any() else None)
-
-    def _local_search(self, u, res, r, law, stubborn):
-        """The law with the branches of ``stubborn`` and their neighbours
-        forced to a consistent local set (xfemslip.contact.branches), or None
-        when the search finds none or only the current set."""
-        c = self.p.contact
-        near = local_branches.neighbours(self.c_dofs, self.K_ff, stubborn)
-        first = np.nonzero(stubborn)[0]
-        # open neighbours stay out: the search has no open branch, and its
-        # Woodbury form assumes a closed (stick) block for every member
-        rest = np.nonzero(near & ~stubborn & (res.state != OPEN))[0]
-        idx = np.concatenate([first, rest])[: local_branches.MAX_CLUSTER]
-        mask = np.zeros(c.n, bool)
-        mask[idx] = True
-        stick = force_branches(law, stick_at=mask).evaluate(
-            u, self.mode, law.pt_committed, law.gt_committed
-        )
-        # the tangent of res with the cluster's blocks in stick, formed in
-        # the stick evaluation's array (not a copy of res.blocks: one array
-        # of the padded blocks less, memory.NEWTON_BLOCKS)
-        blocks = stick.blocks
-        np.copyto(blocks, res.blocks, where=~mask[:, None, None])
-        K = self.K_ff + coo_block(self.c_dofs, blocks, self.free.size)
-        branches = local_branches.search(c, self.c_dofs, K, u[self.free], res, r, idx)
-        if branches is None:
-            logger.info("local branch search: no consistent stick/slip set")
-            return None
-        now = local_branches.current_branches(res, idx)
-        if np.array_equal(branches, now):
-            return None
-        logger.info(
-            "local branch search over %d patch(es): %d change branch",
-            idx.size,
-            int(np.count_nonzero(branches != now)),
-        )
-        # a patch of the cluster held in stick by a hold gets its own
-        # cohesion back (a forced slip needs the finite bound)
-        base = dataclasses.replace(
-            law, cohesion=np.where(mask, c.cohesion, law.cohesion)
-        )
-        branches = np.asarray(branches)
-        moving = branches != 0
-        return force_branches(
-            base, stick_at=idx[~moving], slip_at=idx[moving], sign=branches[moving]
-        )
 
     def _line_search(self, u, du, lam, eta0, pt_prev, gt_prev, law=None):
         """Backtracking on eta along the Newton direction (Armijo on the norm).
@@ -791,7 +712,6 @@ class _NewtonLog:
 
     iterations: int = 0
     freezes: int = 0
-    fallbacks: int = 0  # secant iterations replaced by a consistent one
     reversals: int = 0  # Newton steps that held reversing patches in stick
     searches: int = 0  # local branch searches (xfemslip.contact.branches)
     found: int = 0  # of them, those that found a consistent set
@@ -808,17 +728,3 @@ def _finite(res: ContactResult) -> bool:
     return all(
         np.all(np.isfinite(a)) for a in (res.force, res.gn, res.gt, res.pn, res.pt)
     )
-
-
-def _cycling(history):
-    """Points whose tangential branch alternated A, B, A, B, ... over the last
-    PINGPONG_PERIODS * 2 iterates (A != B, both closed), or None."""
-    n = 2 * PINGPONG_PERIODS
-    if len(history) < n:
-        return None
-    last = history[-n:]
-    a, b = last[-2], last[-1]
-    mask = (a != b) & (a != OPEN) & (b != OPEN)
-    for i, regime in enumerate(last):
-        mask &= regime == (a if i % 2 == 0 else b)
-    return mask if mask.any() else None

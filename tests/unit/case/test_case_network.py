@@ -327,7 +327,8 @@ def test_allow_network_that_crosses_is_built_with_a_junction_per_crossing(tmp_pa
     independent of the geometry code) becomes a junction of the model."""
     from xfemslip.fem.mesh import build_mesh
     from xfemslip.geometry.dfn import intersecting_pairs
-    from xfemslip.geometry.fracture import GEOMETRY_TOL, find_junctions
+    from xfemslip.geometry.fracture import GEOMETRY_TOL
+    from xfemslip.geometry.junctions import find_junctions
 
     network = GENERATE.replace('intersections = "avoid"', 'intersections = "allow"')
     network = network.replace("count = 5", "count = 40")

@@ -66,7 +66,7 @@ def test_searched_branches_solve_the_cluster_consistently(friction):
     )
     blocks = res.blocks.copy()
     blocks[mask] = stick.blocks[mask]
-    K = solver.K_ff + coo_block(solver.c_dofs, blocks, solver.free.size)
+    K = solver.K_ff + coo_block(solver.c_dofs, blocks, solver.free.size, c.kernels)
     branches = local_branches.search(c, solver.c_dofs, K, u[solver.free], res, r, idx)
     assert branches is not None
     # the far-field load makes the middle of the fault slip (paper, Sec. 4)

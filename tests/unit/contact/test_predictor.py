@@ -156,7 +156,7 @@ def test_unloading_and_reloading():
     the unloading step takes one solve with the guess.  Without it the
     first full step reverses the slip of the patches (forward to backward,
     over the stick band); they are held in stick and the step is solved again
-    (NewtonSolver._reversals: 2 solves; before that remedy the plain iterates
+    (remedies.slip_reversals: 2 solves; before that remedy the plain iterates
     wandered between the sets for 46 iterations)."""
     plain, model = _run(_reservoir(friction=0.2), False, path=[1.0, 0.3, 1.0])
     guess, _ = _run(_reservoir(friction=0.2), True, path=[1.0, 0.3, 1.0])

@@ -20,7 +20,7 @@ from xfemslip.fem.boundary import dirichlet, rigid_body_pins, traction_load
 from xfemslip.fem.enrichment import HEAVISIDE, build_enriched_cells, find_candidates
 from xfemslip.fem.material import elasticity_matrix
 from xfemslip.fem.mesh import build_mesh
-from xfemslip.geometry.fracture import build_fractures
+from xfemslip.geometry.junctions import build_fractures
 from xfemslip.simulation import build_model
 
 N = 8  # 8 x 8 cells on the unit square, h = 0.125
@@ -64,7 +64,7 @@ def _load_stage(spec):
     fractures = build_fractures(mesh, spec.fractures, box)
     cand = find_candidates(mesh, fractures)
     ec = build_enriched_cells(mesh, fractures, cand)
-    bulk = assemble_bulk(mesh, D, cand, ec)
+    bulk = assemble_bulk(mesh, D, cand, ec, backend="numba")
     F = traction_load(
         mesh, spec.boundary, spec.loading, ec, cand, bulk.dofmap, fractures
     )

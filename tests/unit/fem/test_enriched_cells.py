@@ -1,5 +1,5 @@
 """enrichment.build_enriched_cells (group-wise evaluation) against a
-cell-by-cell evaluation of every slot with the public candidate_values."""
+cell-by-cell evaluation of every slot, one candidate at a time."""
 
 from __future__ import annotations
 
@@ -7,12 +7,26 @@ import numpy as np
 
 from tests.support.casegen import fracture_spec
 from xfemslip.fem.enrichment import (
+    HEAVISIDE,
     build_enriched_cells,
-    candidate_values,
     find_candidates,
+    group_values,
 )
 from xfemslip.fem.mesh import build_mesh
-from xfemslip.geometry.fracture import GEOMETRY_TOL, build_fractures
+from xfemslip.geometry.fracture import GEOMETRY_TOL
+from xfemslip.geometry.junctions import build_fractures
+
+
+def candidate_values(fractures, cand, k, pts, side, tol, probe=None):
+    """F (n,) and grad F (n, 2) of candidate k at points with fracture side (n,).
+
+    probe : (n, 2) points deciding the side of junction lines (default pts).
+    """
+    F, grad = group_values(
+        fractures, cand.fracture[k], cand.tip[k], pts, side, tol, probe
+    )
+    j = 0 if cand.func[k] == HEAVISIDE else cand.func[k] - 1
+    return F[:, j], grad[:, j]
 
 
 def _network(n=24):

@@ -142,7 +142,7 @@ def _enriched_diagonal(m):
     """Per candidate: its enriched stiffness diagonal (min over x, y) over the
     diagonal of its node's standard dofs, recomputed from the enriched cells."""
     ec = m.ec
-    K, _ = _enriched_matrices(m.mesh, ec, m.D, None)
+    K, _ = _enriched_matrices(m.mesh, ec, m.D, None, backend=m.kernels)
     cand = find_candidates(m.mesh, m.fractures)
     diag = np.zeros((cand.node.size, 2))
     for e in range(ec.cells.size):

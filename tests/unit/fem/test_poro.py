@@ -149,7 +149,7 @@ def test_body_load_is_self_equilibrated_and_points_inwards():
     """F_body = int B^T m alpha dp: zero resultant, and under depletion the
     forces on the reservoir's top nodes point down, on its bottom nodes up."""
     model = build_model(loads_case(BASE.format(extra=FRACTURE + PORE), "p.toml"))
-    F = body_load(model.mesh, model.bulk, model.pore, model.ec)
+    F = body_load(model.mesh, model.bulk, model.pore, model.ec, model.kernels)
     n_std = 2 * model.mesh.n_nodes
     Fs = F[:n_std].reshape(-1, 2)
     assert abs(Fs[:, 0].sum()) < 1e-6 * np.abs(Fs).max()
@@ -394,7 +394,7 @@ def test_body_load_splits_cut_cells_at_the_fracture(caplog):
     model = build_model(loads_case(SPLIT.format(E=20.0e9), "split.toml"))
     assert "not on a mesh line" not in caplog.text  # the fracture covers the edge
     mesh, pore = model.mesh, model.pore
-    F = body_load(mesh, model.bulk, pore, model.ec)
+    F = body_load(mesh, model.bulk, pore, model.ec, model.kernels)
     q = 0.7 * -20.0e6
     x, y = mesh.x, mesh.y
     ix = np.searchsorted(x, mesh.nodes[:, 0])
@@ -432,7 +432,9 @@ def test_enriched_stiffness_takes_the_material_of_each_quadrature_point():
     model = build_model(loads_case(SPLIT.format(E=5.0e9), "split.toml"))
     ec, mats = model.ec, model.materials
     assert set(np.unique(mats.qp)) == {0, 1}
-    K, _ = _enriched_matrices(model.mesh, ec, mats.D, mats.cell[ec.cells], mats.qp)
+    K, _ = _enriched_matrices(
+        model.mesh, ec, mats.D, mats.cell[ec.cells], mats.qp, backend=model.kernels
+    )
     for e in range(ec.cells.size):
         q0, q1 = ec.qp_offsets[e], ec.qp_offsets[e + 1]
         K_ref = 0.0

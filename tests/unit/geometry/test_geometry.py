@@ -15,7 +15,8 @@ import pytest
 from tests.support.casegen import fracture_spec
 from xfemslip.errors import GeometryError
 from xfemslip.fem.mesh import build_mesh
-from xfemslip.geometry.fracture import build_fracture, build_fractures, clip_segment
+from xfemslip.geometry.fracture import build_fracture, clip_segment
+from xfemslip.geometry.junctions import build_fractures
 
 # 8 x 8 cells on the unit square: h = 0.125 and every node coordinate is exact
 # in binary, so fractures "on a node" or "on an edge" are exactly there.

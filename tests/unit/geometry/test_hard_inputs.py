@@ -18,11 +18,8 @@ from tests.support.hardcases import arc, depletion, measure, polygon, zigzag
 from xfemslip.case import loads_case
 from xfemslip.errors import GeometryError, UsageError
 from xfemslip.fem.mesh import build_mesh
-from xfemslip.geometry.fracture import (
-    MAX_PIECES_PER_CELL,
-    SIMPLIFY_MIN_SEGMENT,
-    build_fractures,
-)
+from xfemslip.geometry.fracture import MAX_PIECES_PER_CELL, SIMPLIFY_MIN_SEGMENT
+from xfemslip.geometry.junctions import build_fractures
 from xfemslip.studies import depletion as depletion_module
 
 # Harness bound of one process; each ran for minutes (or for ever) when it was

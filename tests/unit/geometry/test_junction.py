@@ -18,7 +18,7 @@ from tests.support.casegen import fracture_spec
 from xfemslip.errors import GeometryError
 from xfemslip.fem.enrichment import HEAVISIDE, build_enriched_cells, find_candidates
 from xfemslip.fem.mesh import build_mesh
-from xfemslip.geometry.fracture import JUNCTION_SNAP_CELLS, build_fractures
+from xfemslip.geometry.junctions import JUNCTION_SNAP_CELLS, build_fractures
 
 N_CELLS = 10  # h = 0.1
 H = 1.0 / N_CELLS

@@ -39,12 +39,10 @@ from xfemslip.case import loads_case
 from xfemslip.errors import GeometryError
 from xfemslip.fem.mesh import build_mesh
 from xfemslip.geometry.dfn import intersecting_pairs
-from xfemslip.geometry.fracture import (
-    GEOMETRY_TOL,
+from xfemslip.geometry.fracture import GEOMETRY_TOL, clip_to_domain, on_boundary
+from xfemslip.geometry.junctions import (
     JUNCTION_MIN_ANGLE,
     JUNCTION_SNAP_CELLS,
-    _clip_to_domain,
-    _on_boundary,
     build_fractures,
     find_junctions,
 )
@@ -87,9 +85,9 @@ def _junctions(segments, box=BOX, h=H):
     tol = GEOMETRY_TOL * h
     polylines, free = [], []
     for k, seg in enumerate(segments):
-        pts, _ = _clip_to_domain(np.asarray(seg, float), box, tol, f"[{k}]")
+        pts, _ = clip_to_domain(np.asarray(seg, float), box, tol, f"[{k}]")
         polylines.append(pts.copy())
-        free.append([not _on_boundary(p, box, tol) for p in pts[[0, -1]]])
+        free.append([not on_boundary(p, box, tol) for p in pts[[0, -1]]])
     names = [f"fractures[{k}]" for k in range(len(segments))]
     found = find_junctions(polylines, free, names, h, tol)
     return np.array(polylines), found
@@ -152,7 +150,7 @@ def test_near_parallel_pairs_stay_apart(gap, tilt):
 
 
 def test_ends_left_apart_are_counted_in_the_log(caplog):
-    caplog.set_level(logging.INFO, logger="xfemslip.geometry.fracture")
+    caplog.set_level(logging.INFO, logger="xfemslip.geometry.junctions")
     _check([MAIN, [[0.3, 0.51], [0.7, 0.515]]])
     assert "2 fracture end(s) within 0.05 m (h/2) of another fracture left as " in (
         caplog.text
@@ -381,7 +379,7 @@ def _generated(document, seed):
     cell = min(np.diff(spec.mesh.x).min(), np.diff(spec.mesh.y).min())
     before = np.array([f.points for f in spec.fractures], float)
     clipped = np.array(
-        [_clip_to_domain(s, box, GEOMETRY_TOL * cell, "")[0] for s in before]
+        [clip_to_domain(s, box, GEOMETRY_TOL * cell, "")[0] for s in before]
     )
     after, found = _junctions(before, box, cell)
     _assert_consistent(clipped, after, found, cell)

@@ -54,14 +54,10 @@ def _enriched_both(text, folder):
     mesh, fractures = _geometry(spec)
     ec = build_enriched_cells(mesh, fractures, find_candidates(mesh, fractures))
     D = elasticity_matrix(spec.material.E, spec.material.nu, spec.material.model)
-    out = {}
-    for name in ("numba", "numpy"):
-        previous = kernels.use(name)
-        try:
-            out[name] = _enriched_matrices(mesh, ec, D, None)
-        finally:
-            kernels.use(previous)
-    return out["numba"], out["numpy"]
+    return tuple(
+        _enriched_matrices(mesh, ec, D, None, backend=name)
+        for name in ("numba", "numpy")
+    )
 
 
 @pytest.mark.parametrize(
@@ -202,7 +198,7 @@ def test_whole_runs_agree(tmp_path):
     results = {}
     for backend in ("numba", "numpy"):
         model = build_model(loads_case(_small_case(backend), tmp_path / "c.toml"))
-        assert model.contact.kernels == backend
+        assert model.kernels == model.contact.kernels == backend
         solver = NewtonSolver(model.problem, 1e-12, 60, "consistent")
         results[backend] = solver.run(3)
     for a, b in zip(results["numba"], results["numpy"], strict=True):
@@ -241,3 +237,16 @@ def test_a_small_run_never_imports_numba(tmp_path):
 
     with h5py.File(tmp_path / "out" / "result.h5") as f:
         assert f.attrs["kernels"] == "numpy"
+
+
+def test_both_backends_provide_every_kernel():
+    """A model's backend name gives a namespace with every kernel the package
+    calls (KERNELS); "auto" is a choice (kernels.choose), not a backend."""
+    for name in ("numba", "numpy"):
+        namespace = kernels.backend(name)
+        missing = [
+            k for k in kernels.KERNELS if not callable(getattr(namespace, k, None))
+        ]
+        assert missing == [], (name, missing)
+    with pytest.raises(ValueError, match="unknown kernel backend 'auto'"):
+        kernels.backend("auto")

@@ -18,7 +18,7 @@ from tests.support.bulk_reference import ETA, XI, enriched_reference
 from tests.support.casegen import fracture_case
 from xfemslip.fem.enrichment import HEAVISIDE, find_candidates
 from xfemslip.fem.material import elasticity_matrix
-from xfemslip.kernels import enriched_cell_matrices, rectangle_stiffness
+from xfemslip.kernels.bulk import enriched_cell_matrices, rectangle_stiffness
 from xfemslip.kernels.shape import q4_shape
 from xfemslip.simulation import build_model
 

@@ -1,6 +1,7 @@
 """kernels.block_triplets / assembly.coo_block against a dense double loop."""
 
 import numpy as np
+import pytest
 
 from xfemslip import kernels
 from xfemslip.fem.assembly import coo_block
@@ -15,9 +16,10 @@ def _padded(seed, m=40, k=10, n=30):
     return dofs.astype(np.int64), blocks, n
 
 
-def test_triplets_are_the_masked_expansion_in_order():
+@pytest.mark.parametrize("backend", ["numba", "numpy"])
+def test_triplets_are_the_masked_expansion_in_order(backend):
     dofs, blocks, _ = _padded(1)
-    r, c, v = kernels.block_triplets(dofs, blocks)
+    r, c, v = kernels.backend(backend).block_triplets(dofs, blocks)
     k = dofs.shape[1]
     rows = np.repeat(dofs, k, axis=1).ravel()
     cols = np.tile(dofs, (1, k)).ravel()
@@ -27,7 +29,8 @@ def test_triplets_are_the_masked_expansion_in_order():
     np.testing.assert_array_equal(v, blocks.ravel()[keep])
 
 
-def test_coo_block_sums_every_kept_entry():
+@pytest.mark.parametrize("backend", ["numba", "numpy"])
+def test_coo_block_sums_every_kept_entry(backend):
     dofs, blocks, n = _padded(2)
     dense = np.zeros((n, n))
     for e in range(dofs.shape[0]):
@@ -36,11 +39,12 @@ def test_coo_block_sums_every_kept_entry():
                 if di >= 0 and dj >= 0:
                     dense[di, dj] += blocks[e, i, j]
     np.testing.assert_allclose(
-        coo_block(dofs, blocks, n).toarray(), dense, rtol=1e-14, atol=1e-14
+        coo_block(dofs, blocks, n, backend).toarray(), dense, rtol=1e-14, atol=1e-14
     )
 
 
-def test_no_kept_entry_gives_an_empty_matrix():
+@pytest.mark.parametrize("backend", ["numba", "numpy"])
+def test_no_kept_entry_gives_an_empty_matrix(backend):
     dofs = -np.ones((3, 4), np.int64)
-    K = coo_block(dofs, np.ones((3, 4, 4)), 5)
+    K = coo_block(dofs, np.ones((3, 4, 4)), 5, backend)
     assert K.shape == (5, 5) and K.nnz == 0

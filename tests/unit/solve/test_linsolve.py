@@ -43,7 +43,7 @@ def _newton_systems(n=30, steps=3):
     solve = solver._solve
 
     def record(res, r, k, it, eta):
-        Kc = coo_block(solver.c_dofs, res.blocks, solver.free.size)
+        Kc = coo_block(solver.c_dofs, res.blocks, solver.free.size, res.contact.kernels)
         systems.append((Kc, r.copy()))
         return solve(res, r, k, it, eta)
 

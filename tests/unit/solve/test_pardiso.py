@@ -72,7 +72,7 @@ def test_fixed_pattern_equals_the_assembled_sum():
     for _ in range(2):  # the same pattern for new values
         blocks = rng.standard_normal((15, 4, 4))
         A = pattern.matrix(pattern.data(pattern.values(blocks)))
-        ref = (K + coo_block(dofs, blocks, n)).toarray()
+        ref = (K + coo_block(dofs, blocks, n, "numpy")).toarray()
         # equal up to the order of summation of repeated entries
         np.testing.assert_allclose(
             A.toarray(), ref, rtol=0, atol=1e-14 * abs(ref).max()
@@ -118,7 +118,10 @@ def test_newton_systems_match_superlu(friction, slips, mode, monkeypatch):
     ls = LinearSolver(newton.K_ff, "pardiso", newton.free, None, newton.c_dofs)
     asym, changes, last = [], 0, None
     for blocks, r, _ in seq:
-        A = (newton.K_ff + coo_block(newton.c_dofs, blocks, newton.free.size)).tocsc()
+        A = (
+            newton.K_ff
+            + coo_block(newton.c_dofs, blocks, newton.free.size, newton.linear.kernels)
+        ).tocsc()
         asym.append(abs(A - A.T).max() / abs(A).max())
         changes += last is None or not np.array_equal(blocks, last)
         last = blocks
@@ -184,7 +187,7 @@ def test_sparse_contact_tangent_through_solve():
     newton, seq = _newton_systems(n=16, steps=2)
     ls = LinearSolver(newton.K_ff, "pardiso", newton.free)
     for blocks, r, _ in seq:
-        Kc = coo_block(newton.c_dofs, blocks, newton.free.size)
+        Kc = coo_block(newton.c_dofs, blocks, newton.free.size, newton.linear.kernels)
         x = ls.solve(Kc, r)
         x_ref = spla.spsolve((newton.K_ff + Kc).tocsc(), r)
         assert np.linalg.norm(x - x_ref) <= 1e-8 * np.linalg.norm(x_ref)
@@ -229,7 +232,9 @@ def test_failure_falls_back_to_superlu(monkeypatch, caplog):
     ls = LinearSolver(newton.K_ff, "pardiso", newton.free, None, newton.c_dofs)
     with caplog.at_level(logging.WARNING, logger="xfemslip.solve.linear"):
         for blocks, r, _ in seq:
-            Kc = coo_block(newton.c_dofs, blocks, newton.free.size)
+            Kc = coo_block(
+                newton.c_dofs, blocks, newton.free.size, newton.linear.kernels
+            )
             x = ls.solve_contact(blocks, r)
             x_ref = spla.spsolve((newton.K_ff + Kc).tocsc(), r)
             assert np.linalg.norm(x - x_ref) <= 1e-8 * np.linalg.norm(x_ref)
