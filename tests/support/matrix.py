@@ -274,13 +274,17 @@ def reservoir_text(
     nu=0.3,
     initial_stress=None,
     max_iterations=30,
+    kn=None,
 ) -> str:
     """The reservoir case on an n x n mesh with one fracture, plus one
-    ``extra_fracture`` on each polyline of ``extra_fractures``."""
+    ``extra_fracture`` on each polyline of ``extra_fractures``; ``kn`` sets
+    both penalties of the first fracture (None: the file's)."""
     doc = tomllib.loads(RESERVOIR.read_text())
     fracture = doc["fractures"][0]
     fracture.update(angle=float(angle), friction=float(friction))
     fracture["cohesion"] = float(cohesion)
+    if kn is not None:
+        fracture["kn"] = fracture["kt"] = kn
     if points is not None:
         for key in ("center", "length", "angle"):
             del fracture[key]
