@@ -28,7 +28,6 @@ from __future__ import annotations
 import argparse
 import json
 import os
-import re
 import statistics
 import subprocess
 import sys
@@ -40,11 +39,12 @@ CASE = ROOT / "cases" / "reservoir_depletion.toml"
 
 
 def case_text(n: int, cracked: bool) -> str:
-    text = CASE.read_text()
-    text = re.sub(r"elements = \[\d+, \d+\]", f"elements = [{n}, {n}]", text)
+    from xfemslip.case import build
+
+    keys = {"mesh.elements": [n, n]}
     if not cracked:
-        text = re.sub(r"\[\[fractures\]\].*?(?=\n\[loading\])", "", text, flags=re.S)
-    return text
+        keys["fractures"] = None
+    return build.case_text(build.file_case(CASE, **keys))
 
 
 def one(n: int, solver: str, cracked: bool) -> dict:
