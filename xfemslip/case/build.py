@@ -10,9 +10,12 @@ file, so a built case is validated like a written one.
 [mesh]
 
 Values may be NumPy scalars and arrays, tuples and paths; entries that are
-``None`` are left out (so a builder can pass an optional key through).
-Floats keep their full precision (TOML writes the shortest repr that reads
-back to the same double).
+``None`` are left out (so a builder can pass an optional key through), and a
+value with no TOML form raises TypeError naming its key path.  Floats keep
+their full precision (TOML writes the shortest repr that reads back to the
+same double).  A case derived from another one (a shipped file, a base
+table) sets dotted keys with ``file_case`` / ``with_keys`` rather than
+editing text.
 """
 
 from __future__ import annotations
