@@ -48,7 +48,7 @@ documents = st.recursive(
 )
 
 
-@settings(max_examples=200, deadline=None)
+@settings(max_examples=200, deadline=None, database=None)
 @given(documents)
 def test_any_document_reads_back_bit_for_bit(doc):
     assert _bits(tomllib.loads(build.case_text(doc))) == _bits(doc)
@@ -66,7 +66,7 @@ def _case(E, nu, size, n, points, friction, stress):
     }
 
 
-@settings(max_examples=40, deadline=None)
+@settings(max_examples=40, deadline=None, database=None)
 @given(
     E=st.floats(1e6, 1e12),
     nu=st.floats(0.0, 0.49),
