@@ -47,6 +47,7 @@ import h5py
 import numpy as np
 from xfem_process import timed_run
 
+from xfemslip.case import build
 from xfemslip.case.fractures import TIP_KINDS
 from xfemslip.errors import XfemslipError
 from xfemslip.reference import closed_form as cf
@@ -141,40 +142,35 @@ def ogs_case(folder: Path, aoh: int) -> Path:
     core = a * math.cos(math.radians(OGS["theta"])) + 3 * h
     x = graded_lines(h, 0.37 * h, core, half)
     y = graded_lines(h, 0.71 * h, core, half)
-    fmt = lambda v: "[" + ", ".join(repr(float(t)) for t in v) + "]"  # noqa: E731
-    text = f"""name = "ogs-peer-{aoh}"
-
-[mesh]
-x = {fmt(x)}
-y = {fmt(y)}
-
-[material]
-E = {OGS["E"]!r}
-nu = {OGS["nu"]!r}
-model = "plane_strain"
-
-[[fractures]]
-center = [0.0, 0.0]
-length = {2 * a!r}
-angle = {OGS["theta"]!r}
-friction = {OGS["f"]!r}
-cohesion = 0.0
-kn = {OGS["k"]!r}
-kt = {OGS["k"]!r}
-
-[loading]
-stress = {{ xx = -20.0e6, yy = -40.0e6, xy = 0.0 }}
-steps = 1
-
-[boundary]
-bottom = {{ uy = 0.0, traction = true }}
-top = "traction"
-left = "traction"
-right = "traction"
-
-[output]
-formats = ["h5"]
-"""
+    text = build.case_text(
+        {
+            "name": f"ogs-peer-{aoh}",
+            "mesh": {"x": x, "y": y},
+            "material": {"E": OGS["E"], "nu": OGS["nu"], "model": "plane_strain"},
+            "fractures": [
+                {
+                    "center": [0.0, 0.0],
+                    "length": 2 * a,
+                    "angle": OGS["theta"],
+                    "friction": OGS["f"],
+                    "cohesion": 0.0,
+                    "kn": OGS["k"],
+                    "kt": OGS["k"],
+                }
+            ],
+            "loading": {
+                "stress": {"xx": -20.0e6, "yy": -40.0e6, "xy": 0.0},
+                "steps": 1,
+            },
+            "boundary": {
+                "bottom": {"uy": 0.0, "traction": True},
+                "top": "traction",
+                "left": "traction",
+                "right": "traction",
+            },
+            "output": {"formats": ["h5"]},
+        }
+    )
     path = folder / "case.toml"
     path.write_text(text)
     return path

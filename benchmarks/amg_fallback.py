@@ -22,7 +22,7 @@ import logging
 import statistics
 import time
 
-from xfemslip.reference.peer import case_text as xfem_case
+from xfemslip.reference.peer import case_table
 
 
 def one(spec, method: str, stall_stop: bool) -> dict:
@@ -55,14 +55,14 @@ def one(spec, method: str, stall_stop: bool) -> dict:
 
 
 def main(argv=None) -> int:
-    from xfemslip.case import loads_case
+    from xfemslip.case import build, loads_case
 
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--h", type=float, default=0.0125)
     ap.add_argument("--runs", type=int, default=2)
     args = ap.parse_args(argv)
     logging.disable(logging.WARNING)
-    spec = loads_case(xfem_case(args.h), "graded.toml")
+    spec = loads_case(build.case_text(case_table(args.h)), "graded.toml")
     variants = [("amg", True), ("amg", False), ("superlu", True)]
     one(spec, "superlu", True)  # warm-up
     runs = {v: [] for v in variants}

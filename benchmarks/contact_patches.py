@@ -40,9 +40,8 @@ def run(folder: Path, n, psi=30.0, friction=0.1, penalty=100.0, patch=None):
     ``[solver] contact_patch`` added when ``patch`` is given.
     """
     prob = V.Problem(f"psi{psi:g}-f{friction:g}", psi, friction=friction)
-    path = V.write_case(folder, n, prob, None, penalty)
-    if patch is not None:
-        path.write_text(path.read_text() + f"\n[solver]\ncontact_patch = {patch!r}\n")
+    solver = None if patch is None else {"contact_patch": patch}
+    path = V.write_case(folder, n, prob, None, penalty, solver=solver)
     solved = V.solve_case(path)
     fa = V.fracture_arrays(solved)
     s, slip = fa["s"], fa["slip"]

@@ -19,39 +19,46 @@ import tempfile
 import time
 from pathlib import Path
 
-CASE = """
-[domain]
-size = [1.0, 1.0]
-[mesh]
-elements = [{mesh}, {mesh}]
-[material]
-E = 5.0e9
-nu = 0.3
-[network]
-friction = 0.3
-tip = "{tip}"
-[network.generate]
-seed = 7
-count = {count}
-intersections = "avoid"
-min_spacing = {spacing}
-outside = "reject"
-orientation = {{ distribution = "von_mises", mean = 45.0, kappa = 2.0 }}
-length = {{ distribution = "power_law", exponent = 2.5, min = {lmin}, max = {lmax} }}
-[loading]
-stress = {{ xx = -20.0e6, yy = -40.0e6 }}
-[boundary]
-bottom = {{ uy = 0.0 }}
-top = "traction"
-left = "traction"
-right = "traction"
-"""
-
 
 def case_text(count: int, mesh: int, tip: str = "ramp") -> str:
+    from xfemslip.case import build
+
     h = 1.0 / mesh
-    return CASE.format(
-        count=count, mesh=mesh, tip=tip, spacing=1.2 * h, lmin=4 * h, lmax=12 * h
+    return build.case_text(
+        {
+            "domain": {"size": [1.0, 1.0]},
+            "mesh": {"elements": [mesh, mesh]},
+            "material": {"E": 5.0e9, "nu": 0.3},
+            "network": {
+                "friction": 0.3,
+                "tip": tip,
+                "generate": {
+                    "seed": 7,
+                    "count": count,
+                    "intersections": "avoid",
+                    "min_spacing": 1.2 * h,
+                    "outside": "reject",
+                    "orientation": {
+                        "distribution": "von_mises",
+                        "mean": 45.0,
+                        "kappa": 2.0,
+                    },
+                    "length": {
+                        "distribution": "power_law",
+                        "exponent": 2.5,
+                        "min": 4 * h,
+                        "max": 12 * h,
+                    },
+                },
+            },
+            "loading": {"stress": {"xx": -20.0e6, "yy": -40.0e6}},
+            "boundary": {
+                "bottom": {"uy": 0.0},
+                "top": "traction",
+                "left": "traction",
+                "right": "traction",
+            },
+        }
     )
 
 

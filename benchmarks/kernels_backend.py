@@ -24,20 +24,26 @@ from pathlib import Path
 
 from xfem_process import timed_run
 
+from xfemslip.case import build
+
 ROOT = Path(__file__).resolve().parents[1]
+NETWORK = ROOT / "cases/fracture_network.toml"
 
 
-def reservoir(n: int) -> str:
-    text = (ROOT / "cases/reservoir_depletion.toml").read_text()
-    return text.replace("elements = [50, 50]", f"elements = [{n}, {n}]")
+def reservoir(n: int) -> dict:
+    path = ROOT / "cases/reservoir_depletion.toml"
+    return build.file_case(path, **{"mesh.elements": [n, n]})
 
 
-def network(n: int, count: int, tip: str) -> str:
-    text = (ROOT / "cases/sweeps/dfn_realizations.toml").read_text()
-    text = text[text.index("[base]") :].replace("[base.", "[").replace("[base]\n", "")
-    text = re.sub(r"elements = \[\d+, \d+\]", f"elements = [{n}, {n}]", text)
-    text = re.sub(r"count = \d+", f"count = {count}", text)
-    return text.replace('tip = "ramp"', f'tip = "{tip}"')
+def network(n: int, count: int, tip: str) -> dict:
+    """The shipped DFN sweep's base case on n x n cells, count fractures."""
+    sweep = build.file_case(ROOT / "cases/sweeps/dfn_realizations.toml")
+    keys = {
+        "mesh.elements": [n, n],
+        "network.generate.count": count,
+        "network.tip": tip,
+    }
+    return build.with_keys(sweep["base"], **keys)
 
 
 CONFIGS = {
@@ -45,7 +51,7 @@ CONFIGS = {
     "reservoir 100": lambda: reservoir(100),
     "reservoir 200": lambda: reservoir(200),
     "reservoir 400": lambda: reservoir(400),
-    "network 80 (shipped)": lambda: (ROOT / "cases/fracture_network.toml").read_text(),
+    "network 80 (shipped)": lambda: build.file_case(NETWORK),
     "dfn 30 ramp, 50": lambda: network(50, 30, "ramp"),
     "dfn 30 ramp, 100": lambda: network(100, 30, "ramp"),
     "dfn 100 ramp, 200": lambda: network(200, 100, "ramp"),
@@ -53,12 +59,13 @@ CONFIGS = {
 }
 
 
-def with_backend(text: str, backend: str) -> str:
-    text = re.sub(r"(?m)^kernels = .*\n", "", text)
-    text = re.sub(r"(?m)^formats = .*$", 'formats = ["h5"]', text)
-    if "[solver]" in text:
-        return text.replace("[solver]", f'[solver]\nkernels = "{backend}"', 1)
-    return text + f'\n[solver]\nkernels = "{backend}"\n'
+def with_backend(case: dict, backend: str) -> str:
+    """Case text with ``[solver] kernels = backend`` and, where the case
+    names output formats, result.h5 only."""
+    keys = {"solver.kernels": backend}
+    if "formats" in case.get("output", {}):
+        keys["output.formats"] = ["h5"]
+    return build.case_text(build.with_keys(case, **keys))
 
 
 def work_of(case: Path) -> float:

@@ -26,23 +26,22 @@ sys.path.insert(0, str(ROOT))  # tests.support
 from tests.support.casegen import sweep_member  # noqa: E402
 from tests.support.hardcases import estimates, measure  # noqa: E402
 from xfemslip import memory  # noqa: E402
+from xfemslip.case import build  # noqa: E402
 
 CASES = ROOT / "cases"
 
 
-def _shipped(name, **replace):
-    text = (CASES / f"{name}.toml").read_text()
-    for old, new in replace.items():
-        assert old in text, old
-        text = text.replace(old, new)
-    return text
+def _shipped(name, **keys):
+    return build.case_text(build.file_case(CASES / f"{name}.toml", **keys))
 
 
 def _network(count, n, seed=1, steps=1):
-    keys = {"network.generate.count": count, "mesh.elements": [n, n]}
-    text = sweep_member(index=seed - 1, **keys)
-    assert "\nsteps = 1\n" in text
-    return text.replace("\nsteps = 1\n", f"\nsteps = {steps}\n")
+    keys = {
+        "network.generate.count": count,
+        "mesh.elements": [n, n],
+        "loading.steps": steps,
+    }
+    return sweep_member(index=seed - 1, **keys)
 
 
 INPUTS = {
@@ -51,16 +50,14 @@ INPUTS = {
     "network": lambda: _shipped("fracture_network"),
     "depleting": lambda: _shipped("depleting_reservoir"),
     "reservoir-400-steps": lambda: _shipped(
-        "reservoir_depletion", **{"steps = 1": "steps = 400"}
+        "reservoir_depletion", **{"loading.steps": 400}
     ),
-    "network-100-steps": lambda: _shipped(
-        "fracture_network", **{"steps = 4": "steps = 100"}
-    ),
+    "network-100-steps": lambda: _shipped("fracture_network", **{"loading.steps": 100}),
     "reservoir-200x200": lambda: _shipped(
-        "reservoir_depletion", **{"elements = [50, 50]": "elements = [200, 200]"}
+        "reservoir_depletion", **{"mesh.elements": [200, 200]}
     ),
     "reservoir-300x300": lambda: _shipped(
-        "reservoir_depletion", **{"elements = [50, 50]": "elements = [300, 300]"}
+        "reservoir_depletion", **{"mesh.elements": [300, 300]}
     ),
     "dfn-60-30x30": lambda: _network(60, 30),
     "dfn-60-30x30-s14-10": lambda: _network(60, 30, seed=14, steps=10),

@@ -23,29 +23,9 @@ from collections import Counter
 
 import numpy as np
 
-from xfemslip.case import loads_case
+from xfemslip.case import build, loads_case
 from xfemslip.errors import GeometryError
 from xfemslip.simulation import build_model
-
-HEADER = """
-[domain]
-size = [1.0, 1.0]
-[mesh]
-elements = [{n}, {n}]
-[material]
-E = 5.0e9
-nu = 0.25
-"""
-FOOTER = """
-[loading]
-initial_stress = { xx = -20.0e6, yy = -40.0e6, xy = 0.0 }
-stress = { xx = -12.0e6, yy = -40.0e6, xy = 0.0 }
-[boundary]
-bottom = { uy = 0.0 }
-top = "traction"
-left = "traction"
-right = "traction"
-"""
 
 
 def network(count: int, seed: int = 6) -> list[np.ndarray]:
@@ -62,13 +42,26 @@ def network(count: int, seed: int = 6) -> list[np.ndarray]:
 
 
 def case_text(fracs, n: int, tip: str) -> str:
-    text = HEADER.format(n=n)
-    for p in fracs:
-        text += (
-            f"[[fractures]]\npoints = {p.round(6).tolist()!r}\nfriction = 0.6\n"
-            f'kn = 5.0e12\nkt = 5.0e12\ntip = "{tip}"\n'
-        )
-    return text + FOOTER
+    """n x n cells, the fractures ``fracs`` (end points rounded to 1e-6 m)."""
+    fracture = {"friction": 0.6, "kn": 5.0e12, "kt": 5.0e12, "tip": tip}
+    return build.case_text(
+        {
+            "domain": {"size": [1.0, 1.0]},
+            "mesh": {"elements": [n, n]},
+            "material": {"E": 5.0e9, "nu": 0.25},
+            "fractures": [dict(fracture, points=p.round(6)) for p in fracs] or None,
+            "loading": {
+                "initial_stress": {"xx": -20.0e6, "yy": -40.0e6, "xy": 0.0},
+                "stress": {"xx": -12.0e6, "yy": -40.0e6, "xy": 0.0},
+            },
+            "boundary": {
+                "bottom": {"uy": 0.0},
+                "top": "traction",
+                "left": "traction",
+                "right": "traction",
+            },
+        }
+    )
 
 
 def main(argv=None) -> int:

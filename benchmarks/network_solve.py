@@ -21,7 +21,6 @@ from __future__ import annotations
 
 import argparse
 import logging
-import re
 import statistics
 import time
 from pathlib import Path
@@ -30,19 +29,19 @@ ROOT = Path(__file__).resolve().parents[1]
 
 
 def case_text(mesh: int, tip: str, solver: str, steps: int) -> str:
-    src = (ROOT / "cases" / "sweeps" / "dfn_realizations.toml").read_text()
-    body = src.split("[base]", 1)[1].split("\n", 2)[2]
-    body = body.replace("[base.", "[")
-    body = body.replace('tip = "ramp"', f'tip = "{tip}"')
-    body = re.sub(r"elements = \[\d+, \d+\]", f"elements = [{mesh}, {mesh}]", body)
-    body = re.sub(
-        r"stress = \{[^}]*\}\nsteps = \d+",
-        "initial_stress = { xx = -20.0e6, yy = -40.0e6, xy = 0.0 }\n"
-        "stress = { xx = -8.0e6, yy = -40.0e6, xy = 0.0 }\n"
-        f"steps = {steps}",
-        body,
-    )
-    return f'name = "dfn-solve"\n{body}\n[solver]\nlinear_solver = "{solver}"\n'
+    from xfemslip.case import build
+
+    sweep = build.file_case(ROOT / "cases" / "sweeps" / "dfn_realizations.toml")
+    keys = {
+        "name": "dfn-solve",
+        "network.tip": tip,
+        "mesh.elements": [mesh, mesh],
+        "loading.initial_stress": {"xx": -20.0e6, "yy": -40.0e6, "xy": 0.0},
+        "loading.stress": {"xx": -8.0e6, "yy": -40.0e6, "xy": 0.0},
+        "loading.steps": steps,
+        "solver.linear_solver": solver,
+    }
+    return build.case_text(build.with_keys(sweep["base"], **keys))
 
 
 def one_run(text: str) -> dict:

@@ -40,6 +40,7 @@ from pathlib import Path
 
 from xfem_process import timed_run
 
+from xfemslip.case import build
 from xfemslip.reference import peer
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -48,10 +49,10 @@ OGS_SCRIPT = ROOT.parent / "shared/peers/ogs/ogs_lie_slip.py"
 
 
 def xfem_prepare(h, folder: Path, **box) -> dict:
-    """Write the case (xfemslip.reference.peer.case_text; ``box``: half, growth,
+    """Write the case (xfemslip.reference.peer.case_table; ``box``: half, growth,
     radius) and warm the caches; returns the state of its runs."""
     case = folder / f"case_{h:g}.toml"
-    case.write_text(peer.case_text(h, **box))
+    case.write_text(build.case_text(peer.case_table(h, **box)))
     out = folder / f"out_{h:g}"
     # Python's bytecode cached as an installed package has it (see
     # benchmarks/startup.py: PYTHONDONTWRITEBYTECODE=1 recompiles every run)

@@ -20,11 +20,11 @@ import tomllib
 from pathlib import Path
 
 import numpy as np
-import tomli_w
 
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))  # tests.support
 from tests.support.hardcases import measure  # noqa: E402
+from xfemslip.case import build  # noqa: E402
 
 CASES = [
     "reservoir_depletion",
@@ -49,7 +49,7 @@ def with_penalty(name: str, exponent: int, tangent=None) -> tuple[str, float]:
     for fracture in doc.get("fractures", []):
         fracture["kn"] = fracture["kt"] = kn
     doc.pop("output", None)
-    return tomli_w.dumps(doc), kn
+    return build.case_text(doc), kn
 
 
 def main() -> int:

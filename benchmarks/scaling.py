@@ -33,7 +33,6 @@ from __future__ import annotations
 import argparse
 import json
 import os
-import re
 import statistics
 import subprocess
 import sys
@@ -48,12 +47,12 @@ CONFIGS = ("default", "pardiso", "floor_pardiso", "floor_superlu")
 
 
 def case_text(n: int, cracked: bool, out: str) -> str:
-    text = CASE.read_text()
-    text = re.sub(r"elements = \[\d+, \d+\]", f"elements = [{n}, {n}]", text)
-    text = re.sub(r'directory = ".*"', f'directory = "{out}"', text)
+    from xfemslip.case import build
+
+    keys = {"mesh.elements": [n, n], "output.directory": out}
     if not cracked:
-        text = re.sub(r"\[\[fractures\]\].*?(?=\n\[loading\])", "", text, flags=re.S)
-    return text
+        keys["fractures"] = None
+    return build.case_text(build.file_case(CASE, **keys))
 
 
 RUN = """

@@ -38,7 +38,6 @@ from __future__ import annotations
 import argparse
 import logging
 import math
-import re
 import sys
 import tempfile
 import time
@@ -47,7 +46,7 @@ from pathlib import Path
 import numpy as np
 
 from xfemslip import kernels
-from xfemslip.case import loads_case
+from xfemslip.case import build, loads_case
 from xfemslip.fem import quadrature as Q
 from xfemslip.post.fields import fracture_fields
 from xfemslip.reference import peer as oc
@@ -69,29 +68,21 @@ def case_text(
     patch=None,
     aligned=False,
 ):
-    """xfemslip.reference.peer.case_text on the mesh graded(h, fine, half, growth), with
+    """xfemslip.reference.peer.case_table on the mesh graded(h, fine, half, growth), with
     one option changed.  aligned: the crack at 0 degrees (off the mesh lines by
     (0.3 h, 0.37 h)) under the stress that gives it the same normal and shear
     traction as the 45-degree crack: (-30, -30, 10) MPa."""
-    txt = oc.case_text(
+    case = oc.case_table(
         h, half=half, fine=fine, growth=growth, radius=radius, tip=tip, kn=kn
     )
     if aligned:
         cx, cy = 0.3 * h, 0.37 * h
         a = oc.A
-        txt = re.sub(
-            r"points = .*\n",
-            f"points = [[{cx - a!r}, {cy!r}], [{cx + a!r}, {cy!r}]]\n",
-            txt,
-        )
-        txt = re.sub(
-            r"stress = \{.*\}",
-            "stress = { xx = -30.0e6, yy = -30.0e6, xy = 10.0e6 }",
-            txt,
-        )
+        case["fractures"][0]["points"] = [[cx - a, cy], [cx + a, cy]]
+        case["loading"]["stress"] = {"xx": -30.0e6, "yy": -30.0e6, "xy": 10.0e6}
     if patch is not None:
-        txt += f"[solver]\ncontact_patch = {patch!r}\n"
-    return txt
+        case["solver"] = {"contact_patch": patch}
+    return build.case_text(case)
 
 
 def solve(txt, aligned=False) -> dict:
@@ -237,14 +228,8 @@ def study_exact(aohs):
             cells = []
             for aoh in aohs:
                 n = int(round(2 * V.HALF_BOX * aoh / V.HALF_LENGTH))
-                path = V.write_case(Path(tmp) / f"{radius}_{aoh}", n, prob, None, 100.0)
-                if radius is not None:
-                    text = path.read_text().replace(
-                        "[loading]",
-                        f'tip = {{ kind = "branch", radius = {radius!r} }}\n[loading]',
-                        1,
-                    )
-                    path.write_text(text)
+                tip = None if radius is None else {"kind": "branch", "radius": radius}
+                path = V.write_case(Path(tmp) / f"{radius}_{aoh}", n, prob, tip, 100.0)
                 row = V.measure(V.solve_case(path), prob, aoh)
                 cells.append(f"{pct(row.slip_error)} ({row.dofs / 1e3:.0f}k)")
             rad = "default" if radius is None else f"{radius:g} m"

@@ -124,17 +124,10 @@ def geometry() -> None:
         crack_rows("geometry", name, crack)
     hh = 1.0 / 20
     d = hh / math.sqrt(2)
-    extra = f"""
-[[fractures]]
-points = {[[0.29 + d, 0.29 - d], [0.71 + d, 0.71 - d]]!r}
-friction = 0.1
-cohesion = 0.0
-kn = 5.0e12
-kt = 5.0e12
-"""
-    two = (
-        reservoir_text(n=20, points=[[0.29 - d, 0.29 + d], [0.71 - d, 0.71 + d]])
-        + extra
+    two = reservoir_text(
+        n=20,
+        points=[[0.29 - d, 0.29 + d], [0.71 - d, 0.71 + d]],
+        extra_fractures=[[[0.29 + d, 0.29 - d], [0.71 + d, 0.71 - d]]],
     )
     for tangent in TANGENTS:
         out = solve(two, RESERVOIR, tangent)
@@ -146,10 +139,7 @@ kt = 5.0e12
             "none (no closed form)",
             "both slip" if out.converged else "-",
         )
-    cross = reservoir_text(n=20) + extra.replace(
-        repr([[0.29 + d, 0.29 - d], [0.71 + d, 0.71 - d]]),
-        repr([[0.29, 0.71], [0.71, 0.29]]),
-    )
+    cross = reservoir_text(n=20, extra_fractures=[[[0.29, 0.71], [0.71, 0.29]]])
     try:
         build_model(loads_case(cross, RESERVOIR))
         msg = "NOT refused"

@@ -40,6 +40,8 @@ from pathlib import Path
 import h5py
 import meshio
 
+from xfemslip.case import build
+
 ROOT = Path(__file__).resolve().parents[2]
 RESERVOIR = ROOT / "cases" / "reservoir_depletion.toml"
 TIMEOUT = 300  # s, per process (a harness bound, not a timing assertion)
@@ -47,9 +49,9 @@ TIMEOUT = 300  # s, per process (a harness bound, not a timing assertion)
 
 def case_text(n: int, steps: int) -> str:
     """The reservoir case at n x n cells and ``steps`` load steps."""
-    text = RESERVOIR.read_text()
-    text = text.replace("elements = [50, 50]", f"elements = [{n}, {n}]")
-    return text.replace("steps = 1", f"steps = {steps}")
+    return build.case_text(
+        build.file_case(RESERVOIR, **{"mesh.elements": [n, n], "loading.steps": steps})
+    )
 
 
 def write_case(folder: Path, name: str, n: int, steps: int) -> Path:

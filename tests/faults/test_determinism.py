@@ -16,6 +16,8 @@ from pathlib import Path
 import h5py
 import numpy as np
 
+from xfemslip.case import build
+
 ROOT = Path(__file__).resolve().parents[2]
 RESERVOIR = ROOT / "cases" / "reservoir_depletion.toml"
 TIMED_ATTRS = {"wall_time_s"}
@@ -58,9 +60,8 @@ def _same(a, b) -> bool:
 
 
 def test_result_h5_is_bitwise_reproducible(tmp_path):
-    text = RESERVOIR.read_text()
-    text = text.replace("elements = [50, 50]", "elements = [16, 16]")
-    text = text.replace("steps = 1", "steps = 3")
+    keys = {"mesh.elements": [16, 16], "loading.steps": 3}
+    text = build.case_text(build.file_case(RESERVOIR, **keys))
     case = tmp_path / "case.toml"
     case.write_text(text)
     runs = {

@@ -21,6 +21,7 @@ import pytest
 from click.testing import CliRunner
 
 import xfemslip.simulation as simulation
+from xfemslip.case import build
 from xfemslip.cli import cli
 from xfemslip.errors import OutputError
 from xfemslip.io import hdf5
@@ -29,11 +30,9 @@ ROOT = Path(__file__).resolve().parents[2]
 RESERVOIR = ROOT / "cases" / "reservoir_depletion.toml"
 
 
-def case_file(folder: Path, *, n=10, steps=3, formats='["h5", "vtu"]') -> Path:
-    text = RESERVOIR.read_text()
-    text = text.replace("elements = [50, 50]", f"elements = [{n}, {n}]")
-    text = text.replace("steps = 1", f"steps = {steps}")
-    text = text.replace('formats = ["h5", "vtu"]', f"formats = {formats}")
+def case_file(folder: Path, *, n=10, steps=3, formats=("h5", "vtu")) -> Path:
+    keys = {"mesh.elements": [n, n], "loading.steps": steps, "output.formats": formats}
+    text = build.case_text(build.file_case(RESERVOIR, **keys))
     folder.mkdir(parents=True, exist_ok=True)
     path = folder / "case.toml"
     path.write_text(text)
@@ -198,7 +197,7 @@ def test_output_under_a_file_is_a_clear_error(tmp_path, runner):
 def test_existing_output_is_refused_untouched(tmp_path, runner):
     """README: an output folder holding results is refused (exit 2) unless
     --overwrite; the earlier files stay byte for byte."""
-    case = case_file(tmp_path, steps=1, formats='["h5"]')
+    case = case_file(tmp_path, steps=1, formats=["h5"])
     out = tmp_path / "out"
     first = runner.invoke(cli, ["run", "-q", str(case), "-o", str(out)])
     assert first.exit_code == 0

@@ -24,6 +24,7 @@ import pytest
 from click.testing import CliRunner
 
 from tests.faults import harness
+from xfemslip.case import build
 from xfemslip.cli import cli
 from xfemslip.io import folder as folder_module
 from xfemslip.io.fileset import replace_files
@@ -349,11 +350,8 @@ def test_output_path_that_is_a_file_is_refused_untouched(runner, scenario, tmp_p
     assert result.exit_code == 2
     assert "is a file" in result.stderr.splitlines()[-1]
     case = tmp_path / "case.toml"
-    case.write_text(
-        scenario.case_a.read_text().replace(
-            'directory = "out/reservoir-depletion"', f'directory = "{out}"'
-        )
-    )
+    keys = {"output.directory": out}
+    case.write_text(build.case_text(build.file_case(scenario.case_a, **keys)))
     result = runner.invoke(cli, ["run", "-q", str(case)])
     assert result.exit_code == 2
     assert result.stderr.splitlines() == [f"Error: {out} exists and is not a directory"]

@@ -17,7 +17,7 @@ import numpy as np
 from hypothesis import assume, given, settings
 from hypothesis import strategies as st
 
-from xfemslip.case import loads_case
+from xfemslip.case import build, loads_case
 from xfemslip.conventions import OPEN, SLIP, STICK
 from xfemslip.fem.quadrature import cell_subtriangles, polygon_area, split_polygon
 from xfemslip.kernels.contact import coulomb_return_map
@@ -188,31 +188,26 @@ def _rotate(p):
     return [L - p[1], p[0]]
 
 
-def _solve(points, stress, roller, tip):
-    sxx, syy, sxy = stress
-    text = f"""
-[domain]
-size = [{L}, {L}]
-[mesh]
-elements = [8, 8]
-[material]
-E = 10.0e9
-nu = 0.25
-model = "plane_strain"
-[[fractures]]
-points = {points!r}
-friction = 0.4
-kn = 1.0e12
-kt = 1.0e12
-tip = {tip}
-[loading]
-stress = {{ xx = {sxx!r}, yy = {syy!r}, xy = {sxy!r} }}
-[boundary]
-{roller}
-[solver]
-tolerance = 1.0e-11
-max_iterations = 40
-"""
+def _solve(points, stress, boundary, tip):
+    text = build.case_text(
+        {
+            "domain": {"size": [L, L]},
+            "mesh": {"elements": [8, 8]},
+            "material": {"E": 10.0e9, "nu": 0.25, "model": "plane_strain"},
+            "fractures": [
+                {
+                    "points": points,
+                    "friction": 0.4,
+                    "kn": 1.0e12,
+                    "kt": 1.0e12,
+                    "tip": tip,
+                }
+            ],
+            "loading": {"stress": build.stress_table(stress)},
+            "boundary": boundary,
+            "solver": {"tolerance": 1.0e-11, "max_iterations": 40},
+        }
+    )
     model = build_model(loads_case(text))
     solver = NewtonSolver(model.problem, 1e-11, 40, "consistent")
     (result,) = solver.run(1)
@@ -234,7 +229,7 @@ grid = st.integers(0, 1024).map(lambda k: k / 1024.0)  # exact binary fractions
 # other corners, so the answers differ by the quadrature error (~0.5 % of sigma on
 # 1 m cells).  The radius stays below the shortest fracture (2 m): see the
 # default-radius xfail in tests/unit/fem/test_enrichment.py.
-TIPS = {"ramp": ('"ramp"', 1e-6), "branch": ('{ kind = "branch", radius = 1.5 }', 2e-2)}
+TIPS = {"ramp": ("ramp", 1e-6), "branch": ({"kind": "branch", "radius": 1.5}, 2e-2)}
 
 
 @settings(derandomize=True, database=None, max_examples=8, deadline=None)
@@ -259,8 +254,12 @@ def test_rotating_the_problem_by_90_degrees_changes_nothing(
     base = _solve(
         points,
         (sxx, syy, sxy),
-        'bottom = { uy = 0.0, traction = true }\ntop = "traction"\n'
-        'left = "traction"\nright = "traction"',
+        {
+            "bottom": {"uy": 0.0, "traction": True},
+            "top": "traction",
+            "left": "traction",
+            "right": "traction",
+        },
         tip_table,
     )
     # rotated: sigma' = R sigma R^T = (syy, sxx, -sxy); the bottom edge becomes the
@@ -268,8 +267,12 @@ def test_rotating_the_problem_by_90_degrees_changes_nothing(
     rot = _solve(
         [[float(v) for v in _rotate(p)] for p in points],
         (syy, sxx, -sxy),
-        'right = { ux = 0.0, traction = true }\ntop = "traction"\n'
-        'left = "traction"\nbottom = "traction"',
+        {
+            "right": {"ux": 0.0, "traction": True},
+            "top": "traction",
+            "left": "traction",
+            "bottom": "traction",
+        },
         tip_table,
     )
     assert base["s"].size == rot["s"].size > 0

@@ -181,7 +181,7 @@ def test_two_parallel_fractures_one_element_apart(tangent):
     one = reservoir_text(n=20, points=[[0.29, 0.29], [0.71, 0.71]])
     pts_a = [[0.29 - d, 0.29 + d], [0.71 - d, 0.71 + d]]
     pts_b = [[0.29 + d, 0.29 - d], [0.71 + d, 0.71 - d]]
-    two = reservoir_text(n=20, points=pts_a) + _extra_fracture(pts_b)
+    two = reservoir_text(n=20, points=pts_a, extra_fractures=[pts_b])
     single = solve(one, RESERVOIR, tangent)
     pair = solve(two, RESERVOIR, tangent)
     assert single.converged and pair.converged, pair.error
@@ -193,22 +193,11 @@ def test_two_parallel_fractures_one_element_apart(tangent):
     assert np.all(np.isfinite(pair.steps[-1].u))
 
 
-def _extra_fracture(points) -> str:
-    return f"""
-[[fractures]]
-points = {points!r}
-friction = 0.1
-cohesion = 0.0
-kn = 5.0e12
-kt = 5.0e12
-"""
-
-
 def test_overlapping_fractures_are_refused():
     # crossing fractures make a network; one on top of the other
     # (collinear overlap) is still refused
     pts = [[0.4, 0.4], [0.9, 0.9]]
-    text = reservoir_text(n=20) + _extra_fracture(pts)
+    text = reservoir_text(n=20, extra_fractures=[pts])
     with pytest.raises(GeometryError, match="overlap"):
         build_model(loads_case(text, RESERVOIR))
 

@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from xfemslip.case import build
+
 
 def graded_axis(lo, hi, h, far_lo, far_hi, ratio=1.3):
     """Nodes: uniform h on [lo, hi], growing by ``ratio`` out to far_lo / far_hi."""
@@ -23,10 +25,6 @@ def graded_axis(lo, hi, h, far_lo, far_hi, ratio=1.3):
             x = far_lo
         left.append(x)
     return np.concatenate([left[::-1], core, right])
-
-
-def _list(values):
-    return "[" + ", ".join(repr(float(v)) for v in values) + "]"
 
 
 def offset_fault_case(
@@ -61,42 +59,42 @@ def offset_fault_case(
     x = graded_axis(-20 * h - shift, 20 * h + shift, h, -far, far)
     y = graded_axis(a - 2.5 * thickness, d + 2.5 * thickness, h, -far, far)
     xf = 0.0 if on_boundary else h / 2.0
-    text = f"""
-[mesh]
-x = {_list(x)}
-y = {_list(y)}
-
-[material]
-E = {E!r}
-nu = {nu!r}
-
-[reservoir]
-boxes = [[{-far!r}, {a!r}, 0.0, {b!r}], [0.0, {c!r}, {far!r}, {d!r}]]
-E = {E!r}
-nu = {nu!r}
-
-[pore_pressure]
-initial = 10.0e6
-change = {dp!r}
-region = "reservoir"
-
-[[fractures]]
-points = [[{xf!r}, {-fault_half_length!r}], [{xf!r}, {fault_half_length + throw!r}]]
-friction = {friction!r}
-cohesion = {cohesion!r}
-
-[loading]
-initial_stress = {{ xx = -30.0e6, yy = -30.0e6 }}
-stress = {{ xx = -30.0e6, yy = -30.0e6 }}
-steps = {steps}
-
-[boundary]
-left = {{ ux = 0.0 }}
-right = {{ ux = 0.0 }}
-bottom = {{ uy = 0.0 }}
-top = "traction"
-
-[output]
-formats = ["h5"]
-"""
+    text = build.case_text(
+        {
+            "mesh": {"x": [float(v) for v in x], "y": [float(v) for v in y]},
+            "material": {"E": E, "nu": nu},
+            "reservoir": {
+                "boxes": [[-far, a, 0.0, b], [0.0, c, far, d]],
+                "E": E,
+                "nu": nu,
+            },
+            "pore_pressure": {
+                "initial": 10.0e6,
+                "change": dp,
+                "region": "reservoir",
+            },
+            "fractures": [
+                {
+                    "points": [
+                        [xf, -fault_half_length],
+                        [xf, fault_half_length + throw],
+                    ],
+                    "friction": friction,
+                    "cohesion": cohesion,
+                }
+            ],
+            "loading": {
+                "initial_stress": {"xx": -30.0e6, "yy": -30.0e6},
+                "stress": {"xx": -30.0e6, "yy": -30.0e6},
+                "steps": steps,
+            },
+            "boundary": {
+                "left": {"ux": 0.0},
+                "right": {"ux": 0.0},
+                "bottom": {"uy": 0.0},
+                "top": "traction",
+            },
+            "output": {"formats": ["h5"]},
+        }
+    )
     return text, (a, b, c, d), xf

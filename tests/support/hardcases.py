@@ -13,47 +13,48 @@ import sys
 import time
 from pathlib import Path
 
-BASE = """
-name = "{name}"
-[domain]
-size = [1.0, 1.0]
-[mesh]
-elements = [{n}, {n}]
-[material]
-E = 5.0e9
-nu = 0.3
-{extra}
-[loading]
-{initial}stress = {{ xx = -20.0e6, yy = -40.0e6, xy = 0.0 }}
-steps = {steps}
-[boundary]
-bottom = {{ uy = 0.0 }}
-top = "traction"
-left = "traction"
-right = "traction"
-"""
+from xfemslip.case import build
 
-FRACTURE = """
-[[fractures]]
-points = {points}
-friction = 0.1
-kn = 5.0e12
-kt = 5.0e12
-"""
+STRESS = {"xx": -20.0e6, "yy": -40.0e6, "xy": 0.0}
 
 
-def _points(xy) -> str:
-    return "[" + ", ".join(f"[{x!r}, {y!r}]" for x, y in xy) + "]"
+def _case(name, n, *, fractures=(), initial_stress=None, steps=1, **tables) -> str:
+    """A 1 m square on n x n cells under STRESS, bottom on rollers, with the
+    given fracture polylines and extra tables."""
+    return build.case_text(
+        {
+            "name": name,
+            "domain": {"size": [1.0, 1.0]},
+            "mesh": {"elements": [n, n]},
+            "material": {"E": 5.0e9, "nu": 0.3},
+            **tables,
+            "fractures": [
+                {"points": p, "friction": 0.1, "kn": 5.0e12, "kt": 5.0e12}
+                for p in fractures
+            ]
+            or None,
+            "loading": {
+                "initial_stress": initial_stress,
+                "stress": STRESS,
+                "steps": steps,
+            },
+            "boundary": {
+                "bottom": {"uy": 0.0},
+                "top": "traction",
+                "left": "traction",
+                "right": "traction",
+            },
+        }
+    )
 
 
 def zigzag(n_points=1000, n=20) -> str:
     """A polyline zigzagging inside the cell [0.45, 0.5]^2 of a 20 x 20 mesh."""
     xy = [
-        (0.452 + 0.046 * i / (n_points - 1), 0.47 if i % 2 == 0 else 0.48)
+        [0.452 + 0.046 * i / (n_points - 1), 0.47 if i % 2 == 0 else 0.48]
         for i in range(n_points)
     ]
-    frac = FRACTURE.format(points=_points(xy))
-    return BASE.format(name="zigzag", n=n, extra=frac, initial="", steps=1)
+    return _case("zigzag", n, fractures=[xy])
 
 
 def arc(n_points=2000, n=50) -> str:
@@ -61,73 +62,59 @@ def arc(n_points=2000, n=50) -> str:
     xy = []
     for i in range(n_points):
         a = math.radians(135.0 - 90.0 * i / (n_points - 1))
-        xy.append((0.5 + 0.5 * math.cos(a), 0.1 + 0.5 * math.sin(a)))
-    frac = FRACTURE.format(points=_points(xy))
-    return BASE.format(name="arc", n=n, extra=frac, initial="", steps=1)
+        xy.append([0.5 + 0.5 * math.cos(a), 0.1 + 0.5 * math.sin(a)])
+    return _case("arc", n, fractures=[xy])
 
 
 def polygon(n_vertices=5000, n=50) -> str:
     """A reservoir bounded by a 5,000-vertex circle, depleted by 10 MPa."""
     ring = [
-        (
+        [
             0.5 + 0.35 * math.cos(2 * math.pi * i / n_vertices),
             0.5 + 0.35 * math.sin(2 * math.pi * i / n_vertices),
-        )
+        ]
         for i in range(n_vertices)
     ]
-    extra = (
-        FRACTURE.format(points=_points([(0.35, 0.35), (0.65, 0.65)]))
-        + f"""
-[reservoir]
-polygon = {_points(ring)}
-E = 5.0e9
-nu = 0.3
-[pore_pressure]
-initial = 20.0e6
-change = -10.0e6
-region = "reservoir"
-"""
+    return _case(
+        "polygon",
+        n,
+        fractures=[[[0.35, 0.35], [0.65, 0.65]]],
+        initial_stress=STRESS,
+        steps=2,
+        reservoir={"polygon": ring, "E": 5.0e9, "nu": 0.3},
+        pore_pressure={"initial": 20.0e6, "change": -10.0e6, "region": "reservoir"},
     )
-    initial = "initial_stress = { xx = -20.0e6, yy = -40.0e6, xy = 0.0 }\n"
-    return BASE.format(name="polygon", n=n, extra=extra, initial=initial, steps=2)
 
 
-def depletion(n=20) -> str:
+def depletion(n=20, change=-20.0e6) -> str:
     """The shipped depleting reservoir scaled to 1 m: a soft layer between
-    rollers depleted by 20 MPa in 10 steps, one fracture dipping 60 degrees
-    in it (it first slips near dp = -12 MPa)."""
-    return f"""
-name = "deplete"
-[domain]
-size = [1.0, 1.0]
-[mesh]
-elements = [{n}, {n}]
-[material]
-E = 20.0e9
-nu = 0.25
-[reservoir]
-box = [0.0, 0.4, 1.0, 0.6]
-E = 8.0e9
-nu = 0.2
-[pore_pressure]
-initial = 30.0e6
-change = -20.0e6
-region = "reservoir"
-[[fractures]]
-center = [0.5, 0.5]
-length = 0.15
-angle = 60.0
-friction = 0.5
-[loading]
-initial_stress = {{ xx = -44.0e6, yy = -62.0e6, xy = 0.0 }}
-stress = {{ xx = -44.0e6, yy = -62.0e6, xy = 0.0 }}
-steps = 10
-[boundary]
-left = {{ ux = 0.0 }}
-right = {{ ux = 0.0 }}
-bottom = {{ uy = 0.0 }}
-top = "traction"
-"""
+    rollers depleted by 20 MPa (``change`` [Pa]) in 10 steps, one fracture
+    dipping 60 degrees in it (it first slips near dp = -12 MPa)."""
+    stress = {"xx": -44.0e6, "yy": -62.0e6, "xy": 0.0}
+    return build.case_text(
+        {
+            "name": "deplete",
+            "domain": {"size": [1.0, 1.0]},
+            "mesh": {"elements": [n, n]},
+            "material": {"E": 20.0e9, "nu": 0.25},
+            "reservoir": {"box": [0.0, 0.4, 1.0, 0.6], "E": 8.0e9, "nu": 0.2},
+            "pore_pressure": {
+                "initial": 30.0e6,
+                "change": change,
+                "region": "reservoir",
+            },
+            "fractures": [
+                {"center": [0.5, 0.5], "length": 0.15, "angle": 60.0, "friction": 0.5}
+            ],
+            "loading": {"initial_stress": stress, "stress": stress, "steps": 10},
+            "boundary": {
+                "left": {"ux": 0.0},
+                "right": {"ux": 0.0},
+                "bottom": {"uy": 0.0},
+                "top": "traction",
+            },
+        }
+    )
 
 
 # Runs argv[2:] and writes its peak RSS [kB] to argv[1].  A process forked

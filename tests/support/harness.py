@@ -13,7 +13,7 @@ from pathlib import Path
 import numpy as np
 
 import xfemslip
-from xfemslip.case import load_case
+from xfemslip.case import build, load_case
 from xfemslip.conventions import OPEN, SLIP, STICK  # noqa: F401 (re-exported)
 from xfemslip.simulation import run_case
 from xfemslip.verify.problems import box_edges, write_edge_csv  # noqa: F401 (re-exported)
@@ -46,21 +46,6 @@ class Result:
         return self.fractures[0]
 
 
-def toml_value(v) -> str:
-    """A Python value as TOML (numbers with full precision)."""
-    if isinstance(v, bool):
-        return "true" if v else "false"
-    if isinstance(v, str):
-        return f'"{v}"'
-    if isinstance(v, int | np.integer):
-        return str(int(v))
-    if isinstance(v, float | np.floating):
-        return repr(float(v))
-    if isinstance(v, dict):
-        return "{ " + ", ".join(f"{k} = {toml_value(x)}" for k, x in v.items()) + " }"
-    return "[" + ", ".join(toml_value(x) for x in v) + "]"
-
-
 def case_text(
     *,
     size=(1.0, 1.0),
@@ -80,45 +65,23 @@ def case_text(
 ) -> str:
     """TOML text of a case; ``fractures`` is a list of dicts of fracture keys,
     ``boundary`` a dict edge -> "traction" | "free" | dict of edge keys."""
-    lines = [
-        'name = "verification"',
-        "",
-        "[domain]",
-        f"size = {toml_value(list(size))}",
-        f"origin = {toml_value(list(origin))}",
-        "",
-        "[mesh]",
-        f"elements = {toml_value(list(elements))}",
-        "",
-        "[material]",
-        f"E = {toml_value(E)}",
-        f"nu = {toml_value(nu)}",
-        f'model = "{model}"',
-        "",
-    ]
-    for fr in fractures:
-        lines.append("[[fractures]]")
-        lines += [f"{k} = {toml_value(v)}" for k, v in fr.items()]
-        lines.append("")
-    lines.append("[loading]")
-    for key, s in (("stress", stress), ("initial_stress", initial_stress)):
-        if s is not None:
-            table = dict(zip(("xx", "yy", "xy"), map(float, s), strict=True))
-            lines.append(f"{key} = {toml_value(table)}")
-    lines += [f"steps = {steps}", "", "[boundary]"]
-    for edge, value in (boundary or {}).items():
-        lines.append(f"{edge} = {toml_value(value)}")
-    lines += [
-        "",
-        "[solver]",
-        f"tolerance = {toml_value(tolerance)}",
-        f"max_iterations = {max_iterations}",
-        "",
-        "[output]",
-        f"formats = {toml_value(list(formats))}",
-        "",
-    ]
-    return "\n".join(lines)
+    return build.case_text(
+        {
+            "name": "verification",
+            "domain": {"size": size, "origin": origin},
+            "mesh": {"elements": elements},
+            "material": {"E": E, "nu": nu, "model": model},
+            "fractures": list(fractures) or None,
+            "loading": {
+                "stress": build.stress_table(stress),
+                "initial_stress": build.stress_table(initial_stress),
+                "steps": steps,
+            },
+            "boundary": dict(boundary or {}),
+            "solver": {"tolerance": tolerance, "max_iterations": max_iterations},
+            "output": {"formats": formats},
+        }
+    )
 
 
 def read_result(path: Path, summary=None) -> Result:

@@ -24,12 +24,13 @@ from __future__ import annotations
 import math
 import tempfile
 import time
+import tomllib
 from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 
-from xfemslip.case import loads_case
+from xfemslip.case import build, loads_case
 from xfemslip.conventions import OPEN, SLIP, STICK  # noqa: F401 (re-exported)
 from xfemslip.errors import ConvergenceError
 from xfemslip.reference import closed_form as cf
@@ -44,6 +45,7 @@ STRESS = (-20.0e6, -40.0e6, 0.0)  # far field of the crack cases [Pa]
 # tau = 8 MPa > f |sigma_n| = 4 MPa at f = 0.1
 SHEAR_STRESS = (-20.0e6, -40.0e6, 8.0e6)
 A = 0.5  # crack half-length [m]
+EDGE_FILES = ("bottom", "top", "left", "right")  # boundary data: <edge>.csv
 H32_N = 32  # elements per side of the crack cases
 E0 = 5.0e9  # Young's modulus of the crack cases [Pa]
 
@@ -170,32 +172,26 @@ class Crack:
         p0 = [c[0] - self.a * t[0], c[1] - self.a * t[1]]
         p1 = [c[0] + self.a * t[0], c[1] + self.a * t[1]]
         kn = self.penalty * self.E / self.h
-        text = f"""
-[domain]
-size = [2.0, 2.0]
-origin = [-1.0, -1.0]
-[mesh]
-elements = [{self.n}, {self.n}]
-[material]
-E = {self.E!r}
-nu = {self.nu!r}
-[[fractures]]
-points = [[{p0[0]!r}, {p0[1]!r}], [{p1[0]!r}, {p1[1]!r}]]
-friction = {self.friction!r}
-cohesion = {self.cohesion!r}
-kn = {kn!r}
-kt = {kn * self.kt_kn!r}
-tip = "{self.tip}"
-[loading]
-steps = {self.steps}
-[boundary]
-bottom = {{ file = "bottom.csv" }}
-top = {{ file = "top.csv" }}
-left = {{ file = "left.csv" }}
-right = {{ file = "right.csv" }}
-[solver]
-max_iterations = {self.max_iterations}
-"""
+        text = build.case_text(
+            {
+                "domain": {"size": [2.0, 2.0], "origin": [-1.0, -1.0]},
+                "mesh": {"elements": [self.n, self.n]},
+                "material": {"E": self.E, "nu": self.nu},
+                "fractures": [
+                    {
+                        "points": [p0, p1],
+                        "friction": self.friction,
+                        "cohesion": self.cohesion,
+                        "kn": kn,
+                        "kt": kn * self.kt_kn,
+                        "tip": self.tip,
+                    }
+                ],
+                "loading": {"steps": self.steps},
+                "boundary": {e: {"file": f"{e}.csv"} for e in EDGE_FILES},
+                "solver": {"max_iterations": self.max_iterations},
+            }
+        )
         return text, folder / "case.toml"
 
     def no_slip_cohesion(self) -> float:
@@ -254,6 +250,17 @@ def run_crack(crack: Crack, tangent="consistent", folder=None) -> tuple:
 # ------------------------------------------------------------- reservoir cases
 
 
+def extra_fracture(points) -> dict:
+    """A fracture with the keys of the reservoir case's one, on ``points``."""
+    return {
+        "points": points,
+        "friction": 0.1,
+        "cohesion": 0.0,
+        "kn": 5.0e12,
+        "kt": 5.0e12,
+    }
+
+
 def reservoir_text(
     *,
     n=20,
@@ -262,35 +269,35 @@ def reservoir_text(
     cohesion=0.0,
     steps=1,
     points=None,
-    extra_fractures="",
+    extra_fractures=(),
     E=5.0e9,
     nu=0.3,
     initial_stress=None,
     max_iterations=30,
+    kn=None,
 ) -> str:
-    """The reservoir case on an n x n mesh with one fracture (and extra ones)."""
-    text = RESERVOIR.read_text()
-    text = text.replace("elements = [50, 50]", f"elements = [{n}, {n}]")
-    text = text.replace("angle = 45.0", f"angle = {float(angle)!r}")
-    text = text.replace("friction = 0.1", f"friction = {float(friction)!r}")
-    text = text.replace("cohesion = 0.0", f"cohesion = {float(cohesion)!r}")
-    text = text.replace("steps = 1", f"steps = {steps}")
-    text = text.replace("E = 5.0e9", f"E = {float(E)!r}")
-    text = text.replace("nu = 0.3", f"nu = {float(nu)!r}")
-    text = text.replace("max_iterations = 30", f"max_iterations = {max_iterations}")
+    """The reservoir case on an n x n mesh with one fracture, plus one
+    ``extra_fracture`` on each polyline of ``extra_fractures``; ``kn`` sets
+    both penalties of the first fracture (None: the file's)."""
+    doc = tomllib.loads(RESERVOIR.read_text())
+    fracture = doc["fractures"][0]
+    fracture.update(angle=float(angle), friction=float(friction))
+    fracture["cohesion"] = float(cohesion)
+    if kn is not None:
+        fracture["kn"] = fracture["kt"] = kn
     if points is not None:
-        text = text.replace("center = [0.5, 0.5]", f"points = {points!r}")
-        text = text.replace("length = 0.6\n", "").replace(
-            f"angle = {float(angle)!r}\n", ""
-        )
+        for key in ("center", "length", "angle"):
+            del fracture[key]
+        fracture["points"] = points
+    doc["fractures"] += [extra_fracture(p) for p in extra_fractures]
+    doc["mesh"]["elements"] = [n, n]
+    doc["material"].update(E=float(E), nu=float(nu))
+    doc["loading"]["steps"] = steps
     if initial_stress is not None:
         xx, yy, xy = initial_stress
-        text = text.replace(
-            "[boundary]",
-            f"[loading.initial_stress]\nxx = {xx!r}\nyy = {yy!r}\nxy = {xy!r}\n\n"
-            "[boundary]",
-        )
-    return text + extra_fractures
+        doc["loading"]["initial_stress"] = {"xx": xx, "yy": yy, "xy": xy}
+    doc["solver"]["max_iterations"] = max_iterations
+    return build.case_text(doc)
 
 
 def window_reference(angle: float, friction: float) -> tuple[bool, float]:
@@ -313,29 +320,32 @@ def block_text(
     """A 2 m x 1 m box cut by a horizontal fault at y = 0.55 (through-going):
     bottom edge fixed, top edge loaded by (shear, -pressure), sides free.  The
     top block is held by the fault alone."""
-    return f"""
-[domain]
-size = [2.0, 1.0]
-[mesh]
-elements = [{2 * n}, {n}]
-[material]
-E = 5.0e9
-nu = 0.25
-[[fractures]]
-points = [[0.0, 0.55], [2.0, 0.55]]
-friction = {friction!r}
-cohesion = {cohesion!r}
-kn = {kn!r}
-kt = {kn!r}
-[loading]
-stress = {{ xx = 0.0, yy = {-pressure!r}, xy = {shear!r} }}
-steps = {steps}
-[boundary]
-bottom = {{ ux = 0.0, uy = 0.0 }}
-top = "traction"
-left = "free"
-right = "free"
-"""
+    return build.case_text(
+        {
+            "domain": {"size": [2.0, 1.0]},
+            "mesh": {"elements": [2 * n, n]},
+            "material": {"E": 5.0e9, "nu": 0.25},
+            "fractures": [
+                {
+                    "points": [[0.0, 0.55], [2.0, 0.55]],
+                    "friction": friction,
+                    "cohesion": cohesion,
+                    "kn": kn,
+                    "kt": kn,
+                }
+            ],
+            "loading": {
+                "stress": {"xx": 0.0, "yy": -pressure, "xy": shear},
+                "steps": steps,
+            },
+            "boundary": {
+                "bottom": {"ux": 0.0, "uy": 0.0},
+                "top": "traction",
+                "left": "free",
+                "right": "free",
+            },
+        }
+    )
 
 
 def block_threshold(pressure, friction, cohesion) -> float:

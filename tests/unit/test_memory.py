@@ -14,7 +14,7 @@ from click.testing import CliRunner
 
 from tests.support.casegen import sweep_member
 from tests.support.hardcases import estimates, measure
-from xfemslip.case import load_case, loads_case
+from xfemslip.case import build, load_case, loads_case
 from xfemslip.cli import cli
 from xfemslip.errors import MeshError, UsageError
 from xfemslip.fem.enrichment import find_candidates
@@ -115,12 +115,9 @@ def test_terms_follow_their_sizes():
     )
 
 
-def _text(name, **replace_text):
-    text = (CASES / f"{name}.toml").read_text()
-    for old, new in replace_text.items():
-        assert old in text
-        text = text.replace(old, new)
-    return text
+def _text(name, **keys):
+    """The shipped case ``name`` with the values at dotted key paths set."""
+    return build.case_text(build.file_case(CASES / f"{name}.toml", **keys))
 
 
 # (case text, what it stands for): the shipped reservoir, many kept load
@@ -128,7 +125,7 @@ def _text(name, **replace_text):
 # to 58 enrichment slots in a cell, the element matrices padded to them).
 MEASURED = {
     "reservoir": lambda: _text("reservoir_depletion"),
-    "60-steps": lambda: _text("reservoir_depletion", **{"steps = 1": "steps = 60"}),
+    "60-steps": lambda: _text("reservoir_depletion", **{"loading.steps": 60}),
     "crowded-network": lambda: sweep_member(
         index=0, **{"network.generate.count": 60, "mesh.elements": [30, 30]}
     ),
@@ -192,9 +189,7 @@ def test_model_check_sees_the_kept_steps(monkeypatch):
     one made before the enriched cells (the tangent blocks of its patches are
     wider than that one assumes); a limit between the two is refused by
     build_model, after assembly and before the first solve."""
-    spec = loads_case(
-        _text("fracture_network", **{"steps = 4": "steps = 100"}), "net.toml"
-    )
+    spec = loads_case(_text("fracture_network", **{"loading.steps": 100}), "net.toml")
     monkeypatch.delenv(ENV_LIMIT, raising=False)
     model = build_model(spec)
     mesh, fractures = model.mesh, model.fractures

@@ -30,7 +30,7 @@ import numpy as np
 import pytest
 
 from tests.support.depletion_cases import offset_fault_case
-from xfemslip.case import loads_case
+from xfemslip.case import build, loads_case
 from xfemslip.fem.poro import fluid_pressure
 from xfemslip.post.fields import step_fields
 from xfemslip.reference.closed_form_depletion import (
@@ -47,44 +47,36 @@ pytestmark = pytest.mark.verification
 S0 = (-40.0e6, -60.0e6, 0.0)
 
 
-def _layer_case(*, reservoir=True, fracture="", dp=-10.0e6, biot=0.8, steps=2):
-    res = (
-        """
-[reservoir]
-box = [0.0, 0.5, 1.0, 0.7]
-E = 5.0e9
-nu = 0.3
-"""
-        if reservoir
-        else ""
+def _layer_case(*, reservoir=True, fracture=None, dp=-10.0e6, biot=0.8, steps=2):
+    stress = {"xx": S0[0], "yy": S0[1]}
+    return build.case_text(
+        {
+            "mesh": {
+                "x": [0.0, 0.3, 0.5, 0.65, 1.0],
+                "y": [0.0, 0.2, 0.5, 0.6, 0.7, 1.2],
+            },
+            "material": {"E": 20.0e9, "nu": 0.2},
+            "reservoir": (
+                {"box": [0.0, 0.5, 1.0, 0.7], "E": 5.0e9, "nu": 0.3}
+                if reservoir
+                else None
+            ),
+            "pore_pressure": {
+                "initial": 30.0e6,
+                "change": dp,
+                "biot": biot,
+                "region": "reservoir" if reservoir else "all",
+            },
+            "fractures": None if fracture is None else [fracture],
+            "loading": {"initial_stress": stress, "stress": stress, "steps": steps},
+            "boundary": {
+                "left": {"ux": 0.0},
+                "right": {"ux": 0.0},
+                "bottom": {"uy": 0.0},
+                "top": "traction",
+            },
+        }
     )
-    region = "reservoir" if reservoir else "all"
-    return f"""
-[mesh]
-x = [0.0, 0.3, 0.5, 0.65, 1.0]
-y = [0.0, 0.2, 0.5, 0.6, 0.7, 1.2]
-
-[material]
-E = 20.0e9
-nu = 0.2
-{res}
-[pore_pressure]
-initial = 30.0e6
-change = {dp!r}
-biot = {biot!r}
-region = "{region}"
-{fracture}
-[loading]
-initial_stress = {{ xx = {S0[0]!r}, yy = {S0[1]!r} }}
-stress = {{ xx = {S0[0]!r}, yy = {S0[1]!r} }}
-steps = {steps}
-
-[boundary]
-left = {{ ux = 0.0 }}
-right = {{ ux = 0.0 }}
-bottom = {{ uy = 0.0 }}
-top = "traction"
-"""
 
 
 def _final_fields(text):
@@ -149,16 +141,15 @@ def test_uniaxial_strain_layered_exact():
     np.testing.assert_allclose(f.pore_pressure[~inside], 30.0e6, rtol=1e-15)
 
 
-STUCK_FRACTURE = """
-[[fractures]]
-points = [[0.13, 0.0], [0.82, 1.2]]
-friction = 0.6
-cohesion = 1.0e9
-"""
+STUCK_FRACTURE = {
+    "points": [[0.13, 0.0], [0.82, 1.2]],
+    "friction": 0.6,
+    "cohesion": 1.0e9,
+}
 
 
 def _fluid_fracture_run(kn):
-    fracture = STUCK_FRACTURE + f"kn = {kn!r}\nkt = {kn!r}\n"
+    fracture = dict(STUCK_FRACTURE, kn=kn, kt=kn)
     model, f = _final_fields(_layer_case(reservoir=False, fracture=fracture, biot=1.0))
     want = _expected(0.2, 1.0, -10.0e6)
     got = _actual(f, np.arange(model.mesh.n_cells))
@@ -193,37 +184,33 @@ def test_fluid_filled_fracture_does_not_perturb():
     assert np.all(fr.state == 1)
 
 
-CRIT_CASE = """
-[domain]
-size = [200.0, 120.0]
-[mesh]
-elements = [40, 24]
-[material]
-E = 20.0e9
-nu = 0.25
-[reservoir]
-box = [0.0, 40.0, 200.0, 80.0]
-E = 8.0e9
-nu = 0.2
-[pore_pressure]
-initial = 30.0e6
-change = -20.0e6
-region = "reservoir"
-[[fractures]]
-center = [101.0, 60.0]
-length = 30.0
-angle = 60.0
-friction = 0.5
-[loading]
-initial_stress = { xx = -44.0e6, yy = -62.0e6 }
-stress = { xx = -44.0e6, yy = -62.0e6 }
-steps = 4
-[boundary]
-left = { ux = 0.0 }
-right = { ux = 0.0 }
-bottom = { uy = 0.0 }
-top = "traction"
-"""
+CRIT_CASE = build.case_text(
+    {
+        "domain": {"size": [200.0, 120.0]},
+        "mesh": {"elements": [40, 24]},
+        "material": {"E": 20.0e9, "nu": 0.25},
+        "reservoir": {"box": [0.0, 40.0, 200.0, 80.0], "E": 8.0e9, "nu": 0.2},
+        "pore_pressure": {
+            "initial": 30.0e6,
+            "change": -20.0e6,
+            "region": "reservoir",
+        },
+        "fractures": [
+            {"center": [101.0, 60.0], "length": 30.0, "angle": 60.0, "friction": 0.5}
+        ],
+        "loading": {
+            "initial_stress": {"xx": -44.0e6, "yy": -62.0e6},
+            "stress": {"xx": -44.0e6, "yy": -62.0e6},
+            "steps": 4,
+        },
+        "boundary": {
+            "left": {"ux": 0.0},
+            "right": {"ux": 0.0},
+            "bottom": {"uy": 0.0},
+            "top": "traction",
+        },
+    }
+)
 
 
 def test_critical_depletion_against_stress_path():

@@ -12,6 +12,7 @@ import numpy as np
 import pytest
 
 import xfemslip
+from xfemslip.case import build
 from xfemslip.conventions import SLIP
 from xfemslip.studies.run import run_sweep
 from xfemslip.studies.sweep import loads_sweep
@@ -38,16 +39,13 @@ def test_realizations_follow_the_far_field_slip_window(tmp_path):
     # the screening is of fractures apart: "avoid" (the shipped sweep crosses
     # them, "allow": over its 20 seeds 15 of 256 fractures below 0.9 f slip,
     # pushed by a fracture crossing them, and 1 of 208 above 1.1 f sticks)
-    text = (
-        SWEEP.read_text()
-        .replace("stop = 20", "stop = 4")
-        .replace(
-            '\nintersections = "allow"\n',
-            '\nintersections = "avoid"\nmin_spacing = 0.03\n',
-        )
-    )
-    assert "stop = 4" in text and "min_spacing = 0.03" in text
-    sweep = loads_sweep(text, SWEEP)
+    keys = {
+        "base.network.generate.intersections": "avoid",
+        "base.network.generate.min_spacing": 0.03,
+    }
+    document = build.file_case(SWEEP, **keys)
+    document["vary"]["network.generate.seed"]["stop"] = 4  # a quoted dotted key
+    sweep = loads_sweep(build.case_text(document), SWEEP)
     rows = run_sweep(sweep, tmp_path, jobs=1)
     assert [r.status for r in rows] == ["ok"] * 4
     seen = {"inside": 0, "outside": 0}

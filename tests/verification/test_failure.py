@@ -30,11 +30,10 @@ from pathlib import Path
 import h5py
 import numpy as np
 import pytest
-import tomli_w
 from click.testing import CliRunner
 
 from tests.support.harness import STICK
-from xfemslip.case import load_case
+from xfemslip.case import build, load_case
 from xfemslip.cli import cli
 from xfemslip.errors import ConvergenceError
 from xfemslip.simulation import run_case
@@ -70,7 +69,7 @@ def write_case(folder: Path, *, steps=STEPS, cohesion=COHESION, formats=("h5", "
     doc["output"] = {"formats": list(formats)}
     folder.mkdir(parents=True, exist_ok=True)
     path = folder / "failing.toml"
-    path.write_text(tomli_w.dumps(doc))
+    path.write_text(build.case_text(doc))
     return path
 
 

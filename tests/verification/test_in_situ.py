@@ -31,11 +31,10 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-import tomli_w
 from click.testing import CliRunner
 
 import xfemslip
-from xfemslip.case import load_case
+from xfemslip.case import build, load_case
 from xfemslip.cli import cli
 from xfemslip.conventions import OPEN, SLIP, STICK
 from xfemslip.fem.assembly import enriched_part_bbar
@@ -100,7 +99,7 @@ def _case(h, *, initial=None, stress=SIGMA0, boundary=None, steps=1, angle=45.0)
 
 def _write(tmp_path, name, doc):
     path = tmp_path / f"{name}.toml"
-    path.write_text(tomli_w.dumps(doc))
+    path.write_text(build.case_text(doc))
     return load_case(path)
 
 
@@ -338,14 +337,11 @@ def test_admissible_in_situ_traction_is_carried_as_before(tmp_path):
 def _reservoir_case(tmp_path, friction):
     """The seed paper's reservoir case with sigma0 = sigma (nothing but the
     in-situ stress) and the fracture's friction replaced."""
-    text = (
-        Path(__file__).parents[2] / "cases" / "reservoir_depletion.toml"
-    ).read_text()
-    line = "stress = { xx = -20.0e6, yy = -40.0e6, xy = 0.0 }"
-    text = text.replace(line, f"{line}\ninitial_stress = {line.split(' = ', 1)[1]}")
-    text = text.replace("friction = 0.1", f"friction = {friction!r}")
+    shipped = Path(__file__).parents[2] / "cases" / "reservoir_depletion.toml"
+    case = build.file_case(shipped, **{"fractures.0.friction": friction})
+    case["loading"]["initial_stress"] = case["loading"]["stress"]
     path = tmp_path / "reservoir.toml"
-    path.write_text(text)
+    path.write_text(build.case_text(case))
     return path
 
 
@@ -378,14 +374,10 @@ def test_deplete_reports_a_fracture_slipping_in_situ_at_zero_change(tmp_path):
     in the reservoir: |tau0| = 7.794 MPa > 0.4 x 18.5 MPa): it slips before any
     depletion, so its critical change is 0 at a point of that fracture, found
     without bisection; the other fractures keep their onsets."""
-    text = (
-        Path(__file__).parents[2] / "cases" / "depleting_reservoir.toml"
-    ).read_text()
-    first = text.index("[[fractures]]")
-    head, tail = text[:first], text[first:]
-    tail = tail.replace("friction = 0.5", "friction = 0.4", 1)
+    shipped = Path(__file__).parents[2] / "cases" / "depleting_reservoir.toml"
+    case = build.file_case(shipped, **{"fractures.0.friction": 0.4})
     path = tmp_path / "dep.toml"
-    path.write_text(head + tail)
+    path.write_text(build.case_text(case))
     spec = load_case(path)
     assert spec.fractures[0].friction == 0.4 and spec.fractures[1].friction == 0.5
     report = deplete(spec, tmp_path / "out")

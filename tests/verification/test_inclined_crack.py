@@ -82,7 +82,7 @@ def run_inclined(
     Returns (s, slip, state, exact slip at s).
     """
     prob = V.Problem("inclined", psi, friction, cohesion, plane)
-    solver = "" if patch is None else f"contact_patch = {patch!r}\n"
+    solver = None if patch is None else {"contact_patch": patch}
     case = V.write_case(folder, n, prob, None, penalty, steps=steps, solver=solver)
     run_case(load_case(case), folder / "out")
     fr = read_result(folder / "out" / "result.h5").fr

@@ -21,11 +21,10 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-import tomli_w
 
 import xfemslip
 from tests.support.harness import SLIP, STICK, read_result
-from xfemslip.case import load_case
+from xfemslip.case import build, load_case
 from xfemslip.simulation import run_case
 
 pytestmark = pytest.mark.verification
@@ -41,7 +40,7 @@ def run_steps(folder: Path, case: str, steps: int, cohesion=None):
         doc["fractures"][0]["cohesion"] = cohesion
     folder.mkdir(parents=True, exist_ok=True)
     path = folder / f"{case}_{steps}.toml"
-    path.write_text(tomli_w.dumps(doc))
+    path.write_text(build.case_text(doc))
     out = folder / f"out_{steps}"
     summary = run_case(load_case(path), out)
     return read_result(out / "result.h5", summary), out / "result.h5"

@@ -28,7 +28,7 @@ import numpy as np
 import pytest
 
 from tests.support.harness import case_text
-from xfemslip.case import loads_case
+from xfemslip.case import build, loads_case
 from xfemslip.conventions import SLIP, STICK
 from xfemslip.simulation import build_model, newton_solver
 from xfemslip.solve.newton import NewtonSolver
@@ -288,39 +288,52 @@ def test_junction_on_a_node_or_an_edge(polys):
 
 # cases/sweeps/dfn_realizations.toml's base case, seed 1: 30 fractures
 # crossing one another (intersections = "allow"), friction 0.3 on all of them.
-DFN = """
-name = "dfn"
-[domain]
-size = [1.0, 1.0]
-[mesh]
-elements = [50, 50]
-[material]
-E = 5.0e9
-nu = 0.3
-[network]
-tip = "ramp"
-friction = 0.3
-[network.generate]
-seed = 1
-count = 30
-intersections = "allow"
-outside = "reject"
-[[network.generate.sets]]
-weight = 0.6
-orientation = { distribution = "von_mises", mean = 30.0, kappa = 8.0 }
-length = { distribution = "power_law", exponent = 2.5, min = 0.12, max = 0.4 }
-[[network.generate.sets]]
-weight = 0.4
-orientation = { distribution = "normal", mean = 120.0, std = 10.0 }
-length = { distribution = "power_law", exponent = 2.5, min = 0.12, max = 0.4 }
-[loading]
-stress = { xx = -20.0e6, yy = -40.0e6, xy = 0.0 }
-[boundary]
-bottom = { uy = 0.0 }
-top = "traction"
-left = "traction"
-right = "traction"
-"""
+POWER_LAW = {"distribution": "power_law", "exponent": 2.5, "min": 0.12, "max": 0.4}
+DFN = build.case_text(
+    {
+        "name": "dfn",
+        "domain": {"size": [1.0, 1.0]},
+        "mesh": {"elements": [50, 50]},
+        "material": {"E": 5.0e9, "nu": 0.3},
+        "network": {
+            "tip": "ramp",
+            "friction": 0.3,
+            "generate": {
+                "seed": 1,
+                "count": 30,
+                "intersections": "allow",
+                "outside": "reject",
+                "sets": [
+                    {
+                        "weight": 0.6,
+                        "orientation": {
+                            "distribution": "von_mises",
+                            "mean": 30.0,
+                            "kappa": 8.0,
+                        },
+                        "length": POWER_LAW,
+                    },
+                    {
+                        "weight": 0.4,
+                        "orientation": {
+                            "distribution": "normal",
+                            "mean": 120.0,
+                            "std": 10.0,
+                        },
+                        "length": POWER_LAW,
+                    },
+                ],
+            },
+        },
+        "loading": {"stress": {"xx": -20.0e6, "yy": -40.0e6, "xy": 0.0}},
+        "boundary": {
+            "bottom": {"uy": 0.0},
+            "top": "traction",
+            "left": "traction",
+            "right": "traction",
+        },
+    }
+)
 
 
 def test_random_network_with_crossings_converges_with_friction_everywhere():

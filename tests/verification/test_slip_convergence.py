@@ -34,7 +34,7 @@ import math
 import numpy as np
 import pytest
 
-from xfemslip.case import loads_case
+from xfemslip.case import build, loads_case
 from xfemslip.post.fields import fracture_fields
 from xfemslip.reference import peer
 from xfemslip.simulation import build_model, newton_solver
@@ -47,7 +47,7 @@ RADIUS = 0.4  # [m] fixed branch radius
 
 def slip_error(h, growth) -> float:
     """Relative L2 error of the slip against closed_form.slip_profile."""
-    text = peer.case_text(h, half=HALF, growth=growth, radius=RADIUS)
+    text = build.case_text(peer.case_table(h, half=HALF, growth=growth, radius=RADIUS))
     spec = loads_case(text)
     model = build_model(spec)
     results = newton_solver(model).run(1)

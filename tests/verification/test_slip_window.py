@@ -23,10 +23,9 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-import tomli_w
 
 from tests.support.harness import SLIP, read_result
-from xfemslip.case import load_case
+from xfemslip.case import build, load_case
 from xfemslip.reference import closed_form as cf
 from xfemslip.simulation import run_case
 
@@ -59,7 +58,7 @@ def slip_share(folder: Path, theta: float, friction: float, elements=None) -> tu
     doc["output"] = {"formats": ["h5"]}
     folder.mkdir(parents=True, exist_ok=True)
     path = folder / f"case_{theta:g}.toml"
-    path.write_text(tomli_w.dumps(doc))
+    path.write_text(build.case_text(doc))
     out = folder / f"out_{theta:g}"
     run_case(load_case(path), out)
     state = read_result(out / "result.h5").fr["state"]

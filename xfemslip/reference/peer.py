@@ -46,42 +46,39 @@ def graded(h, fine=0.8, half=10.0, growth=1.3) -> np.ndarray:
     return np.concatenate([-outer[::-1], core, outer])
 
 
-def case_text(
+def case_table(
     h, *, half=10.0, fine=0.8, growth=1.3, radius=None, tip=None, kn=PENALTY
-) -> str:
-    """The case on graded(h, fine, half, growth); ``radius`` fixes the branch
+) -> dict:
+    """The case on graded(h, fine, half, growth) as the tables of its file
+    (``xfemslip.case.build.case_text`` writes it); ``radius`` fixes the branch
     radius [m] (None: automatic), or ``tip`` names the tip kind; ``kn`` is
-    both penalties [Pa/m]."""
-    coords = ", ".join(f"{v:.12g}" for v in graded(h, fine, half, growth))
+    both penalties [Pa/m].  Mesh lines are rounded to 12 significant digits."""
+    coords = [float(f"{v:.12g}") for v in graded(h, fine, half, growth)]
     t = (math.cos(math.radians(PSI)), math.sin(math.radians(PSI)))
     if radius is not None:
-        tip_line = f'tip = {{ kind = "branch", radius = {radius!r} }}\n'
-    elif tip is not None:
-        tip_line = f'tip = "{tip}"\n'
-    else:
-        tip_line = ""
-    return f"""name = "ogs-peer"
-[mesh]
-x = [{coords}]
-y = [{coords}]
-[material]
-E = {E!r}
-nu = {NU!r}
-model = "plane_strain"
-[[fractures]]
-points = [[{-A * t[0]!r}, {-A * t[1]!r}], [{A * t[0]!r}, {A * t[1]!r}]]
-friction = {F!r}
-cohesion = 0.0
-{tip_line}kn = {kn!r}
-kt = {kn!r}
-[loading]
-stress = {{ xx = {STRESS[0]!r}, yy = {STRESS[1]!r}, xy = 0.0 }}
-[boundary]
-bottom = {{ uy = 0.0, traction = true }}
-top = "traction"
-left = "traction"
-right = "traction"
-"""
+        tip = {"kind": "branch", "radius": radius}
+    return {
+        "name": "ogs-peer",
+        "mesh": {"x": coords, "y": coords},
+        "material": {"E": E, "nu": NU, "model": "plane_strain"},
+        "fractures": [
+            {
+                "points": [[-A * t[0], -A * t[1]], [A * t[0], A * t[1]]],
+                "friction": F,
+                "cohesion": 0.0,
+                "tip": tip,
+                "kn": kn,
+                "kt": kn,
+            }
+        ],
+        "loading": {"stress": {"xx": STRESS[0], "yy": STRESS[1], "xy": 0.0}},
+        "boundary": {
+            "bottom": {"uy": 0.0, "traction": True},
+            "top": "traction",
+            "left": "traction",
+            "right": "traction",
+        },
+    }
 
 
 def slip_error(s, slip, stress=STRESS, psi=PSI) -> float:

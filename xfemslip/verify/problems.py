@@ -43,7 +43,7 @@ from pathlib import Path
 
 import numpy as np
 
-from xfemslip.case import load_case
+from xfemslip.case import build, load_case
 from xfemslip.post.fields import fracture_fields
 from xfemslip.post.jintegral import stress_intensity_factors
 from xfemslip.reference import closed_form as cf
@@ -52,6 +52,7 @@ from xfemslip.simulation import build_model, newton_solver
 logger = logging.getLogger(__name__)
 
 HALF_BOX = 1.0  # [m] the box is [-1, 1]^2
+EDGE_NAMES = ("bottom", "top", "left", "right")  # boundary data: <edge>.csv
 HALF_LENGTH = 0.5  # a [m]
 CENTER = (0.0123, -0.0077)  # off the mesh lines, as in check_inclined_crack.py
 STRESS = (-20.0e6, -40.0e6, 0.0)  # remote stress [Pa], the paper's state
@@ -117,59 +118,50 @@ QUICK_PROBLEMS = ("inclined-30", "stress-30", "frictionless-30", "stick-80")
 def case_text(
     n: int,
     prob: Problem,
-    tip: str | None,
+    tip: str | dict | None,
     penalty: float | None,
     *,
     steps: int = 1,
-    solver: str = "",
+    solver: dict | None = None,
 ) -> str:
     """TOML of the problem on an n x n mesh of the box (edges from CSV files).
 
-    penalty : kn h / E (= kt h / E), or None to leave kn and kt out.
-    steps : load steps; solver : lines of a [solver] table ("" = none).
+    tip : the tip kind or a tip table (``{"kind": "branch", "radius": r}``),
+    None for the default.  penalty : kn h / E (= kt h / E), or None to leave
+    kn and kt out (the case format's default).  steps : load steps; solver :
+    keys of a [solver] table (None = none).
     """
     a = HALF_LENGTH
     p = math.radians(prob.psi)
     t = (math.cos(p), math.sin(p))
-    p0 = (CENTER[0] - a * t[0], CENTER[1] - a * t[1])
-    p1 = (CENTER[0] + a * t[0], CENTER[1] + a * t[1])
-    if penalty is None:  # the case format's default (automatic, if it has one)
-        penalty_lines = ""
-    else:
-        kn = penalty * E / (2 * HALF_BOX / n)
-        penalty_lines = f"kn = {kn!r}\nkt = {kn!r}\n"
-    tip_line = f'tip = "{tip}"\n' if tip else ""
-    return f"""name = "verify-{prob.name}-{n}"
-
-[domain]
-size = [{2 * HALF_BOX!r}, {2 * HALF_BOX!r}]
-origin = [{-HALF_BOX!r}, {-HALF_BOX!r}]
-
-[mesh]
-elements = [{n}, {n}]
-
-[material]
-E = {E!r}
-nu = {NU!r}
-model = "{prob.plane}"
-
-[[fractures]]
-points = [[{p0[0]!r}, {p0[1]!r}], [{p1[0]!r}, {p1[1]!r}]]
-friction = {prob.friction!r}
-cohesion = {prob.cohesion!r}
-{penalty_lines}{tip_line}
-[loading]
-steps = {steps}
-
-[boundary]
-bottom = {{ file = "bottom.csv" }}
-top = {{ file = "top.csv" }}
-left = {{ file = "left.csv" }}
-right = {{ file = "right.csv" }}
-
-[output]
-formats = ["h5"]
-""" + (f"\n[solver]\n{solver}" if solver else "")
+    p0 = [CENTER[0] - a * t[0], CENTER[1] - a * t[1]]
+    p1 = [CENTER[0] + a * t[0], CENTER[1] + a * t[1]]
+    kn = None if penalty is None else penalty * E / (2 * HALF_BOX / n)
+    return build.case_text(
+        {
+            "name": f"verify-{prob.name}-{n}",
+            "domain": {
+                "size": [2 * HALF_BOX, 2 * HALF_BOX],
+                "origin": [-HALF_BOX, -HALF_BOX],
+            },
+            "mesh": {"elements": [n, n]},
+            "material": {"E": E, "nu": NU, "model": prob.plane},
+            "fractures": [
+                {
+                    "points": [p0, p1],
+                    "friction": prob.friction,
+                    "cohesion": prob.cohesion,
+                    "kn": kn,
+                    "kt": kn,
+                    "tip": tip or None,
+                }
+            ],
+            "loading": {"steps": steps},
+            "boundary": {e: {"file": f"{e}.csv"} for e in EDGE_NAMES},
+            "output": {"formats": ["h5"]},
+            "solver": solver or None,
+        }
+    )
 
 
 def exact_kwargs(prob: Problem) -> dict:
@@ -212,7 +204,7 @@ def write_case(
     folder: Path,
     n: int,
     prob: Problem,
-    tip: str | None,
+    tip: str | dict | None,
     penalty: float,
     **options,
 ) -> Path:

@@ -12,6 +12,7 @@ import pytest
 from xfemslip.case import (
     MAX_NAME_BYTES,
     MAX_TOML_DEPTH,
+    build,
     load_case,
     loads_case,
     parse_toml,
@@ -20,18 +21,14 @@ from xfemslip.case import (
 from xfemslip.case.files import READ_CHUNK, UnreadableInput, read_input
 from xfemslip.errors import CaseError
 
-CASE = """\
-name = "tiny"
-[domain]
-size = [1.0, 1.0]
-[mesh]
-elements = [2, 2]
-[material]
-E = 1.0e9
-nu = 0.25
-[boundary]
-bottom = { uy = 0.0 }
-"""
+TINY = {
+    "name": "tiny",
+    "domain": {"size": [1.0, 1.0]},
+    "mesh": {"elements": [2, 2]},
+    "material": {"E": 1.0e9, "nu": 0.25},
+    "boundary": {"bottom": {"uy": 0.0}},
+}
+CASE = build.case_text(TINY)
 
 
 def _refusal(path, limit=10**6) -> str:
@@ -227,19 +224,16 @@ def test_path_problem(path, problem):
         assert found.startswith(problem)
 
 
-def _case_with(**lines) -> str:
-    extra = "".join(f"{k} = {v}\n" for k, v in lines.items() if k == "name")
-    output = lines.get("directory")
-    text = extra + CASE.replace('name = "tiny"\n', "")
-    if output is not None:
-        text += f"[output]\ndirectory = {output}\n"
-    return text
+def _case_with(name=None, directory=None) -> str:
+    """The tiny case without a name, or with ``name``, and an output directory."""
+    output = None if directory is None else {"directory": directory}
+    return build.case_text(dict(TINY, name=name, output=output))
 
 
 def test_name_of_255_bytes_is_accepted_and_256_refused():
-    assert loads_case(_case_with(name='"' + "n" * MAX_NAME_BYTES + '"')).name
+    assert loads_case(_case_with(name="n" * MAX_NAME_BYTES)).name
     with pytest.raises(CaseError) as info:
-        loads_case(_case_with(name='"' + "\u00e9" * 128 + '"'))  # 256 bytes
+        loads_case(_case_with(name="\u00e9" * 128))  # 256 bytes
     assert info.value.problems == [
         (
             "name",
@@ -252,8 +246,8 @@ def test_name_of_255_bytes_is_accepted_and_256_refused():
 @pytest.mark.parametrize(
     ("value", "problem"),
     [
-        ('"o\\u0000ut"', "contains a NUL byte"),
-        ('"' + "d" * 256 + '"', "has a part of 256 bytes"),
+        ("o\u0000ut", "contains a NUL byte"),
+        ("d" * 256, "has a part of 256 bytes"),
     ],
 )
 def test_output_directory_no_file_system_holds_is_refused(value, problem):
@@ -264,7 +258,7 @@ def test_output_directory_no_file_system_holds_is_refused(value, problem):
 
 
 def test_case_error_spells_out_at_most_20_problems():
-    text = "".join(f"k{i} = {i}\n" for i in range(1000)) + CASE
+    text = build.case_text({**{f"k{i}": i for i in range(1000)}, **TINY})
     with pytest.raises(CaseError) as info:
         loads_case(text, "many.toml")
     err = info.value

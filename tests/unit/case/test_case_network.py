@@ -7,38 +7,31 @@ import numpy as np
 import pytest
 from click.testing import CliRunner
 
-from xfemslip.case import describe, load_case
+from xfemslip.case import build, describe, load_case
 from xfemslip.cli import cli
 from xfemslip.errors import CaseError
 from xfemslip.geometry.dfn import segments_csv_text
 
-HEAD = """
-[domain]
-size = [2.0, 1.0]
-[mesh]
-elements = [20, 10]
-[material]
-E = 5.0e9
-nu = 0.3
-[loading]
-stress = { xx = -20.0e6, yy = -40.0e6 }
-[boundary]
-bottom = { uy = 0.0 }
-top = "traction"
-"""
-INLINE = """
-[[fractures]]
-points = [[0.2, 0.8], [0.6, 0.9]]
-friction = 0.4
-"""
+HEAD = {
+    "domain": {"size": [2.0, 1.0]},
+    "mesh": {"elements": [20, 10]},
+    "material": {"E": 5.0e9, "nu": 0.3},
+    "loading": {"stress": {"xx": -20.0e6, "yy": -40.0e6}},
+    "boundary": {"bottom": {"uy": 0.0}, "top": "traction"},
+}
+INLINE = {"points": [[0.2, 0.8], [0.6, 0.9]], "friction": 0.4}
 
 
-def _case(tmp_path, network: str, csv: str | None = None, inline: str = INLINE):
-    """Write case.toml (+ seg.csv) into tmp_path; return the case path."""
+def _case(tmp_path, network=None, csv: str | None = None, inline=INLINE):
+    """Write case.toml (+ seg.csv) into tmp_path; return the case path.
+    ``network`` is the [network] table, ``inline`` the one [[fractures]]
+    table (None: none)."""
     if csv is not None:
         (tmp_path / "seg.csv").write_text(csv, encoding="utf-8")
     path = tmp_path / "case.toml"
-    path.write_text(HEAD + inline + network, encoding="utf-8")
+    fractures = None if inline is None else [inline]
+    text = build.case_text(dict(HEAD, fractures=fractures, network=network))
+    path.write_text(text, encoding="utf-8")
     return path
 
 
@@ -48,7 +41,7 @@ def _problems(tmp_path, network, csv=None, inline=INLINE) -> str:
     return str(info.value)
 
 
-FILE = '[network]\nfile = "seg.csv"\nfriction = 0.6\n'
+FILE = {"file": "seg.csv", "friction": 0.6}
 
 
 def test_csv_round_trip_and_numbering(tmp_path):
@@ -97,7 +90,7 @@ def test_csv_round_trip_and_numbering(tmp_path):
 
 def test_rows_without_id_are_single_fractures_and_defaults_apply(tmp_path):
     csv = "x1,y1,x0,y0,cohesion\n0.5,0.5,0.1,0.1,\n\n# comment\n1.5,0.5,1.1,0.1,2e5\n"
-    spec = load_case(_case(tmp_path, FILE + "kt = 3e11\n", csv, inline=""))
+    spec = load_case(_case(tmp_path, {**FILE, "kt": 3e11}, csv, inline=None))
     assert len(spec.fractures) == 2
     np.testing.assert_array_equal(spec.fractures[1].points, [[1.1, 0.1], [1.5, 0.5]])
     assert [f.cohesion for f in spec.fractures] == [0.0, 2e5]
@@ -165,96 +158,104 @@ def test_csv_errors_are_collected_and_capped(tmp_path):
 
 
 def test_missing_file_and_friction(tmp_path):
-    assert "network.file: cannot read" in _problems(
-        tmp_path, '[network]\nfile = "no.csv"\n'
-    )
-    message = _problems(
-        tmp_path, '[network]\nfile = "seg.csv"\n', "x0,y0,x1,y1\n0.1,0.1,0.5,0.5\n"
-    )
+    assert "network.file: cannot read" in _problems(tmp_path, {"file": "no.csv"})
+    message = _problems(tmp_path, {"file": "seg.csv"}, "x0,y0,x1,y1\n0.1,0.1,0.5,0.5\n")
     assert (
         "seg.csv line 2: no friction: give it in a friction column or as "
         "network.friction" in message
     )
 
 
-GENERATE = """
-[network]
-friction = 0.5
-[network.generate]
-seed = 3
-count = 5
-intersections = "avoid"
-orientation = { distribution = "uniform" }
-length = { distribution = "constant", value = 0.2 }
-"""
+GENERATE = {
+    "friction": 0.5,
+    "generate": {
+        "seed": 3,
+        "count": 5,
+        "intersections": "avoid",
+        "orientation": {"distribution": "uniform"},
+        "length": {"distribution": "constant", "value": 0.2},
+    },
+}
+
+
+def _network(**keys):
+    """GENERATE with the values at dotted key paths set (None removes one)."""
+    return build.with_keys(GENERATE, **keys)
+
 
 GENERATE_ERRORS = [
-    ("seed = 3", "seed = -1", "network.generate.seed: must be >= 0, got -1"),
-    ("count = 5", "count = 5\np21 = 2.0", "give exactly one of count, p20"),
-    ("count = 5", "", "network.generate.count: give exactly one of count, p20"),
+    ({"generate.seed": -1}, "network.generate.seed: must be >= 0, got -1"),
+    ({"generate.p21": 2.0}, "give exactly one of count, p20"),
     (
-        '"uniform" }',
-        '"uniform", kappa = 2.0 }',
+        {"generate.count": None},
+        "network.generate.count: give exactly one of count, p20",
+    ),
+    (
+        {"generate.orientation.kappa": 2.0},
         'orientation.kappa: not used with distribution = "uniform"',
     ),
     (
-        '{ distribution = "uniform" }',
-        '{ distribution = "von_mises", mean = 10.0 }',
+        {"generate.orientation": {"distribution": "von_mises", "mean": 10.0}},
         "orientation.kappa: required key missing",
     ),
     (
-        '{ distribution = "uniform" }',
-        '{ distribution = "fisher" }',
+        {"generate.orientation": {"distribution": "fisher"}},
         'orientation.distribution: must be one of "uniform", "von_mises", "normal"',
     ),
     (
-        '"constant", value = 0.2',
-        '"power_law", exponent = 2.0, min = 0.3, max = 0.2',
+        {
+            "generate.length": {
+                "distribution": "power_law",
+                "exponent": 2.0,
+                "min": 0.3,
+                "max": 0.2,
+            }
+        },
         "length.max: must be > min = 0.3, got 0.2",
     ),
     (
-        '"constant", value = 0.2',
-        '"lognormal", median = 0.1, sigma = 0.1, min = 5.0',
+        {
+            "generate.length": {
+                "distribution": "lognormal",
+                "median": 0.1,
+                "sigma": 0.1,
+                "min": 5.0,
+            }
+        },
         "holds only 0 of the lognormal's probability",
     ),
     (
-        'intersections = "avoid"',
-        'intersections = "sometimes"',
+        {"generate.intersections": "sometimes"},
         "network.generate.intersections: must be one of",
     ),
     (
-        'intersections = "avoid"',
-        'intersections = "allow"\nmin_spacing = 0.1',
+        {"generate.intersections": "allow", "generate.min_spacing": 0.1},
         'min_spacing: only used with intersections = "avoid"',
     ),
     (
-        "seed = 3",
-        "seed = 3\nregion = [[1.0, 0.0], [0.5, 1.0]]",
+        {"generate.region": [[1.0, 0.0], [0.5, 1.0]]},
         "network.generate.region: upper-right corner",
     ),
     (
-        "seed = 3",
-        "seed = 3\nsets = []",
+        {"generate.sets": []},
         "give either sets or orientation and length, not both",
     ),
     (
-        "friction = 0.5",
-        "frction = 0.5",
+        {"friction": None, "frction": 0.5},
         "unknown key 'frction' in [network]; did you mean 'friction'?",
     ),
-    ("count = 5", "count = 60\nmin_spacing = 0.1", "placed only"),
+    ({"generate.count": 60, "generate.min_spacing": 0.1}, "placed only"),
 ]
 
 
-@pytest.mark.parametrize(("old", "new", "expected"), GENERATE_ERRORS)
-def test_generate_errors(tmp_path, old, new, expected):
-    assert old in GENERATE
-    message = _problems(tmp_path, GENERATE.replace(old, new, 1))
+@pytest.mark.parametrize(("keys", "expected"), GENERATE_ERRORS)
+def test_generate_errors(tmp_path, keys, expected):
+    message = _problems(tmp_path, _network(**keys))
     assert expected in message, message
 
 
 def test_generated_fractures_follow_inline_and_file(tmp_path):
-    network = GENERATE.replace("[network]\n", '[network]\nfile = "seg.csv"\n')
+    network = _network(file="seg.csv")
     spec = load_case(_case(tmp_path, network, "x0,y0,x1,y1\n1.2,0.1,1.8,0.4\n"))
     assert [f.source.split(" ")[0] for f in spec.fractures] == (
         ["", "network.file"] + ["network.generate"] * 5
@@ -287,7 +288,7 @@ def test_cli_dfn_exports_a_network_that_reads_back(tmp_path):
     assert result.exit_code == 0, result.output
     assert "6 fractures (1 from [[fractures]])" in result.output
     spec = load_case(path)
-    copy = _case(tmp_path, '[network]\nfile = "net.csv"\n')
+    copy = _case(tmp_path, {"file": "net.csv"})
     again = load_case(copy)
     assert len(again.fractures) == len(spec.fractures)
     for f, g in zip(spec.fractures, again.fractures, strict=True):
@@ -330,9 +331,8 @@ def test_allow_network_that_crosses_is_built_with_a_junction_per_crossing(tmp_pa
     from xfemslip.geometry.fracture import GEOMETRY_TOL
     from xfemslip.geometry.junctions import find_junctions
 
-    network = GENERATE.replace('intersections = "avoid"', 'intersections = "allow"')
-    network = network.replace("count = 5", "count = 40")
-    path = _case(tmp_path, network, inline="")
+    network = _network(**{"generate.intersections": "allow", "generate.count": 40})
+    path = _case(tmp_path, network, inline=None)
     spec = load_case(path)
     pairs = intersecting_pairs(np.array([f.points for f in spec.fractures]))
     assert len(pairs) >= 3  # 40 random 0.2 m fractures on 2 m^2 do cross
@@ -351,7 +351,7 @@ def test_allow_network_that_crosses_is_built_with_a_junction_per_crossing(tmp_pa
 
 def test_cli_dfn_without_network_fractures_and_plot(tmp_path):
     runner = CliRunner()
-    path = _case(tmp_path, "", inline=INLINE)
+    path = _case(tmp_path, None, inline=INLINE)
     result = runner.invoke(cli, ["dfn", str(path), "--csv", str(tmp_path / "o.csv")])
     assert result.exit_code == 2 and "no [network] fractures to export" in result.output
     assert not (tmp_path / "o.csv").exists()
@@ -363,9 +363,9 @@ def test_cli_dfn_without_network_fractures_and_plot(tmp_path):
     length = float(np.hypot(0.4, 0.1))
     assert f"P21 = {length / 2.0:.4g} m/m^2" in result.output
     figure = tmp_path / "net.png"
-    network = GENERATE.replace("[network]\n", '[network]\nfile = "o.csv"\n')
+    network = _network(file="o.csv")
     # o.csv repeats the inline fracture: "avoid" keeps the generated ones off it
-    path = _case(tmp_path, network, inline="")
+    path = _case(tmp_path, network, inline=None)
     result = runner.invoke(cli, ["dfn", str(path), "--plot", str(figure)])
     assert result.exit_code == 0, result.output
     assert figure.stat().st_size > 10_000
@@ -379,7 +379,7 @@ def test_result_numbering_inline_then_file(tmp_path):
     from xfemslip.simulation import run_case
 
     csv = "fracture,x0,y0,x1,y1\nb,1.2,0.2,1.7,0.3\na,0.3,0.2,0.8,0.5\n"
-    path = _case(tmp_path, FILE + 'tip = "ramp"\n', csv)
+    path = _case(tmp_path, {**FILE, "tip": "ramp"}, csv)
     spec = load_case(path)
     run_case(spec, tmp_path / "out")
     lines = {
@@ -403,7 +403,7 @@ def test_result_numbering_inline_then_file(tmp_path):
 # Derived sizes of [network.generate], checked before anything is drawn
 # --------------------------------------------------------------------------- #
 
-POWER = '{ distribution = "power_law", exponent = 2.5, min = 0.1, max = 0.4 }'
+POWER = {"distribution": "power_law", "exponent": 2.5, "min": 0.1, "max": 0.4}
 
 
 def _power_law_mean(exponent, lo, hi, n=2_000_001) -> float:
@@ -418,10 +418,8 @@ def test_p21_count_is_p21_times_area_over_the_mean_length(tmp_path):
     gives the count the closed form of E[L] implies, before any draw."""
     mean = _power_law_mean(2.5, 0.1, 0.4)
     p21 = 5005 * mean / 2.0
-    text = GENERATE.replace("count = 5", f"p21 = {p21!r}").replace(
-        '{ distribution = "constant", value = 0.2 }', POWER
-    )
-    message = _problems(tmp_path, text)
+    keys = {"generate.count": None, "generate.p21": p21, "generate.length": POWER}
+    message = _problems(tmp_path, _network(**keys))
     assert (
         "network.generate.p21: asks for 5005 fractures over the region, more than "
         "5000" in message
@@ -429,35 +427,43 @@ def test_p21_count_is_p21_times_area_over_the_mean_length(tmp_path):
 
 
 @pytest.mark.parametrize(
-    ("old", "new", "expected"),
+    ("keys", "expected"),
     [
-        ("count = 5", "p21 = 1e308", "network.generate.p21: asks for inf fractures"),
-        # 1e308 per m^2 over 2 m^2
-        ("count = 5", "p20 = 1e308", "network.generate.p20: asks for inf fractures"),
         (
-            '{ distribution = "constant", value = 0.2 }',
-            POWER.replace("min = 0.1", "min = 1e-300"),
+            {"generate.count": None, "generate.p21": 1e308},
+            "network.generate.p21: asks for inf fractures",
+        ),
+        # 1e308 per m^2 over 2 m^2
+        (
+            {"generate.count": None, "generate.p20": 1e308},
+            "network.generate.p20: asks for inf fractures",
+        ),
+        (
+            {"generate.length": {**POWER, "min": 1e-300}},
             "network.generate.length: the power_law law with exponent = 2.5, "
             "min = 1e-300, max = 0.4 cannot be drawn in floating point",
         ),
         (
-            '{ distribution = "constant", value = 0.2 }',
-            '{ distribution = "lognormal", median = 1e308, sigma = 10.0 }',
+            {
+                "generate.length": {
+                    "distribution": "lognormal",
+                    "median": 1e308,
+                    "sigma": 10.0,
+                }
+            },
             "network.generate.length: the lognormal law with median = 1e+308, "
             "sigma = 10.0 cannot be drawn",
         ),
         (
-            "seed = 3",
-            "seed = 3\nregion = [[-1e308, 0.0], [1e308, 1.0]]",
+            {"generate.region": [[-1e308, 0.0], [1e308, 1.0]]},
             "network.generate.region: expected [[x0, y0], [x1, y1]] (lower-left and "
             "upper-right corners, m, within +-1e+150), got array of 2 items",
         ),
     ],
     ids=["p21-1e308", "p20-1e308", "power-law-min-1e-300", "lognormal-1e308", "region"],
 )
-def test_generate_values_whose_derived_sizes_overflow(tmp_path, old, new, expected):
-    assert old in GENERATE
-    message = _problems(tmp_path, GENERATE.replace(old, new, 1))
+def test_generate_values_whose_derived_sizes_overflow(tmp_path, keys, expected):
+    message = _problems(tmp_path, _network(**keys))
     assert expected in message, message
     assert message.count(": ") >= 1 and "\n" not in message
 
@@ -466,10 +472,13 @@ def test_a_steep_power_law_within_the_float_range_is_drawn(tmp_path):
     """exponent 10 on [0.05, 0.4]: min**(1 - exponent) = 5e11, finite; the
     drawn lengths follow the law's inverse CDF (all within [min, max]; whole
     fractures, as outside = "reject" redraws those that leave the domain)."""
-    law = POWER.replace("exponent = 2.5", "exponent = 10.0").replace("0.1", "0.05")
-    text = GENERATE.replace('{ distribution = "constant", value = 0.2 }', law)
-    text = text.replace('"avoid"', '"allow"\noutside = "reject"')
-    spec = load_case(_case(tmp_path, text))
+    law = {**POWER, "exponent": 10.0, "min": 0.05}
+    keys = {
+        "generate.length": law,
+        "generate.intersections": "allow",
+        "generate.outside": "reject",
+    }
+    spec = load_case(_case(tmp_path, _network(**keys)))
     generated = [f for f in spec.fractures if f.source.startswith("network.generate")]
     assert len(generated) == 5
     lengths = [float(np.hypot(*(f.points[-1] - f.points[0]))) for f in generated]

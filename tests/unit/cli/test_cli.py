@@ -11,32 +11,24 @@ import pytest
 from click.testing import CliRunner
 
 from xfemslip import __version__
+from xfemslip.case import build
 from xfemslip.cli import cli
 from xfemslip.errors import ConvergenceError, OutputError, UsageError
 
-VALID_CASE = """\
-name = "tiny"
-
-[domain]
-size = [1.0, 1.0]
-
-[mesh]
-elements = [4, 4]
-
-[material]
-E = 1.0e9
-nu = 0.25
-model = "plane_strain"
-
-[loading]
-steps = 1
-
-[boundary]
-bottom = { uy = 0.0 }
-top = { uy = -0.001 }
-left = "free"
-right = "free"
-"""
+VALID = {
+    "name": "tiny",
+    "domain": {"size": [1.0, 1.0]},
+    "mesh": {"elements": [4, 4]},
+    "material": {"E": 1.0e9, "nu": 0.25, "model": "plane_strain"},
+    "loading": {"steps": 1},
+    "boundary": {
+        "bottom": {"uy": 0.0},
+        "top": {"uy": -0.001},
+        "left": "free",
+        "right": "free",
+    },
+}
+VALID_CASE = build.case_text(VALID)
 
 
 @pytest.fixture
@@ -108,7 +100,7 @@ def test_check_valid_case(runner, case_file):
 
 def test_check_invalid_case_names_the_key(runner, tmp_path):
     path = tmp_path / "bad.toml"
-    path.write_text(VALID_CASE.replace("nu = 0.25", "nu = 0.7"))
+    path.write_text(build.case_text(build.with_keys(VALID, **{"material.nu": 0.7})))
     result = runner.invoke(cli, ["check", str(path)])
     assert result.exit_code == 2
     line = _assert_one_error_line(result)
@@ -256,40 +248,37 @@ def test_run_programming_error_propagates(runner, fake, case_file):
 
 # --- input that validates key by key but cannot be built: exit 2, no output ---
 
-_GEOMETRY_CASE = """
-[domain]
-size = [1.0, 1.0]
-[mesh]
-elements = [10, 10]
-[material]
-E = 5.0e9
-nu = 0.3
-{fractures}
-[boundary]
-bottom = {{ ux = 0.0, uy = 0.0 }}
-left = {{ ux = {left_ux} }}
-top = {{ uy = -0.001 }}
-"""
-_FRACTURE = """[[fractures]]
-points = [{points}]
-friction = 0.1
-kn = 5.0e12
-kt = 5.0e12
-"""
+
+def _geometry_case(fractures, left_ux) -> str:
+    """A square fixed at the bottom with fractures on the polylines
+    ``fractures`` and ux = ``left_ux`` on the left edge."""
+    fracture = {"friction": 0.1, "kn": 5.0e12, "kt": 5.0e12}
+    return build.case_text(
+        {
+            "domain": {"size": [1.0, 1.0]},
+            "mesh": {"elements": [10, 10]},
+            "material": {"E": 5.0e9, "nu": 0.3},
+            "fractures": [dict(fracture, points=p) for p in fractures],
+            "boundary": {
+                "bottom": {"ux": 0.0, "uy": 0.0},
+                "left": {"ux": left_ux},
+                "top": {"uy": -0.001},
+            },
+        }
+    )
 
 
 @pytest.mark.parametrize(
     ("fractures", "left_ux", "words"),
     [
         (
-            _FRACTURE.format(points="[0.2, 0.2], [0.8, 0.8]")
-            + _FRACTURE.format(points="[0.5, 0.5], [0.9, 0.9]"),
-            "0.0",
+            [[[0.2, 0.2], [0.8, 0.8]], [[0.5, 0.5], [0.9, 0.9]]],
+            0.0,
             "fractures[0] and fractures[1] overlap",
         ),
         (
-            _FRACTURE.format(points="[0.2, 0.2], [0.8, 0.8]"),
-            "0.01",
+            [[[0.2, 0.2], [0.8, 0.8]]],
+            0.01,
             "boundary.bottom and boundary.left prescribe different ux",
         ),
     ],
@@ -298,7 +287,7 @@ kt = 5.0e12
 @pytest.mark.parametrize("command", ["check", "run"])
 def test_geometry_errors_are_bad_input(tmp_path, command, fractures, left_ux, words):
     path = tmp_path / "geo.toml"
-    path.write_text(_GEOMETRY_CASE.format(fractures=fractures, left_ux=left_ux))
+    path.write_text(_geometry_case(fractures, left_ux))
     out = tmp_path / "out"
     args = [command, str(path)] + (["-o", str(out), "-q"] if command == "run" else [])
     result = CliRunner().invoke(cli, args)
@@ -313,33 +302,33 @@ def test_overwrite_leaves_no_file_of_the_earlier_run(tmp_path):
     """5 load steps (pvd + steps/), then 1 step without VTU into the same folder
     with --overwrite: only result.h5 of the new run is left."""
     case = tmp_path / "c.toml"
-    text = """
-[domain]
-size = [1.0, 1.0]
-[mesh]
-elements = [6, 6]
-[material]
-E = 1.0e9
-nu = 0.25
-[[fractures]]
-points = [[0.2, 0.3], [0.8, 0.7]]
-friction = 0.3
-kn = 1.0e12
-kt = 1.0e12
-[loading]
-steps = {steps}
-[boundary]
-bottom = {{ ux = 0.0, uy = 0.0 }}
-top = {{ uy = -0.001 }}
-[output]
-formats = {formats}
-"""
+
+    def text(steps, formats):
+        return build.case_text(
+            {
+                "domain": {"size": [1.0, 1.0]},
+                "mesh": {"elements": [6, 6]},
+                "material": {"E": 1.0e9, "nu": 0.25},
+                "fractures": [
+                    {
+                        "points": [[0.2, 0.3], [0.8, 0.7]],
+                        "friction": 0.3,
+                        "kn": 1.0e12,
+                        "kt": 1.0e12,
+                    }
+                ],
+                "loading": {"steps": steps},
+                "boundary": {"bottom": {"ux": 0.0, "uy": 0.0}, "top": {"uy": -0.001}},
+                "output": {"formats": formats},
+            }
+        )
+
     out = tmp_path / "out"
-    case.write_text(text.format(steps=5, formats='["h5", "vtu"]'))
+    case.write_text(text(5, ["h5", "vtu"]))
     first = CliRunner().invoke(cli, ["run", "-q", str(case), "-o", str(out)])
     assert first.exit_code == 0, first.output
     assert (out / "result.pvd").exists() and (out / "steps").is_dir()
-    case.write_text(text.format(steps=1, formats='["h5"]'))
+    case.write_text(text(1, ["h5"]))
     again = CliRunner().invoke(cli, ["run", "-q", str(case), "-o", str(out)])
     assert again.exit_code == 2  # refused without --overwrite
     second = CliRunner().invoke(
@@ -471,9 +460,14 @@ def test_group_without_command_still_prints_help(runner):
 def test_deplete_names_pore_pressure_change_zero(runner, tmp_path):
     path = tmp_path / "dep.toml"
     path.write_text(
-        VALID_CASE.replace('name = "tiny"\n', "")
-        + "\n[pore_pressure]\ninitial = 0.0\nchange = -0.0\n"
-        + "\n[[fractures]]\npoints = [[0.2, 0.3], [0.8, 0.7]]\nfriction = 0.5\n"
+        build.case_text(
+            dict(
+                VALID,
+                name=None,
+                pore_pressure={"initial": 0.0, "change": -0.0},
+                fractures=[{"points": [[0.2, 0.3], [0.8, 0.7]], "friction": 0.5}],
+            )
+        )
     )
     out = str(tmp_path / "out")
     result = runner.invoke(cli, ["deplete", "-q", str(path), "-o", out])

@@ -6,46 +6,41 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from xfemslip.case import loads_case
+from xfemslip.case import build, loads_case
 from xfemslip.case.specs import AUTO_PENALTY
 from xfemslip.contact.interface import _point_jumps, contact_patches
 from xfemslip.simulation import build_model
 
-CASE = """
-[domain]
-size = [1.0, 1.0]
-[mesh]
-x = {x}
-y = {y}
-[material]
-E = 1.0e10
-nu = 0.25
-model = "plane_strain"
-[[fractures]]
-points = [[0.13, 0.21], [0.52, 0.47], [0.83, 0.58]]
-friction = 0.3
-{penalty}
-[loading]
-stress = {{ xx = -1.0e6, yy = -2.0e6, xy = 0.0 }}
-[boundary]
-bottom = {{ uy = 0.0 }}
-top = "traction"
-left = "traction"
-right = "traction"
-[solver]
-contact_patch = {patch}
-"""
 
-
-def _model(patch=1.5, penalty="kn = 1.0e13\nkt = 2.0e13", graded=False):
+def _model(patch=1.5, penalty=None, graded=False):
+    """The case on a 20 x 16 grid (x graded near the fracture's kink), with
+    the penalties ``penalty`` (default kn = 1e13, kt = 2e13 Pa/m; {} for the
+    automatic ones) and contact patches of ``patch`` cells."""
+    if penalty is None:
+        penalty = {"kn": 1.0e13, "kt": 2.0e13}
     x = np.linspace(0.0, 1.0, 21)
     if graded:
         x = np.sort(np.concatenate([x, [0.625, 0.675, 0.725, 0.775]]))
-    text = CASE.format(
-        x=[float(v) for v in x],
-        y=[float(v) for v in np.linspace(0.0, 1.0, 17)],
-        penalty=penalty,
-        patch=patch,
+    fracture = {
+        "points": [[0.13, 0.21], [0.52, 0.47], [0.83, 0.58]],
+        "friction": 0.3,
+        **penalty,
+    }
+    text = build.case_text(
+        {
+            "domain": {"size": [1.0, 1.0]},
+            "mesh": {"x": x, "y": np.linspace(0.0, 1.0, 17)},
+            "material": {"E": 1.0e10, "nu": 0.25, "model": "plane_strain"},
+            "fractures": [fracture],
+            "loading": {"stress": {"xx": -1.0e6, "yy": -2.0e6, "xy": 0.0}},
+            "boundary": {
+                "bottom": {"uy": 0.0},
+                "top": "traction",
+                "left": "traction",
+                "right": "traction",
+            },
+            "solver": {"contact_patch": patch},
+        }
     )
     return build_model(loads_case(text))
 
@@ -108,7 +103,7 @@ def test_patch_jump_is_the_weighted_mean_of_the_point_jumps():
 
 
 def test_omitted_penalty_is_automatic_from_E_and_the_local_cell_size():
-    m = _model(1.5, penalty="", graded=True)
+    m = _model(1.5, penalty={}, graded=True)
     c = m.contact
     W = np.bincount(c.patch, weights=m.ip.weight)
     h = np.bincount(c.patch, weights=m.ip.weight * _cell_size(m)) / W
@@ -116,6 +111,6 @@ def test_omitted_penalty_is_automatic_from_E_and_the_local_cell_size():
     np.testing.assert_allclose(c.kt, c.kn)
     assert c.kn.max() > 1.2 * c.kn.min()  # graded: finer cells, stiffer penalty
     # a given kn is used as given
-    m2 = _model(1.5, penalty="kn = 3.0e13", graded=True)
+    m2 = _model(1.5, penalty={"kn": 3.0e13}, graded=True)
     np.testing.assert_allclose(m2.contact.kn, 3.0e13)
     np.testing.assert_allclose(m2.contact.kt, c.kt)

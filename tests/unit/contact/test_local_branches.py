@@ -9,7 +9,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from xfemslip.case import loads_case
+from xfemslip.case import build, loads_case
 from xfemslip.contact import branches as local_branches
 from xfemslip.contact.branches import force_branches
 from xfemslip.conventions import SLIP
@@ -21,8 +21,8 @@ CASE = Path(__file__).resolve().parents[3] / "cases" / "reservoir_depletion.toml
 
 
 def _setup(friction):
-    text = CASE.read_text().replace("elements = [50, 50]", "elements = [20, 20]")
-    text = text.replace("friction = 0.1", f"friction = {friction}")
+    keys = {"mesh.elements": [20, 20], "fractures.0.friction": friction}
+    text = build.case_text(build.file_case(CASE, **keys))
     model = build_model(loads_case(text, CASE))
     solver = NewtonSolver(model.problem, 1e-10, 60, "consistent", predictor=False)
     c = model.problem.contact

@@ -20,7 +20,7 @@ import pytest
 
 from tests.support.casegen import fracture_case
 from xfemslip import conventions
-from xfemslip.case import loads_case
+from xfemslip.case import build, loads_case
 from xfemslip.contact.predictor import predict_state, predicted_law, stress_increment
 from xfemslip.conventions import SLIP, STICK
 from xfemslip.reference.closed_form import slip_window
@@ -33,13 +33,13 @@ PLATE = ROOT / "cases" / "liu_borja_plate.toml"
 
 
 def _reservoir(n=20, angle=45.0, friction=0.1, steps=1):
-    text = RESERVOIR.read_text().replace(
-        "elements = [50, 50]", f"elements = [{n}, {n}]"
-    )
-    text = text.replace("angle = 45.0", f"angle = {angle!r}")
-    text = text.replace("friction = 0.1", f"friction = {friction!r}")
-    text = text.replace("steps = 1", f"steps = {steps}")
-    return loads_case(text, RESERVOIR)
+    keys = {
+        "mesh.elements": [n, n],
+        "fractures.0.angle": angle,
+        "fractures.0.friction": friction,
+        "loading.steps": steps,
+    }
+    return loads_case(build.case_text(build.file_case(RESERVOIR, **keys)), RESERVOIR)
 
 
 def _run(spec, predictor, steps=None, problem_change=None, path=None):
@@ -170,7 +170,7 @@ def test_unloading_and_reloading():
 def test_displacement_driven_steps_use_the_committed_state():
     """cases/liu_borja_plate.toml (no loading.stress, 5 steps): from step 2
     the committed slip set is the guess; the plate slips from step 1 on."""
-    text = PLATE.read_text().replace("elements = [50, 50]", "elements = [16, 16]")
+    text = build.case_text(build.file_case(PLATE, **{"mesh.elements": [16, 16]}))
     spec = loads_case(text, PLATE)
     plain, model = _run(spec, False)
     guess, _ = _run(spec, True)
@@ -233,9 +233,9 @@ def test_no_fracture_is_one_direct_solve():
     (no Krylov, no band) and equals the direct solution of K u = F."""
     import scipy.sparse.linalg as spla
 
-    text = RESERVOIR.read_text().replace("elements = [50, 50]", "elements = [16, 16]")
-    start, end = text.index("[[fractures]]"), text.index("[loading]")
-    solver, model = _run(loads_case(text[:start] + text[end:], RESERVOIR), True)
+    keys = {"mesh.elements": [16, 16], "fractures": None}
+    text = build.case_text(build.file_case(RESERVOIR, **keys))
+    solver, model = _run(loads_case(text, RESERVOIR), True)
     st = solver.linear.stats
     assert _solves(solver) == [1] and st["solves"] == 1
     assert st["factorizations"] == 1 and st["krylov_iterations"] == 0
@@ -257,14 +257,11 @@ def test_initial_stress_is_not_a_load():
     raised to 0.5 so that the in-situ traction, |tau| / -sigma_n = 1/3, is
     admissible: with the case's 0.1 the first step would release the excess,
     ContactSet.in_situ_force)."""
-    base = RESERVOIR.read_text().replace("elements = [50, 50]", "elements = [16, 16]")
-    base = base.replace("friction = 0.1", "friction = 0.5")
-    line = "stress = { xx = -20.0e6, yy = -40.0e6, xy = 0.0 }"
+    keys = {"mesh.elements": [16, 16], "fractures.0.friction": 0.5}
 
     def with_initial(xx, yy):
-        text = base.replace(
-            line, f"{line}\ninitial_stress = {{ xx = {xx!r}, yy = {yy!r}, xy = 0.0 }}"
-        )
+        initial = {"loading.initial_stress": {"xx": xx, "yy": yy, "xy": 0.0}}
+        text = build.case_text(build.file_case(RESERVOIR, **keys, **initial))
         return loads_case(text, RESERVOIR)
 
     spec = with_initial(-10.0e6, -10.0e6)

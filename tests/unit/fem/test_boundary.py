@@ -13,7 +13,7 @@ from types import SimpleNamespace
 import numpy as np
 import pytest
 
-from xfemslip.case import BoundarySpec, EdgeSpec, loads_case
+from xfemslip.case import BoundarySpec, EdgeSpec, build, loads_case
 from xfemslip.errors import GeometryError
 from xfemslip.fem.assembly import assemble_bulk
 from xfemslip.fem.boundary import dirichlet, rigid_body_pins, traction_load
@@ -27,31 +27,37 @@ N = 8  # 8 x 8 cells on the unit square, h = 0.125
 H = 1.0 / N
 
 
-def _model(
-    boundary, stress="{ xx = -20.0e6, yy = -40.0e6, xy = 0.0 }", fracture="", initial=""
-):
+STRESS = (-20.0e6, -40.0e6, 0.0)
+FIXED_BOTTOM = {"bottom": {"ux": 0.0, "uy": 0.0}, "top": "traction"}
+ROLLER_BOTTOM = {
+    "bottom": {"uy": 0.0},
+    "top": "traction",
+    "left": "traction",
+    "right": "traction",
+}
+
+
+def _model(boundary, stress=STRESS, fracture=None, initial=None):
     return build_model(_spec(boundary, stress, fracture, initial))
 
 
-def _spec(
-    boundary, stress="{ xx = -20.0e6, yy = -40.0e6, xy = 0.0 }", fracture="", initial=""
-):
-    text = f"""
-[domain]
-size = [1.0, 1.0]
-[mesh]
-elements = [{N}, {N}]
-[material]
-E = 10.0e9
-nu = 0.3
-model = "plane_strain"
-{fracture}
-[loading]
-stress = {stress}
-{initial}
-[boundary]
-{boundary}
-"""
+def _spec(boundary, stress=STRESS, fracture=None, initial=None):
+    """The square on N x N cells with the edges ``boundary``, the far field
+    (xx, yy, xy) ``stress`` [Pa], optionally a fracture table and an initial
+    stress."""
+    text = build.case_text(
+        {
+            "domain": {"size": [1.0, 1.0]},
+            "mesh": {"elements": [N, N]},
+            "material": {"E": 10.0e9, "nu": 0.3, "model": "plane_strain"},
+            "fractures": None if fracture is None else [fracture],
+            "loading": {
+                "stress": build.stress_table(stress),
+                "initial_stress": build.stress_table(initial),
+            },
+            "boundary": boundary,
+        }
+    )
     return loads_case(text)
 
 
@@ -88,7 +94,7 @@ def _uniform_edge(total):
 
 
 def test_top_traction_on_an_uncracked_mesh():
-    m = _model('bottom = { ux = 0.0, uy = 0.0 }\ntop = "traction"')
+    m = _model(FIXED_BOTTOM)
     assert m.problem.n_dofs == 2 * (N + 1) ** 2  # no fracture, no enriched dof
     top = _edge_forces(m, "top")
     # t = sigma . (0, 1) = (xy, yy) = (0, -40e6) on a width of 1 m
@@ -107,11 +113,7 @@ def test_traction_on_every_edge_is_self_equilibrated():
     sxx, syy, sxy = -20e6, -40e6, 5e6
     # xfemslip.case refuses a case without any prescribed displacement, so the
     # all-traction boundary is handed to traction_load directly
-    m = _model(
-        'bottom = { uy = 0.0 }\nleft = "traction"\nright = "traction"\n'
-        'top = "traction"',
-        stress=f"{{ xx = {sxx}, yy = {syy}, xy = {sxy} }}",
-    )
+    m = _model(ROLLER_BOTTOM, stress=(sxx, syy, sxy))
     all_traction = BoundarySpec(
         **{e: EdgeSpec(kind="traction") for e in ("bottom", "top", "left", "right")}
     )
@@ -152,9 +154,9 @@ def test_traction_on_every_edge_is_self_equilibrated():
 
 def test_initial_stress_applies_only_the_increment():
     m = _model(
-        'bottom = { ux = 0.0, uy = 0.0 }\ntop = "traction"\nright = "traction"',
-        stress="{ xx = -20.0e6, yy = -40.0e6, xy = 3.0e6 }",
-        initial="initial_stress = { xx = -12.0e6, yy = -30.0e6, xy = 1.0e6 }",
+        {**FIXED_BOTTOM, "right": "traction"},
+        stress=(-20.0e6, -40.0e6, 3.0e6),
+        initial=(-12.0e6, -30.0e6, 1.0e6),
     )
     # increment: xx = -8e6, yy = -10e6, xy = 2e6
     top = _edge_forces(m, "top")
@@ -173,8 +175,8 @@ def test_initial_stress_applies_only_the_increment():
 
 def test_traction_in_the_free_component_of_a_displacement_edge():
     m = _model(
-        "bottom = { uy = 0.0, traction = true }\nleft = { ux = 0.0 }",
-        stress="{ xx = -20.0e6, yy = -40.0e6, xy = 6.0e6 }",
+        {"bottom": {"uy": 0.0, "traction": True}, "left": {"ux": 0.0}},
+        stress=(-20.0e6, -40.0e6, 6.0e6),
     )
     bottom = _edge_forces(m, "bottom")
     # t = sigma . (0, -1) = (-xy, -yy); only the free x component is loaded
@@ -188,8 +190,8 @@ def test_traction_in_the_free_component_of_a_displacement_edge():
 @pytest.mark.parametrize(
     "points, tip",
     [
-        pytest.param("[[0.3, 0.0], [0.66, 1.0]]", "ramp", id="crossing"),
-        pytest.param("[[0.39, 0.35], [0.66, 1.0]]", "ramp", id="reaching-the-top"),
+        pytest.param([[0.3, 0.0], [0.66, 1.0]], "ramp", id="crossing"),
+        pytest.param([[0.39, 0.35], [0.66, 1.0]], "ramp", id="reaching-the-top"),
     ],
 )
 def test_enriched_traction_load_does_the_work_of_a_jumping_field(points, tip):
@@ -200,8 +202,8 @@ def test_enriched_traction_load_does_the_work_of_a_jumping_field(points, tip):
     sxy, syy = 7e6, -40e6
     m = _load_stage(
         _spec(
-            'bottom = { ux = 0.0, uy = 0.0 }\ntop = "traction"',
-            stress=f"{{ xx = -20.0e6, yy = {syy}, xy = {sxy} }}",
+            FIXED_BOTTOM,
+            stress=(-20.0e6, syy, sxy),
             fracture=_fracture_table(points, tip),
         )
     )
@@ -230,19 +232,12 @@ def test_enriched_traction_load_does_the_work_of_a_jumping_field(points, tip):
 
 
 def _fracture_table(points, tip):
-    return f"""[[fractures]]
-points = {points}
-friction = 0.5
-kn = 1.0e12
-kt = 1.0e12
-tip = "{tip}"
-"""
+    return {"points": points, "friction": 0.5, "kn": 1.0e12, "kt": 1.0e12, "tip": tip}
 
 
 def test_build_model_with_a_crossing_fracture_reaching_a_fixed_edge():
     m = _model(
-        'bottom = { ux = 0.0, uy = 0.0 }\ntop = "traction"',
-        fracture=_fracture_table("[[0.3, 0.0], [0.66, 1.0]]", "ramp"),
+        FIXED_BOTTOM, fracture=_fracture_table([[0.3, 0.0], [0.66, 1.0]], "ramp")
     )
     assert m.problem.fixed.max() < m.problem.n_dofs
     # both parts touch the fixed bottom: none floats
@@ -350,9 +345,7 @@ def test_pins_for_other_free_modes():
 
 
 def test_reservoir_style_case_pins_ux_at_the_bottom_middle():
-    m = _model(
-        'bottom = { uy = 0.0 }\ntop = "traction"\nleft = "traction"\nright = "traction"'
-    )
+    m = _model(ROLLER_BOTTOM)
     middle = m.mesh.edge_nodes("bottom")[N // 2]
     fixed = set(m.problem.fixed.tolist())
     assert 2 * middle in fixed

@@ -20,7 +20,7 @@ import scipy.sparse.linalg as spla
 
 from tests.support.casegen import fracture_case
 from xfemslip import conventions
-from xfemslip.case import loads_case
+from xfemslip.case import build, loads_case
 from xfemslip.fem.assembly import _enriched_matrices
 from xfemslip.fem.enrichment import ENRICHMENT_DIAG_RATIO, HEAVISIDE, find_candidates
 from xfemslip.simulation import build_model
@@ -324,30 +324,29 @@ def test_sub_cells_respect_the_ramp_kink_lines():
 # -------------------------------------------- closed fracture under hydrostatic load
 
 
-def _hydrostatic_model(tip_table, sigma=-5.0e6):
-    text = f"""
-[domain]
-size = [8.0, 8.0]
-[mesh]
-elements = [8, 8]
-[material]
-E = 10.0e9
-nu = 0.25
-model = "plane_strain"
-[[fractures]]
-points = {SHORT!r}
-friction = 0.4
-kn = 1.0e12
-kt = 1.0e12
-tip = {tip_table}
-[loading]
-stress = {{ xx = {sigma!r}, yy = {sigma!r}, xy = 0.0 }}
-[boundary]
-bottom = {{ uy = 0.0, traction = true }}
-top = "traction"
-left = "traction"
-right = "traction"
-"""
+def _hydrostatic_model(tip, sigma=-5.0e6):
+    fracture = {
+        "points": SHORT,
+        "friction": 0.4,
+        "kn": 1.0e12,
+        "kt": 1.0e12,
+        "tip": tip,
+    }
+    text = build.case_text(
+        {
+            "domain": {"size": [8.0, 8.0]},
+            "mesh": {"elements": [8, 8]},
+            "material": {"E": 10.0e9, "nu": 0.25, "model": "plane_strain"},
+            "fractures": [fracture],
+            "loading": {"stress": {"xx": sigma, "yy": sigma, "xy": 0.0}},
+            "boundary": {
+                "bottom": {"uy": 0.0, "traction": True},
+                "top": "traction",
+                "left": "traction",
+                "right": "traction",
+            },
+        }
+    )
     return build_model(loads_case(text))
 
 
@@ -367,20 +366,20 @@ def _stick_solution(m):
     return c.evaluate(u, conventions.TANGENT_CONSISTENT, c.pt_committed, c.gt_committed)
 
 
-def _assert_closed_under_hydrostatic_compression(tip_table):
+def _assert_closed_under_hydrostatic_compression(tip):
     """sigma = -5 MPa in every direction: the fracture carries sigma_n = -5 MPa and no
     shear in the continuum.  On 8 x 8 cells the penalty solution is rough, but every
     point must stay closed with |p_N| of the order of 5 MPa."""
-    res = _stick_solution(_hydrostatic_model(tip_table))
+    res = _stick_solution(_hydrostatic_model(tip))
     assert np.all(res.state != conventions.OPEN)
     assert np.all(res.pn < 0.0)
     assert np.all(res.pn > -2.0 * 5.0e6)
 
 
-@pytest.mark.parametrize("tip_table", ['"ramp"', '{ kind = "branch", radius = 1.5 }'])
-def test_hydrostatic_compression_keeps_a_short_fracture_closed(tip_table):
-    _assert_closed_under_hydrostatic_compression(tip_table)
+@pytest.mark.parametrize("tip", ["ramp", {"kind": "branch", "radius": 1.5}])
+def test_hydrostatic_compression_keeps_a_short_fracture_closed(tip):
+    _assert_closed_under_hydrostatic_compression(tip)
 
 
 def test_hydrostatic_compression_keeps_a_short_fracture_closed_default_branch():
-    _assert_closed_under_hydrostatic_compression('"branch"')
+    _assert_closed_under_hydrostatic_compression("branch")

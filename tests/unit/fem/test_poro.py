@@ -10,113 +10,97 @@ import numpy as np
 import pytest
 from click.testing import CliRunner
 
-from xfemslip.case import loads_case
+from xfemslip.case import build, loads_case
 from xfemslip.cli import cli
 from xfemslip.errors import CaseError
 from xfemslip.fem.enrichment import find_candidates
 from xfemslip.fem.poro import body_load
 from xfemslip.simulation import build_model
 
-BASE = """
-[domain]
-size = [100.0, 60.0]
-
-[mesh]
-elements = [10, 6]
-
-[material]
-E = 20.0e9
-nu = 0.25
-{extra}
-[loading]
-initial_stress = {{ xx = -44.0e6, yy = -62.0e6 }}
-stress = {{ xx = -44.0e6, yy = -62.0e6 }}
-steps = 2
-
-[boundary]
-left = {{ ux = 0.0 }}
-right = {{ ux = 0.0 }}
-bottom = {{ uy = 0.0 }}
-top = "traction"
-"""
-PORE = """
-[pore_pressure]
-initial = 30.0e6
-change = -20.0e6
-region = "reservoir"
-
-[reservoir]
-box = [0.0, 20.0, 100.0, 40.0]
-E = 8.0e9
-nu = 0.2
-"""
-FRACTURE = """
-[[fractures]]
-center = [51.0, 30.0]
-length = 20.0
-angle = 60.0
-friction = 0.5
-"""
+BASE = {
+    "domain": {"size": [100.0, 60.0]},
+    "mesh": {"elements": [10, 6]},
+    "material": {"E": 20.0e9, "nu": 0.25},
+    "loading": {
+        "initial_stress": {"xx": -44.0e6, "yy": -62.0e6},
+        "stress": {"xx": -44.0e6, "yy": -62.0e6},
+        "steps": 2,
+    },
+    "boundary": {
+        "left": {"ux": 0.0},
+        "right": {"ux": 0.0},
+        "bottom": {"uy": 0.0},
+        "top": "traction",
+    },
+}
+PORE = {
+    "pore_pressure": {"initial": 30.0e6, "change": -20.0e6, "region": "reservoir"},
+    "reservoir": {"box": [0.0, 20.0, 100.0, 40.0], "E": 8.0e9, "nu": 0.2},
+}
+FRACTURE = {
+    "fractures": [
+        {"center": [51.0, 30.0], "length": 20.0, "angle": 60.0, "friction": 0.5}
+    ]
+}
 
 
-def _problems(extra):
+def _case(*parts, **keys) -> str:
+    """BASE with the tables of ``parts``, then the values at the dotted key
+    paths ``keys`` set (None removes the key)."""
+    table = dict(BASE)
+    for part in parts:
+        table.update(part)
+    return build.case_text(build.with_keys(table, **keys))
+
+
+def _problems(**keys):
     with pytest.raises(CaseError) as err:
-        loads_case(BASE.format(extra=extra), "p.toml")
+        loads_case(_case(PORE, **keys), "p.toml")
     return dict(err.value.problems)
 
 
 @pytest.mark.parametrize(
-    "extra, key, words",
+    "keys, key, words",
     [
-        (PORE.replace("region", "biot = 0.0\nregion"), "pore_pressure.biot", "0 <"),
-        (PORE.replace("region", "biot = 1.5\nregion"), "pore_pressure.biot", "<= 1"),
+        ({"pore_pressure.biot": 0.0}, "pore_pressure.biot", "0 <"),
+        ({"pore_pressure.biot": 1.5}, "pore_pressure.biot", "<= 1"),
         (
-            '[pore_pressure]\ninitial = 1.0e6\nchange = -1.0e6\nregion = "reservoir"\n',
+            {
+                "reservoir": None,
+                "pore_pressure.initial": 1.0e6,
+                "pore_pressure.change": -1.0e6,
+            },
             "pore_pressure.region",
             "no [reservoir]",
         ),
+        ({"reservoir.box": [50.0, 20.0, 10.0, 40.0]}, "reservoir.box", "x0 < x1"),
         (
-            PORE.replace("[0.0, 20.0, 100.0, 40.0]", "[50.0, 20.0, 10.0, 40.0]"),
-            "reservoir.box",
-            "x0 < x1",
-        ),
-        (
-            PORE.replace("box = ", "boxes = [[0.0, 1.0, 2.0, 3.0]]\nbox = "),
+            {"reservoir.boxes": [[0.0, 1.0, 2.0, 3.0]]},
             "reservoir",
             "exactly one of",
         ),
+        ({"reservoir.box": [0.0, 20.0, 100.0]}, "reservoir.box", "4 numbers"),
         (
-            PORE.replace("[0.0, 20.0, 100.0, 40.0]", "[0.0, 20.0, 100.0]"),
-            "reservoir.box",
-            "4 numbers",
-        ),
-        (
-            PORE.replace("[0.0, 20.0, 100.0, 40.0]", "[200.0, 20.0, 300.0, 40.0]"),
+            {"reservoir.box": [200.0, 20.0, 300.0, 40.0]},
             "reservoir.box",
             "no element centre",
         ),
-        (PORE.replace("nu = 0.2", "nu = 0.5"), "reservoir.nu", "0.5"),
+        ({"reservoir.nu": 0.5}, "reservoir.nu", "0.5"),
         (
-            PORE.replace("change", "chnage"),
+            {"pore_pressure.change": None, "pore_pressure.chnage": -20.0e6},
             "pore_pressure.chnage",
             "did you mean 'change'",
         ),
-        (
-            PORE.replace('region = "reservoir"', 'region = "res"'),
-            "pore_pressure.region",
-            "reservoir",
-        ),
+        ({"pore_pressure.region": "res"}, "pore_pressure.region", "reservoir"),
     ],
 )
-def test_bad_keys_name_the_key(extra, key, words):
-    problems = _problems(extra)
+def test_bad_keys_name_the_key(keys, key, words):
+    problems = _problems(**keys)
     assert any(k == key and words in m for k, m in problems.items()), problems
 
 
 def test_initial_pressure_needs_initial_stress():
-    text = BASE.format(extra=PORE).replace(
-        "initial_stress = { xx = -44.0e6, yy = -62.0e6 }\n", ""
-    )
+    text = _case(PORE, **{"loading.initial_stress": None})
     with pytest.raises(CaseError) as err:
         loads_case(text, "p.toml")
     assert "loading.initial_stress" in str(err.value)
@@ -125,7 +109,7 @@ def test_initial_pressure_needs_initial_stress():
 
 def test_absent_tables_change_nothing():
     """Without the new tables the specs are None and the model is the old one."""
-    spec = loads_case(BASE.format(extra=FRACTURE), "p.toml")
+    spec = loads_case(_case(FRACTURE), "p.toml")
     assert spec.pore_pressure is None and spec.reservoir is None
     model = build_model(spec)
     assert model.pore is None
@@ -135,12 +119,12 @@ def test_absent_tables_change_nothing():
 def test_reservoir_with_host_constants_gives_the_same_stiffness():
     """Per-cell material: a [reservoir] with the host's E, nu assembles the
     same K (intact and enriched cells), one with other constants does not."""
-    plain = build_model(loads_case(BASE.format(extra=FRACTURE), "p.toml"))
-    same = PORE.replace("E = 8.0e9", "E = 20.0e9").replace("nu = 0.2", "nu = 0.25")
-    twin = build_model(loads_case(BASE.format(extra=FRACTURE + same), "p.toml"))
+    plain = build_model(loads_case(_case(FRACTURE), "p.toml"))
+    same = {"reservoir.E": 20.0e9, "reservoir.nu": 0.25}
+    twin = build_model(loads_case(_case(FRACTURE, PORE, **same), "p.toml"))
     diff = abs(plain.bulk.K - twin.bulk.K).max()
     assert diff <= 1e-12 * abs(plain.bulk.K).max()
-    soft = build_model(loads_case(BASE.format(extra=FRACTURE + PORE), "p.toml"))
+    soft = build_model(loads_case(_case(FRACTURE, PORE), "p.toml"))
     assert abs(plain.bulk.K - soft.bulk.K).max() > 0.1 * abs(plain.bulk.K).max()
     assert np.count_nonzero(soft.materials.cell) == 20  # 2 rows of 10 cells
 
@@ -148,7 +132,7 @@ def test_reservoir_with_host_constants_gives_the_same_stiffness():
 def test_body_load_is_self_equilibrated_and_points_inwards():
     """F_body = int B^T m alpha dp: zero resultant, and under depletion the
     forces on the reservoir's top nodes point down, on its bottom nodes up."""
-    model = build_model(loads_case(BASE.format(extra=FRACTURE + PORE), "p.toml"))
+    model = build_model(loads_case(_case(FRACTURE, PORE), "p.toml"))
     F = body_load(model.mesh, model.bulk, model.pore, model.ec, model.kernels)
     n_std = 2 * model.mesh.n_nodes
     Fs = F[:n_std].reshape(-1, 2)
@@ -176,7 +160,7 @@ def runner():
 
 def test_check_prints_the_new_tables(runner, tmp_path):
     case = tmp_path / "p.toml"
-    case.write_text(BASE.format(extra=FRACTURE + PORE))
+    case.write_text(_case(FRACTURE, PORE))
     result = runner.invoke(cli, ["check", str(case)])
     assert result.exit_code == 0, result.output
     assert "pore pressure: initial 3e+07 Pa, change -2e+07 Pa" in result.output
@@ -187,9 +171,7 @@ def test_check_prints_the_new_tables(runner, tmp_path):
 
 def test_check_prints_the_polygon_and_refuses_a_bad_one(runner, tmp_path):
     case = tmp_path / "p.toml"
-    text = BASE.format(
-        extra=FRACTURE + PORE.replace("box = [0.0, 20.0, 100.0, 40.0]", L_POLYGON)
-    )
+    text = _case(FRACTURE, PORE, **L_POLYGON)
     case.write_text(text)
     result = runner.invoke(cli, ["check", str(case)])
     assert result.exit_code == 0, result.output
@@ -197,8 +179,9 @@ def test_check_prints_the_polygon_and_refuses_a_bad_one(runner, tmp_path):
         "in polygon [0, 20]; [100, 20]; [100, 40]; [30, 40]; [30, 60]; [0, 60] m"
         in (result.output)
     )
+    crossed = [*L_POINTS[:4], L_POINTS[5], L_POINTS[4]]
     case.write_text(
-        text.replace("[30.0, 60.0], [0.0, 60.0]", "[0.0, 60.0], [30.0, 60.0]")
+        _case(FRACTURE, PORE, **{**L_POLYGON, "reservoir.polygon": crossed})
     )
     result = runner.invoke(cli, ["check", str(case)])
     assert result.exit_code == 2
@@ -208,7 +191,7 @@ def test_check_prints_the_polygon_and_refuses_a_bad_one(runner, tmp_path):
 
 def test_bad_key_exits_2_with_one_line(runner, tmp_path):
     case = tmp_path / "bad.toml"
-    case.write_text(BASE.format(extra=PORE.replace("nu = 0.2", "nu = 0.7")))
+    case.write_text(_case(PORE, **{"reservoir.nu": 0.7}))
     result = runner.invoke(cli, ["run", str(case), "-o", str(tmp_path / "o")])
     assert result.exit_code == 2
     lines = result.stderr.strip().splitlines()
@@ -218,7 +201,7 @@ def test_bad_key_exits_2_with_one_line(runner, tmp_path):
 
 def test_deplete_without_pore_pressure_exits_2(runner, tmp_path):
     case = tmp_path / "dry.toml"
-    case.write_text(BASE.format(extra=FRACTURE))
+    case.write_text(_case(FRACTURE))
     result = runner.invoke(cli, ["deplete", str(case), "-o", str(tmp_path / "o")])
     assert result.exit_code == 2
     assert "[pore_pressure]" in result.stderr
@@ -227,7 +210,7 @@ def test_deplete_without_pore_pressure_exits_2(runner, tmp_path):
 
 def test_deplete_writes_tables_and_fields(runner, tmp_path):
     case = tmp_path / "dep.toml"
-    case.write_text(BASE.format(extra=FRACTURE + PORE))
+    case.write_text(_case(FRACTURE, PORE))
     out = tmp_path / "out"
     result = runner.invoke(
         cli, ["deplete", str(case), "-o", str(out), "--tolerance", "5e4", "-q"]
@@ -260,9 +243,8 @@ def test_plots_and_screen_use_the_effective_stress(runner, tmp_path):
     defaults to the case's far-field pore pressure (region "all": p0 + dp)."""
     from xfemslip.plot.data import figure_data
 
-    extra = FRACTURE + PORE.replace('region = "reservoir"', 'region = "all"')
     case = tmp_path / "all.toml"
-    case.write_text(BASE.format(extra=extra))
+    case.write_text(_case(FRACTURE, PORE, **{"pore_pressure.region": "all"}))
     out = tmp_path / "out"
     assert runner.invoke(cli, ["run", str(case), "-o", str(out), "-q"]).exit_code == 0
     data = figure_data(out / "result.h5")
@@ -285,7 +267,7 @@ def test_bisection_trial_falls_back_to_step_cutting(monkeypatch):
     from xfemslip.studies.depletion import critical_depletion
 
     def run(fail_call):
-        model = build_model(loads_case(BASE.format(extra=FRACTURE + PORE), "p.toml"))
+        model = build_model(loads_case(_case(FRACTURE, PORE), "p.toml"))
         solver = newton_solver(model)
         real, calls = solver._newton, []
 
@@ -327,7 +309,7 @@ def test_deplete_failure_keeps_the_converged_steps(runner, tmp_path, monkeypatch
 
     monkeypatch.setattr(solver_module.NewtonSolver, "_newton", newton)
     case = tmp_path / "dep.toml"
-    case.write_text(BASE.format(extra=FRACTURE + PORE))
+    case.write_text(_case(FRACTURE, PORE))
     out = tmp_path / "out"
     result = runner.invoke(cli, ["deplete", str(case), "-o", str(out), "-q"])
     assert result.exit_code == 1
@@ -343,31 +325,27 @@ def test_deplete_failure_keeps_the_converged_steps(runner, tmp_path, monkeypatch
 # A vertical fracture through the whole domain at x = 0.5, in the middle of
 # the column 0.4 < x < 0.6; the reservoir box is the part left of it, so its
 # edge x = 0.5 runs along the fracture, mid-cell.
-SPLIT = """
-[mesh]
-x = [0.0, 0.2, 0.4, 0.6, 0.8, 1.0]
-y = [0.0, 0.3, 0.6, 1.0]
-[material]
-E = 20.0e9
-nu = 0.25
-[reservoir]
-box = [0.0, 0.0, 0.5, 1.0]
-E = {E}
-nu = 0.3
-[pore_pressure]
-initial = 30.0e6
-change = -20.0e6
-biot = 0.7
-region = "reservoir"
-[[fractures]]
-points = [[0.5, 0.0], [0.5, 1.0]]
-friction = 0.5
-[loading]
-initial_stress = {{ xx = -44.0e6, yy = -62.0e6 }}
-[boundary]
-left = {{ ux = 0.0 }}
-bottom = {{ uy = 0.0 }}
-"""
+def _split_case(E) -> str:
+    """The case above with the reservoir's Young's modulus E [Pa]."""
+    return build.case_text(
+        {
+            "mesh": {
+                "x": [0.0, 0.2, 0.4, 0.6, 0.8, 1.0],
+                "y": [0.0, 0.3, 0.6, 1.0],
+            },
+            "material": {"E": 20.0e9, "nu": 0.25},
+            "reservoir": {"box": [0.0, 0.0, 0.5, 1.0], "E": E, "nu": 0.3},
+            "pore_pressure": {
+                "initial": 30.0e6,
+                "change": -20.0e6,
+                "biot": 0.7,
+                "region": "reservoir",
+            },
+            "fractures": [{"points": [[0.5, 0.0], [0.5, 1.0]], "friction": 0.5}],
+            "loading": {"initial_stress": {"xx": -44.0e6, "yy": -62.0e6}},
+            "boundary": {"left": {"ux": 0.0}, "bottom": {"uy": 0.0}},
+        }
+    )
 
 
 def _hat(nodes, v):
@@ -391,7 +369,7 @@ def test_body_load_splits_cut_cells_at_the_fracture(caplog):
     enriched (Heaviside, shifted) dof of node a carries (H_R - H_a) times the
     same integral (H_R = +1: R is the fracture's + side).  Classifying the cut
     cells by their centre (x = 0.5, in neither part) drops their load."""
-    model = build_model(loads_case(SPLIT.format(E=20.0e9), "split.toml"))
+    model = build_model(loads_case(_split_case(20.0e9), "split.toml"))
     assert "not on a mesh line" not in caplog.text  # the fracture covers the edge
     mesh, pore = model.mesh, model.pore
     F = body_load(mesh, model.bulk, pore, model.ec, model.kernels)
@@ -429,7 +407,7 @@ def test_enriched_stiffness_takes_the_material_of_each_quadrature_point():
     from tests.support.bulk_reference import enriched_reference
     from xfemslip.fem.assembly import _enriched_matrices
 
-    model = build_model(loads_case(SPLIT.format(E=5.0e9), "split.toml"))
+    model = build_model(loads_case(_split_case(5.0e9), "split.toml"))
     ec, mats = model.ec, model.materials
     assert set(np.unique(mats.qp)) == {0, 1}
     K, _ = _enriched_matrices(
@@ -459,52 +437,87 @@ def test_enriched_stiffness_takes_the_material_of_each_quadrature_point():
 
 
 # ------------------------------------------------------------ polygon reservoir
-L_BOXES = "boxes = [[0.0, 20.0, 100.0, 40.0], [0.0, 40.0, 30.0, 60.0]]"
-L_POLYGON = (
-    "polygon = [[0.0, 20.0], [100.0, 20.0], [100.0, 40.0], [30.0, 40.0], "
-    "[30.0, 60.0], [0.0, 60.0]]"
-)
+L_POINTS = [
+    [0.0, 20.0],
+    [100.0, 20.0],
+    [100.0, 40.0],
+    [30.0, 40.0],
+    [30.0, 60.0],
+    [0.0, 60.0],
+]
+NO_BOX = {"reservoir.box": None}
+L_BOXES = {
+    **NO_BOX,
+    "reservoir.boxes": [[0.0, 20.0, 100.0, 40.0], [0.0, 40.0, 30.0, 60.0]],
+}
+L_POLYGON = {**NO_BOX, "reservoir.polygon": L_POINTS}
 
 
 @pytest.mark.parametrize(
-    "shape, key, words",
+    "keys, key, words",
     [
-        ("polygon = [[0.0, 20.0], [100.0, 20.0]]", "reservoir.polygon", "at least 3"),
         (
-            "polygon = [[0.0, 20.0], [100.0, 20.0, 1.0], [50.0, 40.0]]",
+            {**NO_BOX, "reservoir.polygon": [[0.0, 20.0], [100.0, 20.0]]},
+            "reservoir.polygon",
+            "at least 3",
+        ),
+        (
+            {
+                **NO_BOX,
+                "reservoir.polygon": [[0.0, 20.0], [100.0, 20.0, 1.0], [50.0, 40.0]],
+            },
             "reservoir.polygon[1]",
             "2 numbers",
         ),
         (
-            "polygon = [[0.0, 20.0], [100.0, 40.0], [100.0, 20.0], [0.0, 40.0]]",
+            {
+                **NO_BOX,
+                "reservoir.polygon": [
+                    [0.0, 20.0],
+                    [100.0, 40.0],
+                    [100.0, 20.0],
+                    [0.0, 40.0],
+                ],
+            },
             "reservoir.polygon",
             "edges 0 and 2 cross",
         ),
         (
-            "polygon = [[0.0, 20.0], [50.0, 30.0], [100.0, 40.0]]",
+            {**NO_BOX, "reservoir.polygon": [[0.0, 20.0], [50.0, 30.0], [100.0, 40.0]]},
             "reservoir.polygon",
             "zero area",
         ),
         (
-            "polygon = [[0.0, 20.0], [0.0, 20.0], [50.0, 30.0], [0.0, 40.0]]",
+            {
+                **NO_BOX,
+                "reservoir.polygon": [
+                    [0.0, 20.0],
+                    [0.0, 20.0],
+                    [50.0, 30.0],
+                    [0.0, 40.0],
+                ],
+            },
             "reservoir.polygon",
             "coincide",
         ),
         (
-            "polygon = [[200.0, 0.0], [300.0, 0.0], [300.0, 50.0]]",
+            {
+                **NO_BOX,
+                "reservoir.polygon": [[200.0, 0.0], [300.0, 0.0], [300.0, 50.0]],
+            },
             "reservoir.polygon",
             "no element centre",
         ),
         (
-            "polygon = [[0.0, 20.0], [100.0, 20.0], ['a', 40.0]]",
+            {**NO_BOX, "reservoir.polygon": [[0.0, 20.0], [100.0, 20.0], ["a", 40.0]]},
             "reservoir.polygon[2][0]",
             "",
         ),
-        (L_POLYGON + "\nbox = [0.0, 20.0, 100.0, 40.0]", "reservoir", "exactly one of"),
+        ({"reservoir.polygon": L_POINTS}, "reservoir", "exactly one of"),
     ],
 )
-def test_bad_polygon_names_the_key(shape, key, words):
-    problems = _problems(PORE.replace("box = [0.0, 20.0, 100.0, 40.0]", shape))
+def test_bad_polygon_names_the_key(keys, key, words):
+    problems = _problems(**keys)
     assert any(k == key and words in m for k, m in problems.items()), problems
 
 
@@ -514,9 +527,7 @@ def test_polygon_equals_the_same_region_as_boxes():
     models = [
         build_model(
             loads_case(
-                BASE.format(
-                    extra=FRACTURE + PORE.replace("box = [0.0, 20.0, 100.0, 40.0]", s)
-                ),
+                _case(FRACTURE, PORE, **s),
                 "p.toml",
             )
         )
@@ -574,20 +585,10 @@ def test_polygon_edge_along_an_inclined_fault(caplog):
 def _trapezoid_case(fault):
     """Trapezoidal reservoir below the line (0, 7)-(100, 47), with or without a
     fault along that line."""
-    fracture = """
-[[fractures]]
-points = [[0.0, 7.0], [100.0, 47.0]]
-friction = 0.5
-"""
-    return BASE.format(
-        extra=f"""
-[pore_pressure]
-initial = 30.0e6
-change = -20.0e6
-region = "reservoir"
-[reservoir]
-polygon = [[0.0, 7.0], [100.0, 47.0], [100.0, 0.0], [0.0, 0.0]]
-E = 8.0e9
-nu = 0.2
-{fracture if fault else ""}"""
+    trapezoid = [[0.0, 7.0], [100.0, 47.0], [100.0, 0.0], [0.0, 0.0]]
+    fracture = {"points": [[0.0, 7.0], [100.0, 47.0]], "friction": 0.5}
+    return _case(
+        PORE,
+        **NO_BOX,
+        **{"reservoir.polygon": trapezoid, "fractures": [fracture] if fault else None},
     )

@@ -15,6 +15,7 @@ import numpy as np
 import pytest
 
 from tests.support.casegen import fracture_spec
+from xfemslip.case import build
 from xfemslip.errors import GeometryError
 from xfemslip.fem.enrichment import HEAVISIDE, build_enriched_cells, find_candidates
 from xfemslip.fem.mesh import build_mesh
@@ -237,32 +238,22 @@ def test_x_wedges_move_independently_only_with_junction_functions():
 
 
 def _case_text(polylines, n=20, tip="ramp", friction=0.0):
-    text = f"""
-[domain]
-size = [1.0, 1.0]
-[mesh]
-elements = [{n}, {n}]
-[material]
-E = 5.0e9
-nu = 0.3
-"""
-    for p in polylines:
-        text += f"""[[fractures]]
-points = {p!r}
-friction = {friction!r}
-kn = 5.0e12
-kt = 5.0e12
-tip = "{tip}"
-"""
-    text += """[loading]
-stress = { xx = -20.0e6, yy = -40.0e6, xy = 5.0e6 }
-[boundary]
-bottom = { uy = 0.0 }
-top = "traction"
-left = "traction"
-right = "traction"
-"""
-    return text
+    fracture = {"friction": friction, "kn": 5.0e12, "kt": 5.0e12, "tip": tip}
+    return build.case_text(
+        {
+            "domain": {"size": [1.0, 1.0]},
+            "mesh": {"elements": [n, n]},
+            "material": {"E": 5.0e9, "nu": 0.3},
+            "fractures": [dict(fracture, points=p) for p in polylines] or None,
+            "loading": {"stress": {"xx": -20.0e6, "yy": -40.0e6, "xy": 5.0e6}},
+            "boundary": {
+                "bottom": {"uy": 0.0},
+                "top": "traction",
+                "left": "traction",
+                "right": "traction",
+            },
+        }
+    )
 
 
 def _model(polylines, **kw):

@@ -23,6 +23,7 @@ the uniform traction sigma . n (the patch test), whatever their junctions.
 
 from __future__ import annotations
 
+import copy
 import logging
 import math
 import tomllib
@@ -30,12 +31,11 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-import tomli_w
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from tests.support.casegen import SHIPPED_DFN, fracture_spec
-from xfemslip.case import loads_case
+from xfemslip.case import build, loads_case
 from xfemslip.errors import GeometryError
 from xfemslip.fem.mesh import build_mesh
 from xfemslip.geometry.dfn import intersecting_pairs
@@ -338,42 +338,37 @@ def test_tricky_pairs_and_triples_build_with_consistent_junctions(segments):
 
 # ------------------------------------------------- generated networks
 
-TEST_TABLE = """
-[domain]
-size = [2.0, 1.0]
-[mesh]
-elements = [20, 10]
-[material]
-E = 5.0e9
-nu = 0.3
-[loading]
-stress = { xx = -20.0e6, yy = -40.0e6 }
-[boundary]
-bottom = { uy = 0.0 }
-top = "traction"
-[network]
-friction = 0.5
-[network.generate]
-seed = 3
-count = 40
-intersections = "allow"
-orientation = { distribution = "uniform" }
-length = { distribution = "constant", value = 0.2 }
-"""
+TEST_TABLE = {
+    "domain": {"size": [2.0, 1.0]},
+    "mesh": {"elements": [20, 10]},
+    "material": {"E": 5.0e9, "nu": 0.3},
+    "loading": {"stress": {"xx": -20.0e6, "yy": -40.0e6}},
+    "boundary": {"bottom": {"uy": 0.0}, "top": "traction"},
+    "network": {
+        "friction": 0.5,
+        "generate": {
+            "seed": 3,
+            "count": 40,
+            "intersections": "allow",
+            "orientation": {"distribution": "uniform"},
+            "length": {"distribution": "constant", "value": 0.2},
+        },
+    },
+}
 
 
 def _network_cases():
     """(name, TOML document): the allow network of test_case_network and the
     shipped DFN sweep's base, with its count and with 100 fractures."""
     dfn = tomllib.loads(Path(SHIPPED_DFN).read_text())["base"]
-    dense = tomllib.loads(tomli_w.dumps(dfn))
+    dense = copy.deepcopy(dfn)
     dense["network"]["generate"]["count"] = 100
-    return [("allow-40", tomllib.loads(TEST_TABLE)), ("dfn", dfn), ("dfn-100", dense)]
+    return [("allow-40", copy.deepcopy(TEST_TABLE)), ("dfn", dfn), ("dfn-100", dense)]
 
 
 def _generated(document, seed):
     document["network"]["generate"]["seed"] = seed
-    spec = loads_case(tomli_w.dumps(document), "generated.toml")
+    spec = loads_case(build.case_text(document), "generated.toml")
     (x0, y0), (w, h) = spec.origin, spec.size
     box = np.array([x0, x0 + w, y0, y0 + h])
     cell = min(np.diff(spec.mesh.x).min(), np.diff(spec.mesh.y).min())

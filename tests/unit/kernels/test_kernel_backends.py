@@ -19,7 +19,7 @@ import pytest
 
 from tests.support.casegen import sweep_member
 from xfemslip import kernels
-from xfemslip.case import load_case, loads_case
+from xfemslip.case import build, load_case, loads_case
 from xfemslip.conventions import OPEN, SLIP, STICK, TANGENT_CONSISTENT, TANGENT_SECANT
 from xfemslip.fem.assembly import _enriched_matrices
 from xfemslip.fem.enrichment import build_enriched_cells, find_candidates
@@ -61,15 +61,13 @@ def _enriched_both(text, folder):
 
 
 @pytest.mark.parametrize(
-    "case, edit",
-    [
-        ("reservoir_depletion.toml", ("elements = [50, 50]", "elements = [17, 23]")),
-        ("fracture_network.toml", ("elements = [80, 80]", "elements = [40, 40]")),
-    ],
+    "case, elements",
+    [("reservoir_depletion.toml", [17, 23]), ("fracture_network.toml", [40, 40])],
     ids=["branch-tip", "network-junctions"],
 )
-def test_enriched_cell_matrices_agree(case, edit, tmp_path):
-    text = (ROOT / "cases" / case).read_text().replace(*edit)
+def test_enriched_cell_matrices_agree(case, elements, tmp_path):
+    shipped = build.file_case(ROOT / "cases" / case, **{"mesh.elements": elements})
+    text = build.case_text(shipped)
     (K0, B0), (K1, B1) = _enriched_both(text, tmp_path)
     assert K1.shape == K0.shape and B1.shape == B0.shape
     assert K0.shape[0] > 50  # the case has enriched cells to compare
@@ -184,12 +182,16 @@ def test_shipped_reservoir_case_is_numpy_and_the_dfn_limit_is_numba(
     assert kernels.choose("auto", kernel_work(ec)) == "numba"
 
 
-def _small_case(backend: str, steps=3, friction=0.3) -> str:
-    text = (ROOT / "cases/reservoir_depletion.toml").read_text()
-    text = text.replace("elements = [50, 50]", "elements = [24, 24]")
-    text = text.replace("friction = 0.1", f"friction = {friction}")
-    text = text.replace("steps = 1", f"steps = {steps}")
-    return text.replace("[solver]", f'[solver]\nkernels = "{backend}"')
+def _small_case(backend: str, steps=3, friction=0.3, formats=("h5", "vtu")) -> str:
+    keys = {
+        "mesh.elements": [24, 24],
+        "fractures.0.friction": friction,
+        "loading.steps": steps,
+        "solver.kernels": backend,
+        "output.formats": formats,
+    }
+    case = build.file_case(ROOT / "cases/reservoir_depletion.toml", **keys)
+    return build.case_text(case)
 
 
 def test_whole_runs_agree(tmp_path):
@@ -212,11 +214,7 @@ def test_a_small_run_never_imports_numba(tmp_path):
     """The point of the NumPy backend: `xfemslip run` of a small case loads
     no Numba at all (no import, no target set-up, no compilation)."""
     case = tmp_path / "small.toml"
-    case.write_text(
-        _small_case("auto", steps=1).replace(
-            'formats = ["h5", "vtu"]', 'formats = ["h5"]'
-        )
-    )
+    case.write_text(_small_case("auto", steps=1, formats=["h5"]))
     code = (
         "import sys\n"
         "from xfemslip.cli import cli\n"

@@ -15,6 +15,8 @@ import pytest
 from click.testing import CliRunner
 
 from tests.support.casegen import SWEEP_BASE as BASE
+from tests.support.casegen import SWEEP_CASE as CASE
+from xfemslip.case import build
 from xfemslip.cli import cli
 from xfemslip.errors import UsageError
 from xfemslip.plot.data import FractureData, _piece_outlines, figure_data
@@ -44,11 +46,8 @@ def two_runs(tmp_path_factory):
     outs = []
     for angle in (45.0, 63.0):
         case = root / f"a{angle:g}.toml"
-        case.write_text(
-            BASE.replace("angle = 45.0", f"angle = {angle}").replace(
-                'formats = ["h5"]', 'formats = ["h5", "vtu"]'
-            )
-        )
+        keys = {"fractures.0.angle": angle, "output.formats": ["h5", "vtu"]}
+        case.write_text(build.case_text(build.with_keys(CASE, **keys)))
         out = root / f"{int(angle):03d}_angle={angle:g}"
         plot = ["--plot"] if angle == 45.0 else []
         result = runner.invoke(cli, ["run", str(case), "-o", str(out), *plot])

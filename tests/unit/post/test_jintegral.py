@@ -17,7 +17,7 @@ import math
 import numpy as np
 import pytest
 
-from xfemslip.case import load_case
+from xfemslip.case import build, load_case
 from xfemslip.fem.material import elasticity_matrix
 from xfemslip.post import jintegral as J
 from xfemslip.reference import closed_form as cf
@@ -175,25 +175,19 @@ def test_domain_leaving_the_mesh_is_refused(solved):
         J.stress_intensity_factors(s.model, s.u, s.contact, traction="raw")
 
 
-RESERVOIR_TIP_CASE = """
-[domain]
-size = [40.0, 40.0]
-[mesh]
-elements = [40, 40]
-[material]
-E = 20.0e9
-nu = 0.25
-[reservoir]
-box = [{x0}, 0.0, 40.0, 40.0]
-E = 5.0e9
-nu = 0.35
-[[fractures]]
-points = [[12.3, 14.1], [27.7, 25.9]]
-friction = 0.5
-[boundary]
-left = {{ ux = 0.0 }}
-bottom = {{ uy = 0.0 }}
-"""
+def _reservoir_tip_case(x0) -> str:
+    """A 40 m square, the reservoir right of x = x0, a fracture whose upper
+    tip (27.7, 25.9) lies in it."""
+    return build.case_text(
+        {
+            "domain": {"size": [40.0, 40.0]},
+            "mesh": {"elements": [40, 40]},
+            "material": {"E": 20.0e9, "nu": 0.25},
+            "reservoir": {"box": [x0, 0.0, 40.0, 40.0], "E": 5.0e9, "nu": 0.35},
+            "fractures": [{"points": [[12.3, 14.1], [27.7, 25.9]], "friction": 0.5}],
+            "boundary": {"left": {"ux": 0.0}, "bottom": {"uy": 0.0}},
+        }
+    )
 
 
 def test_tip_in_the_reservoir_uses_the_reservoir_material(monkeypatch, caplog):
@@ -203,7 +197,7 @@ def test_tip_in_the_reservoir_uses_the_reservoir_material(monkeypatch, caplog):
     domain across the reservoir edge is refused with a warning."""
     from xfemslip.case import loads_case
 
-    model = build_model(loads_case(RESERVOIR_TIP_CASE.format(x0=0.0), "r.toml"))
+    model = build_model(loads_case(_reservoir_tip_case(0.0), "r.toml"))
     tip = model.fractures[0].tips[1]
     mu_r = 5.0e9 / (2 * 1.35)
     kappa = cf.kolosov(0.35, "plane_strain")
@@ -230,6 +224,6 @@ def test_tip_in_the_reservoir_uses_the_reservoir_material(monkeypatch, caplog):
     assert k.k_ii == pytest.approx(K2, rel=1e-4)
     assert "both materials" not in caplog.text
     # reservoir edge x = 25 through the domain of the tip at (27.7, 25.9)
-    split = build_model(loads_case(RESERVOIR_TIP_CASE.format(x0=25.0), "r.toml"))
+    split = build_model(loads_case(_reservoir_tip_case(25.0), "r.toml"))
     J.stress_intensity_factors(split, u, zero, radius_cells=3.0)
     assert "holds both materials" in caplog.text

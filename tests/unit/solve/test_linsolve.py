@@ -11,7 +11,7 @@ import pytest
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
-from xfemslip.case import loads_case
+from xfemslip.case import build, loads_case
 from xfemslip.errors import CaseError
 from xfemslip.fem.assembly import coo_block
 from xfemslip.simulation import build_model
@@ -24,12 +24,10 @@ pytest.importorskip("pyamg")
 
 
 def _text(n, steps=1, fracture=True):
-    text = CASE.read_text().replace("elements = [50, 50]", f"elements = [{n}, {n}]")
-    text = text.replace("steps = 1", f"steps = {steps}")
+    keys = {"mesh.elements": [n, n], "loading.steps": steps}
     if not fracture:
-        start, end = text.index("[[fractures]]"), text.index("[loading]")
-        text = text[:start] + text[end:]
-    return text
+        keys["fractures"] = None
+    return build.case_text(build.file_case(CASE, **keys))
 
 
 def _newton_systems(n=30, steps=3):
@@ -166,10 +164,16 @@ def test_singular_matrix_is_reported_by_both_paths():
 def test_case_option(tmp_path):
     text = CASE.read_text()
     assert loads_case(text, CASE).solver.linear_solver == "auto"
-    spec = loads_case(text.replace("max_iterations = 30", 'linear_solver = "amg"'))
+
+    # the shipped [solver] table with linear_solver in place of max_iterations
+    def solver_is(name):
+        keys = {"solver.max_iterations": None, "solver.linear_solver": name}
+        return build.case_text(build.file_case(CASE, **keys))
+
+    spec = loads_case(solver_is("amg"))
     assert spec.solver.linear_solver == "amg"
     with pytest.raises(CaseError, match="solver.linear_solver: must be one of"):
-        loads_case(text.replace("max_iterations = 30", 'linear_solver = "lu"'), "c")
+        loads_case(solver_is("lu"), "c")
 
 
 @pytest.mark.slow

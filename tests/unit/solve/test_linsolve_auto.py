@@ -12,7 +12,7 @@ import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
 from tests.support.casegen import sweep_member
-from xfemslip.case import loads_case
+from xfemslip.case import build, loads_case
 from xfemslip.simulation import build_model, run_case
 from xfemslip.solve import linear as linsolve
 from xfemslip.solve.linear import LinearSolver, choose, system_facts
@@ -28,6 +28,11 @@ def _without_mkl(monkeypatch):
     """The rule of an install without the mkl extra (with it, "auto" takes
     PARDISO from AUTO_PARDISO_MIN_DOFS on: test_pardiso.py)."""
     monkeypatch.setattr(linsolve.pardiso, "available", lambda: False)
+
+
+def _reservoir(n) -> str:
+    """The shipped reservoir case on n x n cells."""
+    return build.case_text(build.file_case(CASE, **{"mesh.elements": [n, n]}))
 
 
 def _grid(n, sx=1.0, sy=1.0):
@@ -75,7 +80,7 @@ def test_solver_weighs_the_band(monkeypatch):
     follows the rule on both sides of the limit (the reservoir case on 30 x 30
     cells)."""
     monkeypatch.setattr(linsolve, "AUTO_AMG_MIN_DOFS", 100)
-    model = build_model(loads_case(CASE.read_text().replace("[50, 50]", "[30, 30]")))
+    model = build_model(loads_case(_reservoir(30)))
     newton = NewtonSolver(model.problem, 1e-8, 30, "consistent", "superlu")
     K, free, xy = newton.K_ff, newton.free, model.mesh.nodes
     share = system_facts(K, free, xy)["band_share"]
@@ -96,7 +101,7 @@ def test_auto_picks_per_case_end_to_end(tmp_path, monkeypatch, caplog):
     dofs) goes to AMG, a 30-fracture generated network on 30 x 30 cells (over
     90 %) to SuperLU.  The size floor is lowered so that both are small."""
     monkeypatch.setattr(linsolve, "AUTO_AMG_MIN_DOFS", 1000)
-    single = loads_case(CASE.read_text().replace("[50, 50]", "[40, 40]"), CASE)
+    single = loads_case(_reservoir(40), CASE)
     network = loads_case(NETWORK, "network.toml")
     chosen = {}
     for name, spec in (("single", single), ("network", network)):
@@ -173,7 +178,7 @@ def test_amg_fallback_is_counted_timed_and_logged(monkeypatch, caplog):
     is part of the solve time, the warning names the iterations and the time,
     and the next system goes straight to SuperLU."""
     monkeypatch.setattr(linsolve, "AMG_MAX_ITERATIONS", 2)
-    model = build_model(loads_case(CASE.read_text().replace("[50, 50]", "[20, 20]")))
+    model = build_model(loads_case(_reservoir(20)))
     newton = NewtonSolver(model.problem, 1e-8, 30, "consistent", "amg")
     ls = newton.linear
     rng = np.random.default_rng(2)

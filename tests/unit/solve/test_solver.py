@@ -8,7 +8,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from xfemslip.case import loads_case
+from xfemslip.case import build, loads_case
 from xfemslip.errors import ConvergenceError
 from xfemslip.simulation import build_model
 from xfemslip.solve.newton import NewtonSolver
@@ -17,9 +17,12 @@ CASE = Path(__file__).resolve().parents[3] / "cases" / "reservoir_depletion.toml
 
 
 def _solve(tangent, steps=1, n=20, friction=0.1):
-    text = CASE.read_text().replace("elements = [50, 50]", f"elements = [{n}, {n}]")
-    text = text.replace("friction = 0.1", f"friction = {friction}")
-    text = text.replace("steps = 1", f"steps = {steps}")
+    keys = {
+        "mesh.elements": [n, n],
+        "fractures.0.friction": friction,
+        "loading.steps": steps,
+    }
+    text = build.case_text(build.file_case(CASE, **keys))
     model = build_model(loads_case(text, CASE))
     # without the stick/slip predictor: these tests watch Newton's own
     # iterates settle (the predictor's first solve lands on the final set
@@ -70,8 +73,8 @@ E_OVER_H = 5.0e9 / 0.02
 def _stiff(ratio, tangent="consistent"):
     """The shipped reservoir with kn = kt = ratio * E/h, no step cutting."""
     kn = ratio * E_OVER_H
-    text = CASE.read_text().replace("kn = 5.0e12", f"kn = {kn!r}")
-    text = text.replace("kt = 5.0e12", f"kt = {kn!r}")
+    keys = {"fractures.0.kn": kn, "fractures.0.kt": kn}
+    text = build.case_text(build.file_case(CASE, **keys))
     model = build_model(loads_case(text, CASE))
     return NewtonSolver(model.problem, 1e-8, 30, tangent, max_step_cuts=0)
 

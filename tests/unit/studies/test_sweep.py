@@ -15,6 +15,8 @@ import pytest
 from click.testing import CliRunner
 
 from tests.support.casegen import SWEEP_BASE as BASE
+from tests.support.casegen import SWEEP_CASE as CASE
+from xfemslip.case import build
 from xfemslip.case.tables import Table
 from xfemslip.cli import cli
 from xfemslip.errors import CaseError
@@ -176,16 +178,7 @@ def test_product_and_zip(tmp_path, base):
 
 
 def test_unquoted_dotted_keys_and_inline_base(tmp_path):
-    inline = "\n".join(
-        (
-            "[base." + line[1:]
-            if line.startswith("[") and not line.startswith("[[")
-            else "[[base." + line[2:]
-            if line.startswith("[[")
-            else line
-        )
-        for line in BASE.splitlines()
-    ).replace('name = "tiny"', "")
+    inline = build.case_text({"base": build.with_keys(CASE, name=None)})
     body = "[vary]\nmaterial.E = { start = 1e9, stop = 3e9, num = 3 }\n" + inline
     sweep = loads_sweep(body, tmp_path / "inline.toml")
     assert sweep.keys == ("material.E",)
@@ -263,10 +256,10 @@ def test_invalid_generated_cases_are_named_with_their_parameters(tmp_path, base)
 
 def test_a_case_whose_geometry_cannot_be_built_is_refused_alone(tmp_path):
     # keys all valid, but the second case puts the two fractures on each other
-    two = BASE.replace("center = [0.5, 0.5]", "center = [0.5, 0.3]")
-    second = two[two.index("[[fractures]]") : two.index("[loading]")]
-    second = second.replace("[0.5, 0.3]", "[0.5, 0.7]")  # parallel to the first
-    (tmp_path / "base.toml").write_text(two.replace("[loading]", second + "[loading]"))
+    fracture = CASE["fractures"][0]
+    # a second fracture parallel to the first
+    two = [dict(fracture, center=[0.5, 0.3]), dict(fracture, center=[0.5, 0.7])]
+    (tmp_path / "base.toml").write_text(build.case_text(dict(CASE, fractures=two)))
     body = (
         'base = "base.toml"\n[vary]\n"fractures[1].center" = [[0.5, 0.7], [0.5, 0.3]]\n'
     )
@@ -410,7 +403,7 @@ def test_rerun_after_editing_the_base_runs_again(tmp_path, base):
     path = _sweep(tmp_path, 'base = "base.toml"\n[vary]\n"material.E" = [5e9]\n')
     out = tmp_path / "out"
     assert run_sweep(load_sweep(path), out)[0].status == "ok"
-    base.write_text(BASE.replace("nu = 0.3", "nu = 0.25"))
+    base.write_text(build.case_text(build.with_keys(CASE, **{"material.nu": 0.25})))
     rows = run_sweep(load_sweep(path), out)
     assert rows[0].status == "ok"  # same id, different case text: not skipped
     assert run_sweep(load_sweep(path), out, force=True)[0].status == "ok"
@@ -532,7 +525,7 @@ def test_case_ids_and_names_stay_folder_names(tmp_path, base):
     cid = case_id(7, 10, params)
     assert len(cid) == 100 and cid.startswith("007_key0=1.5_key1=1.5")
     long_name = "\u00e9" * 200  # 400 bytes
-    base.write_text(BASE.replace('name = "tiny"', f'name = "{long_name}"'))
+    base.write_text(build.case_text(dict(CASE, name=long_name)))
     body = 'base = "base.toml"\n[vary]\n"fractures[0].friction" = [0.1, 0.2]\n'
     spec = loads_sweep(body, tmp_path / "s.toml")
     for case in spec.cases:
@@ -541,9 +534,9 @@ def test_case_ids_and_names_stay_folder_names(tmp_path, base):
 
 
 def test_a_sweep_of_too_much_case_text_is_refused(tmp_path, base):
-    """A base of 6,000 inline fractures (~0.9 MB of TOML) times 10,000 cases."""
-    fracture = BASE[BASE.index("[[fractures]]") : BASE.index("[loading]")]
-    base.write_text(BASE.replace("[loading]", fracture * 6000 + "[loading]"))
+    """A base of 6,001 fractures (~0.8 MB of TOML) times 10,000 cases."""
+    many = dict(CASE, fractures=CASE["fractures"] * 6001)
+    base.write_text(build.case_text(many))
     body = (
         'base = "base.toml"\n[vary]\n'
         '"material.nu" = { start = 0.0, stop = 0.4, num = 10000 }\n'

@@ -3,6 +3,7 @@ per-fracture columns and dfn_summary.csv against the result.h5 files."""
 
 from __future__ import annotations
 
+import copy
 import csv
 
 import numpy as np
@@ -10,42 +11,46 @@ import pytest
 from click.testing import CliRunner
 
 import xfemslip
-from xfemslip.case import loads_case
+from xfemslip.case import build, loads_case
 from xfemslip.cli import cli
 
 # Reservoir stress state, friction 0.3: fractures near 45-60 degrees from
 # sigma_1 (vertical) slip, the others stick.  "allow" + "reject": seed 4
 # has two crossings (X), seed 6 a fracture ending on another (T).
-SWEEP = """
-name = "dfn3"
-[vary]
-"network.generate.seed" = { start = 4, stop = 6, step = 1 }
-[base]
-[base.domain]
-size = [1.0, 1.0]
-[base.mesh]
-elements = [20, 20]
-[base.material]
-E = 5.0e9
-nu = 0.3
-[base.network]
-friction = 0.3
-tip = "ramp"
-[base.network.generate]
-seed = 1
-count = 6
-intersections = "allow"
-outside = "reject"
-orientation = { distribution = "uniform" }
-length = { distribution = "power_law", exponent = 2.0, min = 0.25, max = 0.45 }
-[base.loading]
-stress = { xx = -20.0e6, yy = -40.0e6, xy = 0.0 }
-[base.boundary]
-bottom = { uy = 0.0 }
-top = "traction"
-left = "traction"
-right = "traction"
-"""
+DFN3 = {
+    "name": "dfn3",
+    "vary": {"network.generate.seed": {"start": 4, "stop": 6, "step": 1}},
+    "base": {
+        "domain": {"size": [1.0, 1.0]},
+        "mesh": {"elements": [20, 20]},
+        "material": {"E": 5.0e9, "nu": 0.3},
+        "network": {
+            "friction": 0.3,
+            "tip": "ramp",
+            "generate": {
+                "seed": 1,
+                "count": 6,
+                "intersections": "allow",
+                "outside": "reject",
+                "orientation": {"distribution": "uniform"},
+                "length": {
+                    "distribution": "power_law",
+                    "exponent": 2.0,
+                    "min": 0.25,
+                    "max": 0.45,
+                },
+            },
+        },
+        "loading": {"stress": {"xx": -20.0e6, "yy": -40.0e6, "xy": 0.0}},
+        "boundary": {
+            "bottom": {"uy": 0.0},
+            "top": "traction",
+            "left": "traction",
+            "right": "traction",
+        },
+    },
+}
+SWEEP = build.case_text(DFN3)
 OLD_COLUMNS = [
     "case",
     "network.generate.seed",
@@ -164,18 +169,16 @@ def test_a_realization_that_cannot_be_built_is_refused_and_the_others_run(tmp_pa
     """Seed 5 also moves the inline fracture out of the domain: that case is
     reported (one line on stderr, a 'refused' row) and not run, seeds 4 and
     6 run; exit code 1; dfn_summary.csv counts 2 realizations and 1 left out."""
-    inline = (
-        "[[base.fractures]]\npoints = [[0.05, 0.05], [0.15, 0.1]]\nfriction = 0.3\n"
-        'tip = "ramp"\n'
-    )
-    body = SWEEP.replace("[base.loading]", inline + "[base.loading]")
-    body = body.replace(
-        '"network.generate.seed" = { start = 4, stop = 6, step = 1 }',
-        '"network.generate.seed" = [4, 5, 6]\n'
-        '"fractures[0].points" = [[[0.05, 0.05], [0.15, 0.1]], '
-        "[[3.05, 0.05], [3.15, 0.1]], [[0.05, 0.05], [0.15, 0.1]]]",
-    )
-    body = body.replace('name = "dfn3"', 'name = "dfn3"\ncombine = "zip"')
+    inline = [[0.05, 0.05], [0.15, 0.1]]
+    outside = [[3.05, 0.05], [3.15, 0.1]]
+    document = copy.deepcopy(DFN3)
+    document["combine"] = "zip"
+    document["vary"] = {
+        "network.generate.seed": [4, 5, 6],
+        "fractures[0].points": [inline, outside, inline],
+    }
+    document["base"]["fractures"] = [{"points": inline, "friction": 0.3, "tip": "ramp"}]
+    body = build.case_text(document)
     path = tmp_path / "dfn3.toml"
     path.write_text(body)
     out = tmp_path / "out"
