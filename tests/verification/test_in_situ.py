@@ -139,7 +139,7 @@ def test_critically_stressed_crack_slips_as_if_loaded_from_zero(tmp_path):
     # released slip lacks the elastic penalty jump tau0 / kt = 2e-6 m
     assert np.abs(slip_r - slip_l).max() < 1.5 * 10.0e6 / peer.PENALTY
     assert np.all(state == SLIP)
-    assert np.abs(slip_r).max() > 4.9e-3  # 5.06 mm: the old answer was 0
+    assert np.abs(slip_r).max() > 4.9e-3  # 5.06 mm, not the unreleased 0
 
 
 def _edge_forces(mesh, boundary_free, stress):

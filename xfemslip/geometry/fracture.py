@@ -50,16 +50,17 @@ MAX_PIECES_PER_CELL = 12
 DISTANCE_CHUNK = 1 << 19
 
 # Crack-tip treatment when the case does not choose one (see enrichment.py and
-# benchmarks/RESULTS.md): branch functions on the nodes within a radius of each
+# docs/method.md, *Enrichment*): branch functions on the nodes within a radius of each
 # tip.  The automatic radius is geometric, TIP_RADIUS_FRACTION of the fracture's
 # length (a fixed region as h -> 0 is what gives the optimal convergence order,
 # Laborde et al. 2005, IJNME 64), kept between TIP_RADIUS_CELLS and
 # TIP_RADIUS_MAX_CELLS tip-cell sizes: at least enough nodes for the functions to
 # act, at most a bounded number of enriched nodes per tip (the cost and the
 # conditioning grow with (radius / h)^2).  Measured on the inclined crack
-# (benchmarks/RESULTS.md), slip L2 error at h = a/10, a/20, a/40: 0.80 / 0.41 /
-# 0.16 % with this 6-cell cap (order 1.18), 0.14 % with an 8-cell cap, 0.23 %
-# with 5 cells (order 0.91), 0.29 % with a fixed 4-cell radius.  The cap of 8
+# (docs/performance.md, *Accuracy against run time*), slip L2 error at
+# h = a/10, a/20, a/40: 0.80 / 0.41 / 0.16 % with this 6-cell cap (order
+# 1.18), 0.14 % with an 8-cell cap, 0.23 % with 5 cells (order 0.91), 0.29 %
+# with a fixed 4-cell radius.  The cap of 8
 # made the SuperLU factorization of the 160 x 160 reservoir case 3x slower than
 # 4 cells (its band of changed dofs too wide to keep the factorization); 6
 # costs 2x, the price of order >= 1.

@@ -120,8 +120,8 @@ JUNCTION_SNAP_CELLS = 0.5
 # A snap turns an end segment by up to atan(snap / its length); below 10 deg
 # it would join fractures that run alongside each other (a near-parallel
 # pair, en echelon ends, a near copy) into a sliver a few cells long, which
-# the cells cannot resolve either way (benchmarks/RESULTS.md, "Buildable
-# fracture networks": the snaps this refuses and what they change).
+# the cells cannot resolve either way (docs/performance.md, "Buildable
+# networks": the snaps this refuses and what they change).
 JUNCTION_MIN_ANGLE = 10.0  # [deg]
 # A snap may shorten an end segment (a trim, a V); it must not make it vanish
 # or leave a stub far below the cell size.

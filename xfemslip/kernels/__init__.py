@@ -35,7 +35,7 @@ KERNELS = (
 )
 # "auto" takes NumPy up to this many enriched-cell quadrature points times
 # (8 + 2 S)^2 (simulation.kernel_work), and Numba above.  Measured
-# (benchmarks/kernels_backend.py, RESULTS.md *Kernel backends*): NumPy's
+# (benchmarks/kernels_backend.py, docs/performance.md *Kernel backends*): NumPy's
 # enriched-cell assembly and contact law cost 0.06 s more than Numba's on the
 # 50 x 50 reservoir case (work 3.6e7) and about 0.35 s more on the shipped
 # 15-fracture network (1.9e8), against about 0.5 s of Numba import and

@@ -37,7 +37,7 @@ def rectangle_stiffness(hx, hy, D):
     plain Q4 is too stiff by parasitic shear.  That stiffness grows with
     (cell length / length scale of the field)^2, which is what the coarse,
     elongated cells of a graded far field see; it made the slip of a crack
-    converge to a floor (benchmarks/RESULTS.md, "Slip convergence on the
+    converge to a floor (docs/performance.md, "Slip convergence on the
     OpenGeoSys peer problem").  Enriched cells stay plain Q4 (the bubbles are
     internal to each cell, so the two kinds of cells are conforming).
     2x2 Gauss is exact for every term (at most quadratic in xi or eta).

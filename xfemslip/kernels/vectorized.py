@@ -4,7 +4,7 @@ without importing Numba.
 
 Why two implementations: a warm ``xfemslip run`` of a small case paid about
 0.2 s to import Numba and 0.3 s for its target set-up at the first cached
-dispatch (benchmarks/RESULTS.md, *Start-up*), against a few milliseconds of
+dispatch (docs/performance.md, *Start-up*), against a few milliseconds of
 kernel work on a 50 x 50 mesh; a first run after install paid about 9 s of
 compilation.  Every kernel here is a loop over independent cells or points,
 which NumPy does as whole-array operations: the intact cells share one

@@ -11,7 +11,7 @@ mesh is rectilinear: cells of size h on [-fine, fine]^2 (the crack and a
 margin), growing by ``growth`` per cell to the edges.  Reference:
 closed_form.slip_profile (the infinite plane; a finite traction box is
 softer, by about +0.55 % of the slip at half = 10 m, falling like
-(A / half)^2: benchmarks/RESULTS.md, "Slip convergence on the OpenGeoSys
+(A / half)^2: docs/performance.md, "Slip convergence on the OpenGeoSys
 peer problem").
 """
 

@@ -50,7 +50,7 @@ PINGPONG_PERIODS = 3
 # the release is let through) left 5 of the 20 allow-DFN seeds failing with
 # the predictor on; without a limit a patch can be held and released
 # forever (seed 1, predictor off); 2 and 3 converge on all 20 seeds both
-# ways (benchmarks/RESULTS.md, "Newton on fracture networks").
+# ways (docs/networks.md, "Newton on networks").
 REVERSAL_HOLDS = 2
 # Local branch searches (xfemslip.contact.branches) per Newton solve: a patch
 # that reverses its slip again after REVERSAL_HOLDS holds has no consistent

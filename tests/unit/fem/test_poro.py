@@ -108,7 +108,8 @@ def test_initial_pressure_needs_initial_stress():
 
 
 def test_absent_tables_change_nothing():
-    """Without the new tables the specs are None and the model is the old one."""
+    """Without [pore_pressure] and [reservoir] the specs are None and the model
+    is that of a case without pore pressure."""
     spec = loads_case(_case(FRACTURE), "p.toml")
     assert spec.pore_pressure is None and spec.reservoir is None
     model = build_model(spec)

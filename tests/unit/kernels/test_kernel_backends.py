@@ -166,7 +166,7 @@ def test_choose(monkeypatch):
 def test_shipped_reservoir_case_is_numpy_and_the_dfn_limit_is_numba(
     monkeypatch, tmp_path
 ):
-    """Where the measured rule puts the shipped cases (RESULTS.md, *Kernel
+    """Where the measured rule puts the shipped cases (docs/performance.md, *Kernel
     backends*): the 50 x 50 reservoir case and the 15-fracture network below
     the limit, 100 generated fractures on 200 x 200 cells above it."""
     monkeypatch.delenv(kernels.ENV_OVERRIDE, raising=False)
