@@ -192,13 +192,12 @@ def event_sizes(result: Result, inputs: EventInputs) -> list[list[FractureEvent]
 # In words
 
 MOMENT_HEAD = "M0' [N m/m]"
+W_SOURCE = {True: "events.extent", False: "the slipping length"}
 # --------------------------------------------------------------------------- #
 
 
 def _w_text(event: FractureEvent, inputs: EventInputs) -> str:
-    if inputs.extent is not None:
-        return f"W = {event.extent:.3g} m (events.extent)"
-    return f"W = {event.extent:.3g} m (the slipping length)"
+    return f"W = {event.extent:.3g} m ({W_SOURCE[inputs.extent is not None]})"
 
 
 def _mw_text(event: FractureEvent) -> str:
@@ -212,13 +211,12 @@ def summary_lines(events: list[FractureEvent], inputs: EventInputs) -> list[str]
     head = (
         f"{'fracture':>8}  {'slipped':>7}  {'max slip [mm]':>13}  "
         f"{'slipping [m]':>12}  {MOMENT_HEAD:>12}  {'drop [MPa]':>10}  "
-        f"{'Mw':>6}  W [m]"
+        f"{'Mw':>6}  W [m] ({W_SOURCE[inputs.extent is not None]})"
     )
     lines = [head]
     for e in events:
         drop = f"{e.stress_drop / 1e6:.3g}" if math.isfinite(e.stress_drop) else "-"
         w = f"{e.extent:.3g}" if e.extent > 0 else "-"
-        w += " (events.extent)" if inputs.extent is not None else " (slipping length)"
         lines.append(
             f"{e.fracture:>8}  {'yes' if e.slipped else 'no':>7}  "
             f"{e.max_slip * 1e3:>13.4g}  {e.slipping_length:>12.4g}  "
