@@ -93,3 +93,29 @@ def test_moment_of_the_released_crack_matches_the_closed_form(tmp_path):
         np.array([A]), A, E, NU, "plane_strain", SIGMA0, 45.0, F
     )[0]
     assert event.max_slip == pytest.approx(abs(exact_max), rel=0.02)
+
+
+def test_shipped_seismic_event_case_against_its_closed_form(tmp_path):
+    """cases/seismic_event.toml: a 200 m fault at 60 degrees in (-25, -50)
+    MPa with friction 0.3 (dtau = 1.45 MPa), released in situ; `run` prints
+    M0' within 1.5 % of pi a^2 (kappa + 1) dtau / 4 and Mw for W = 500 m."""
+    from pathlib import Path
+
+    from click.testing import CliRunner
+
+    from xfemslip.cli import cli
+
+    case = Path(__file__).parents[2] / "cases" / "seismic_event.toml"
+    out = tmp_path / "out"
+    run = CliRunner().invoke(cli, ["run", str(case), "-o", str(out)])
+    assert run.exit_code == 0, run.output
+    angle, a, nu, friction, extent = 60.0, 100.0, 0.25, 0.3, 500.0
+    stress = (-25.0e6, -50.0e6, 0.0)
+    dtau = abs(cf.driving_shear(stress, angle, friction))
+    exact = math.pi * a**2 * (4.0 - 4.0 * nu) * dtau / 4.0
+    result = xfemslip.read_result(out)
+    ((event,),) = event_sizes(result, event_inputs(result))[-1:]
+    assert abs(event.moment_per_length / exact - 1.0) < 0.015  # measured 1.05 %
+    mw = (2 / 3) * (math.log10(event.moment_per_length * extent) - 9.1)
+    assert run.output.strip().endswith(f"Mw {mw:.2f} for W = 500 m (events.extent)")
+    assert abs(mw - (2 / 3) * (math.log10(exact * extent) - 9.1)) < 0.005
