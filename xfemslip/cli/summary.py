@@ -17,27 +17,38 @@ from xfemslip.cli.common import debug_option, reported_errors
 __all__ = ["event_report", "summary"]
 
 
-def event_report(result, spec=None) -> list[str]:
-    """The lines printed for ``result`` (its final converged step); ``spec``
-    the case when at hand, else rebuilt from the result's case text.  None
-    without a converged step (the status line before says so)."""
+def event_report(result, spec=None, every_step: bool = False) -> list[str]:
+    """The lines printed for ``result``: its final converged step, or every
+    one; ``spec`` the case when at hand, else rebuilt from the result's case
+    text.  None without a converged step (the status line before says so)."""
     from xfemslip.post.events import event_inputs, event_sizes, summary_lines
 
     if not result.steps:
         return []
     inputs = event_inputs(result, spec)
-    final = result.steps[-1]
-    head = (
-        f"fractures at step {final.step} of {result.load_steps} "
-        f"(load factor {final.load_factor:.4g}), slip cumulative over the steps:"
-    )
-    return [head, *summary_lines(event_sizes(result, inputs)[-1], inputs)]
+    sizes = event_sizes(result, inputs)
+    shown = range(len(sizes)) if every_step else [len(sizes) - 1]
+    lines = []
+    for k in shown:
+        step = result.steps[k]
+        lines.append(
+            f"fractures at step {step.step} of {result.load_steps} "
+            f"(load factor {step.load_factor:.4g}), slip cumulative over the steps:"
+        )
+        lines += summary_lines(sizes[k], inputs)
+    return lines
 
 
 @click.command()
 @click.argument("result_path", metavar="RESULT", type=click.Path(path_type=Path))
+@click.option(
+    "--steps",
+    "every_step",
+    is_flag=True,
+    help="A table for every converged load step, not only the last.",
+)
 @debug_option
-def summary(result_path: Path, debug: bool) -> None:
+def summary(result_path: Path, every_step: bool, debug: bool) -> None:
     """Print what happened in the run that wrote RESULT (a result.h5 or its
     folder): per fracture whether it slipped, max slip, slipping length,
     moment per unit length, stress drop and magnitude with its extent W."""
@@ -53,7 +64,7 @@ def summary(result_path: Path, debug: bool) -> None:
         )
         if not result.steps:
             click.echo("no converged load step: nothing to report on the fractures")
-        for line in event_report(result):
+        for line in event_report(result, every_step=every_step):
             click.echo(line)
 
 

@@ -23,7 +23,9 @@ E, NU = 10.0e9, 0.25
 MU = E / (2 * (1 + NU))
 # two fractures at 45 degrees, |tau| = 10 MPa on sigma_n = -30 MPa: with
 # friction 0.1 the first slips, with 0.6 the second sticks; a third, at
-# 0 degrees with no shear on it, sticks too
+# 0 degrees with no shear on it, sticks too.  The top edge then moves down
+# by 0.2 mm over the two steps (about 1 MPa more vertical compression): the
+# first slips further, the others keep stuck.
 FRACTURES = (
     ([[0.3, 0.3], [0.6, 0.6]], 0.1),
     ([[1.3, 0.3], [1.6, 0.6]], 0.6),
@@ -43,7 +45,7 @@ initial_stress = {{ xx = -20.0e6, yy = -40.0e6 }}
 steps = 2
 [boundary]
 bottom = {{ uy = 0.0 }}
-top = {{ uy = 0.0 }}
+top = {{ uy = -2.0e-4 }}
 left = {{ ux = 0.0 }}
 right = {{ ux = 0.0 }}
 [output]
@@ -137,6 +139,23 @@ def test_summary_prints_the_same_table_for_the_result_folder(ran):
     assert result.output.splitlines()[-(len(FRACTURES) + 3) :] == tail
     again = CliRunner().invoke(cli, ["summary", str(out / "result.h5")])
     assert again.output == result.output
+
+
+def test_summary_steps_prints_a_table_per_load_step(ran):
+    """The table of each step is that step's arrays (the slip grows from
+    step 1 to step 2 as the top edge moves down)."""
+    _, out = ran
+    result = CliRunner().invoke(cli, ["summary", str(out), "--steps"])
+    assert result.exit_code == 0, result.output
+    read = xfemslip.read_result(out)
+    blocks = result.output.split("fractures at step ")[1:]
+    assert [b.split(" ", 1)[0] for b in blocks] == ["1", "2"]
+    first, second = (np.abs(s.fractures[0].slip).max() for s in read.steps)
+    assert second > 1.01 * first
+    for block, step in zip(blocks, read.steps, strict=True):
+        rows = _table("\n".join(block.splitlines()[1:]))
+        for row, ff in zip(rows, step.fractures, strict=True):
+            assert float(row[2]) == pytest.approx(np.abs(ff.slip).max() * 1e3, 1e-3)
 
 
 def test_quiet_run_leaves_the_table_out(tmp_path):
