@@ -15,14 +15,16 @@ nesting cap, path checks), ``grid`` (``[domain]``, ``[mesh]``), ``fractures``
 (``[[fractures]]`` and polyline checks), ``boundary`` (``[boundary]`` and its
 CSV files), ``network``, ``segments`` and ``generate`` (``[network]``: a CSV
 file of segments, random networks), ``pore`` (``[pore_pressure]``,
-``[reservoir]``), ``describe`` (the ``xfemslip check`` printout) and
-``build`` (case text from Python values, for tests and benchmarks).
+``[reservoir]``), ``events`` (``[events]``), ``describe`` (the ``xfemslip
+check`` printout) and ``build`` (case text from Python values, for tests and
+benchmarks).
 """
 
 from __future__ import annotations
 
 from xfemslip.case.boundary import CSV_HEADER, EDGE_KEYS, EDGE_WORDS
 from xfemslip.case.describe import describe
+from xfemslip.case.events import EVENTS_KEYS
 from xfemslip.case.files import (
     CSV_TOLERANCE,
     MAX_CSV_BYTES,
@@ -57,6 +59,7 @@ from xfemslip.case.specs import (
     BoundarySpec,
     CaseSpec,
     EdgeSpec,
+    EventsSpec,
     FractureSpec,
     LoadingSpec,
     MaterialSpec,
@@ -78,6 +81,7 @@ __all__ = [
     "EDGES",
     "EDGE_KEYS",
     "EDGE_WORDS",
+    "EVENTS_KEYS",
     "FRACTURE_KEYS",
     "MATERIAL_MODELS",
     "MAX_CSV_BYTES",
@@ -99,6 +103,7 @@ __all__ = [
     "BoundarySpec",
     "CaseSpec",
     "EdgeSpec",
+    "EventsSpec",
     "FractureSpec",
     "LoadingSpec",
     "MaterialSpec",

@@ -196,6 +196,17 @@ def _describe_pore(spec: CaseSpec) -> list[str]:
     return lines
 
 
+def _describe_events(spec: CaseSpec) -> str:
+    """The out-of-plane extent W that moment magnitudes use."""
+    extent = spec.events.extent if spec.events is not None else None
+    if extent is None:
+        return (
+            "events: moment magnitudes for W = each fracture's slipping length "
+            "(no events.extent)"
+        )
+    return f"events: moment magnitudes for an out-of-plane extent W = {fmt(extent)} m"
+
+
 def _network_count(spec: CaseSpec) -> str:
     """`` ([[fractures]] 1, network.file 3, network.generate 40)`` or ""."""
     sources = [
@@ -244,6 +255,7 @@ def describe(spec: CaseSpec) -> str:
     ]
     lines += [_describe_edge(e, getattr(spec.boundary, e)) for e in EDGES]
     lines += _describe_pore(spec)
+    lines.append(_describe_events(spec))
     lines.append("solver:")
     for option in SOLVER_OPTIONS:
         value = getattr(spec.solver, option.name)

@@ -28,6 +28,7 @@ from pathlib import Path
 
 from xfemslip.case import options
 from xfemslip.case.boundary import read_boundary
+from xfemslip.case.events import read_events
 from xfemslip.case.files import MAX_NAME_BYTES, parse_toml, path_problem, read_text
 from xfemslip.case.fractures import read_fractures
 from xfemslip.case.grid import read_grid
@@ -260,6 +261,7 @@ def loads_case(text: str, path: str | Path = "<string>") -> CaseSpec:
     output = _read_output(root, name)
     pore_pressure = read_pore_pressure(root)
     reservoir = read_reservoir(root, grid)
+    events = read_events(root)
     if problems:
         raise CaseError(path, problems)
     return CaseSpec(
@@ -277,4 +279,5 @@ def loads_case(text: str, path: str | Path = "<string>") -> CaseSpec:
         output=output,
         pore_pressure=pore_pressure,
         reservoir=reservoir,
+        events=events,
     )

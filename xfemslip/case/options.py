@@ -38,6 +38,7 @@ TOP_KEYS = (
     "output",
     "pore_pressure",
     "reservoir",
+    "events",
 )
 STRESS_KEYS = ("xx", "yy", "xy")
 MATERIAL_MODELS = ("plane_strain", "plane_stress")

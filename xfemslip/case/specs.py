@@ -177,6 +177,14 @@ class ReservoirSpec:
 
 
 @dataclass(frozen=True, kw_only=True)
+class EventsSpec:
+    """[events]: the out-of-plane extent W of a moment magnitude."""
+
+    extent: float | None = None  # W [m]; None: each fracture's slipping length
+    UNITS: ClassVar[dict[str, str]] = {"extent": "m"}
+
+
+@dataclass(frozen=True, kw_only=True)
 class CaseSpec:
     path: Path  # the case file
     text: str  # the case file's text as read
@@ -192,3 +200,4 @@ class CaseSpec:
     output: OutputSpec
     pore_pressure: PorePressureSpec | None = None  # None: no pore pressure
     reservoir: ReservoirSpec | None = None  # None: one material everywhere
+    events: EventsSpec | None = None  # None: no [events] table

@@ -1,5 +1,5 @@
 """Command-line interface: ``xfemslip run | check | info | verify | sweep |
-plot | screen | deplete | dfn``.
+plot | screen | deplete | dfn | summary``.
 
 The commands parse arguments, configure logging, call the library and map its
 errors to messages and exit codes (:mod:`xfemslip.cli.common`); they do no
@@ -18,6 +18,7 @@ from xfemslip.cli.dfn import dfn
 from xfemslip.cli.env import check_environment
 from xfemslip.cli.run import check, info, run
 from xfemslip.cli.studies import plot, screen, sweep
+from xfemslip.cli.summary import summary
 from xfemslip.cli.verify import verify
 from xfemslip.errors import UsageError
 
@@ -35,7 +36,7 @@ def cli() -> None:
         raise click.exceptions.Exit(EXIT_USAGE) from None
 
 
-for _command in (run, check, info, verify, sweep, plot, screen, deplete, dfn):
+for _command in (run, check, info, verify, sweep, plot, screen, deplete, dfn, summary):
     cli.add_command(_command)
 
 

@@ -40,7 +40,11 @@ def run(
     plot: bool,
     debug: bool,
 ) -> None:
-    """Run the case file CASE and write its results."""
+    """Run the case file CASE and write its results.
+
+    Ends with what happened on each fracture (slip, moment, magnitude), as
+    ``xfemslip summary`` prints it; -q leaves that out.
+    """
     with reported_errors(debug):
         configure_logging(verbose, quiet)
         spec = load_case_file(case)
@@ -54,6 +58,11 @@ def run(
             f"{summary.newton_iterations} Newton iterations, "
             f"{summary.wall_time_s:.2f} s -> {summary.out_dir}"
         )
+        if not quiet:  # what happened on the fractures
+            from xfemslip.cli.summary import event_report
+
+            for line in event_report(summary, spec):
+                click.echo(line)
         if not summary.converged:
             raise click.exceptions.Exit(EXIT_FAILURE)
         if plot:  # matplotlib is imported only here

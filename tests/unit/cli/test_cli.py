@@ -148,6 +148,7 @@ class FakeSimulation:
             newton_iterations=4,
             iterations_per_step=[4],
             wall_time_s=0.42,
+            steps=[],  # no fields: the run's event table is left out
         )
 
 

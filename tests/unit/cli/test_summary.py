@@ -1,0 +1,219 @@
+"""The event table that ends ``xfemslip run`` and ``xfemslip summary``.
+
+The numbers of the table are checked against the result's arrays, computed
+here independently: each contact point weighs the stretch between the
+midpoints to its neighbours, the ends of a fracture inside the domain at
+s = 0 and s = its length; mu = E / (2 (1 + nu)); Mw from Hanks & Kanamori.
+"""
+
+from __future__ import annotations
+
+import math
+import shutil
+
+import h5py
+import numpy as np
+import pytest
+from click.testing import CliRunner
+
+import xfemslip
+from xfemslip.cli import cli
+
+E, NU = 10.0e9, 0.25
+MU = E / (2 * (1 + NU))
+# two fractures at 45 degrees, |tau| = 10 MPa on sigma_n = -30 MPa: with
+# friction 0.1 the first slips, with 0.6 the second sticks; a third, at
+# 0 degrees with no shear on it, sticks too.  The top edge then moves down
+# by 0.2 mm over the two steps (about 1 MPa more vertical compression): the
+# first slips further, the others keep stuck.
+FRACTURES = (
+    ([[0.3, 0.3], [0.6, 0.6]], 0.1),
+    ([[1.3, 0.3], [1.6, 0.6]], 0.6),
+    ([[0.4, 1.5], [1.6, 1.5]], 0.1),
+)
+HEAD = f"""name = "events-unit"
+[domain]
+size = [2.0, 2.0]
+[mesh]
+elements = [40, 40]
+[material]
+E = {E!r}
+nu = {NU!r}
+[loading]
+stress = {{ xx = -20.0e6, yy = -40.0e6 }}
+initial_stress = {{ xx = -20.0e6, yy = -40.0e6 }}
+steps = 2
+[boundary]
+bottom = {{ uy = 0.0 }}
+top = {{ uy = -2.0e-4 }}
+left = {{ ux = 0.0 }}
+right = {{ ux = 0.0 }}
+[output]
+formats = ["h5"]
+"""
+
+
+def _fractures_toml() -> str:
+    return "".join(
+        f"[[fractures]]\npoints = {points}\nfriction = {f}\ncohesion = 0.0\n"
+        for points, f in FRACTURES
+    )
+
+
+def _write(tmp_path, extra: str = "") -> str:
+    path = tmp_path / "case.toml"
+    path.write_text(HEAD + extra + _fractures_toml(), encoding="utf-8")
+    return str(path)
+
+
+def _expected(result, extent=None):
+    """(slipped, max slip [mm], slipping length [m], M0', Mw, W) per fracture
+    of the final step, from the arrays."""
+    rows = []
+    for (points, _), ff in zip(FRACTURES, result.fractures, strict=True):
+        length = math.dist(*points)
+        mid = 0.5 * (ff.s[1:] + ff.s[:-1])
+        stretch = np.diff(np.concatenate([[0.0], mid, [length]]))
+        slipping = ff.state == 2
+        m0 = MU * float(np.sum(stretch * np.abs(ff.slip)))
+        lslip = float(np.sum(stretch[slipping]))
+        w = extent if extent is not None else lslip
+        mw = (2 / 3) * (math.log10(m0 * w) - 9.1) if m0 * w > 0 else -math.inf
+        rows.append(
+            (bool(slipping.any()), np.abs(ff.slip).max() * 1e3, lslip, m0, mw, w)
+        )
+    return rows
+
+
+def _table(output: str) -> list[list[str]]:
+    lines = output.splitlines()
+    start = next(i for i, line in enumerate(lines) if line.startswith("fracture "))
+    return [line.split() for line in lines[start + 1 : start + 1 + len(FRACTURES)]]
+
+
+def _check_table(output, result, extent=None):
+    for row, exp in zip(_table(output), _expected(result, extent), strict=True):
+        slipped, max_mm, lslip, m0, mw, w = exp
+        assert row[1] == ("yes" if slipped else "no")
+        assert float(row[2]) == pytest.approx(max_mm, rel=1e-3)
+        assert float(row[3]) == pytest.approx(lslip, rel=1e-3, abs=1e-12)
+        assert float(row[4]) == pytest.approx(m0, rel=1e-3)
+        if math.isfinite(mw):
+            assert float(row[6]) == pytest.approx(mw, abs=0.006)
+            assert float(row[7]) == pytest.approx(w, rel=1e-3)
+        else:
+            assert row[6] == "-" and row[7] == "-"
+
+
+@pytest.fixture(scope="module")
+def ran(tmp_path_factory):
+    """The case run once through the CLI: (output, result folder)."""
+    tmp = tmp_path_factory.mktemp("events")
+    out = tmp / "out"
+    result = CliRunner().invoke(cli, ["run", _write(tmp), "-o", str(out)])
+    assert result.exit_code == 0, result.output
+    return result.output, out
+
+
+def test_run_ends_with_the_table_of_the_result_arrays(ran):
+    output, out = ran
+    result = xfemslip.read_result(out)
+    expected = _expected(result)
+    assert [e[0] for e in expected] == [True, False, False]  # as designed
+    _check_table(output, result)
+    last = output.strip().splitlines()[-1]
+    slipped = expected[0]
+    assert last == (
+        f"1 of 3 fractures slipped; max slip {slipped[1]:.3g} mm on fracture 0 "
+        f"over {slipped[2]:.3g} m; Mw {slipped[4]:.2f} for W = {slipped[5]:.3g} m "
+        "(the slipping length)"
+    )
+
+
+def test_summary_prints_the_same_table_for_the_result_folder(ran):
+    output, out = ran
+    result = CliRunner().invoke(cli, ["summary", str(out)])
+    assert result.exit_code == 0, result.output
+    assert result.output.startswith("events-unit: converged, 2 converged step(s)")
+    tail = output.splitlines()[-(len(FRACTURES) + 3) :]
+    assert result.output.splitlines()[-(len(FRACTURES) + 3) :] == tail
+    again = CliRunner().invoke(cli, ["summary", str(out / "result.h5")])
+    assert again.output == result.output
+
+
+def test_summary_steps_prints_a_table_per_load_step(ran):
+    """The table of each step is that step's arrays (the slip grows from
+    step 1 to step 2 as the top edge moves down)."""
+    _, out = ran
+    result = CliRunner().invoke(cli, ["summary", str(out), "--steps"])
+    assert result.exit_code == 0, result.output
+    read = xfemslip.read_result(out)
+    blocks = result.output.split("fractures at step ")[1:]
+    assert [b.split(" ", 1)[0] for b in blocks] == ["1", "2"]
+    first, second = (np.abs(s.fractures[0].slip).max() for s in read.steps)
+    assert second > 1.01 * first
+    for block, step in zip(blocks, read.steps, strict=True):
+        rows = _table("\n".join(block.splitlines()[1:]))
+        for row, ff in zip(rows, step.fractures, strict=True):
+            assert float(row[2]) == pytest.approx(np.abs(ff.slip).max() * 1e3, 1e-3)
+
+
+def test_quiet_run_leaves_the_table_out(tmp_path):
+    result = CliRunner().invoke(
+        cli, ["run", _write(tmp_path), "-o", str(tmp_path / "o"), "-q"]
+    )
+    assert result.exit_code == 0, result.output
+    assert "fractures slipped" not in result.output
+    assert "M0'" not in result.output
+
+
+def test_events_extent_is_the_w_of_every_magnitude(tmp_path):
+    path = _write(tmp_path, "[events]\nextent = 300.0\n")
+    result = CliRunner().invoke(cli, ["run", path, "-o", str(tmp_path / "o")])
+    assert result.exit_code == 0, result.output
+    _check_table(result.output, xfemslip.read_result(tmp_path / "o"), 300.0)
+    assert result.output.strip().endswith("for W = 300 m (events.extent)")
+
+
+def test_summary_of_a_result_whose_case_files_are_elsewhere(ran, tmp_path):
+    """A [network] CSV next to the original case is not next to the result:
+    the fracture ends come from the contact points, and the summary says so."""
+    _, out = ran
+    (tmp_path / "seg.csv").write_text("x0,y0,x1,y1\n0.4,1.5,1.6,1.5\n")
+    copy = tmp_path / "copy"
+    shutil.copytree(out, copy)
+    with h5py.File(copy / "result.h5", "r+") as h5:
+        text = h5.attrs["case_toml"]
+        text = text.decode() if isinstance(text, bytes) else text
+        # the third fracture as a network.file member instead
+        h5.attrs["case_toml"] = (
+            text.replace(
+                "[[fractures]]\npoints = [[0.4, 1.5], [1.6, 1.5]]\nfriction = 0.1\n"
+                "cohesion = 0.0\n",
+                "",
+            )
+            + '[network]\nfile = "seg.csv"\nfriction = 0.1\n'
+        )
+    result = CliRunner().invoke(cli, ["summary", str(copy)])
+    assert result.exit_code == 0, result.output
+    assert "note: fracture ends estimated from the contact points" in result.output
+    assert "network.file" in result.output
+    exp = _expected(xfemslip.read_result(out))
+    row = _table(result.output)[0]
+    assert float(row[4]) == pytest.approx(exp[0][3], rel=0.05)
+
+
+def test_summary_of_a_missing_file_or_not_a_result_exits_2(tmp_path):
+    runner = CliRunner()
+    missing = runner.invoke(cli, ["summary", str(tmp_path / "nope.h5")])
+    assert missing.exit_code == 2
+    assert missing.output.strip().splitlines() == [
+        f"Error: {tmp_path / 'nope.h5'}: no such file (expected a result.h5)"
+    ]
+    other = tmp_path / "other.h5"
+    with h5py.File(other, "w") as h5:
+        h5["data"] = np.arange(3)
+    result = runner.invoke(cli, ["summary", str(other)])
+    assert result.exit_code == 2
+    assert len(result.output.strip().splitlines()) == 1
+    assert "not a result.h5 of xfemslip" in result.output

@@ -1,0 +1,121 @@
+"""Event size of the slipping straight crack against its closed form.
+
+The crack of the in-situ release problem (the OpenGeoSys peer crack, a = 1 m
+at 45 degrees, in a graded box of half-width 40 m, cells of h = 0.1 m around
+it) is loaded only through ``initial_stress`` and slips along its whole
+length.  Its slip is the elliptical profile (kappa + 1) / (2 mu) dtau
+sqrt(a^2 - x^2), whose integral gives the seismic moment per unit length
+
+    M0' = mu int |s| ds = pi a^2 (kappa + 1) dtau / 4,   kappa = 3 - 4 nu,
+
+and the crack-model stress drop recovers dtau from M0' and the slipping
+length 2a.  The error of the moment is that of the slip integral (the slip's
+relative L2 error of this setup is 1.17 %; measured: M0' 1.24 % low,
+the midpoint stretches missing part of the sqrt profile next to the tips).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+import tomli_w
+
+import xfemslip
+from xfemslip.case import load_case
+from xfemslip.post.events import event_inputs, event_sizes
+from xfemslip.reference import closed_form as cf
+from xfemslip.reference import peer
+from xfemslip.simulation import run_case
+
+pytestmark = pytest.mark.verification
+
+A, E, NU, F = peer.A, peer.E, peer.NU, peer.F
+SIGMA0 = peer.STRESS  # (-20, -40, 0) MPa on a crack at 45 degrees
+HALF = 40.0  # half-width of the box [m]
+W = 250.0  # out-of-plane extent given as events.extent [m]
+
+
+def _case(h: float) -> dict:
+    coords = [float(v) for v in peer.graded(h, half=HALF)]
+    t = (math.cos(math.radians(45.0)), math.sin(math.radians(45.0)))
+    stress = dict(zip(("xx", "yy", "xy"), SIGMA0, strict=True))
+    return {
+        "name": "event",
+        "mesh": {"x": coords, "y": coords},
+        "material": {"E": E, "nu": NU, "model": "plane_strain"},
+        "fractures": [
+            {
+                "points": [[-A * t[0], -A * t[1]], [A * t[0], A * t[1]]],
+                "friction": F,
+                "cohesion": 0.0,
+                "kn": peer.PENALTY,
+                "kt": peer.PENALTY,
+            }
+        ],
+        "loading": {"stress": stress, "initial_stress": stress, "steps": 1},
+        # rollers, no displacement: nothing but the in-situ stress drives it
+        "boundary": {
+            e: {"uy" if e in ("top", "bottom") else "ux": 0.0}
+            for e in ("bottom", "top", "left", "right")
+        },
+        "events": {"extent": W},
+        "output": {"formats": ["h5"]},
+    }
+
+
+def test_moment_of_the_released_crack_matches_the_closed_form(tmp_path):
+    path = tmp_path / "event.toml"
+    path.write_text(tomli_w.dumps(_case(0.1)))
+    spec = load_case(path)
+    assert spec.events.extent == W
+    run_case(spec, tmp_path / "out")
+    result = xfemslip.read_result(tmp_path / "out")
+    # computed from the result read back alone (the case text it carries)
+    inputs = event_inputs(result)
+    assert inputs.extent == W and inputs.note == ""
+    ((event,),) = event_sizes(result, inputs)
+    dtau = abs(cf.driving_shear(SIGMA0, 45.0, F))  # 7 MPa
+    kappa = 3.0 - 4.0 * NU
+    exact = math.pi * A**2 * (kappa + 1.0) * dtau / 4.0  # N m / m
+    error = abs(event.moment_per_length - exact) / exact
+    assert error < 0.015, error  # measured 1.24 % (low: the tips)
+    assert event.slipped
+    assert event.slipping_length == pytest.approx(2.0 * A, rel=1e-12)
+    # the crack model inverts the same closed form: dtau to the moment's error
+    assert event.stress_drop == pytest.approx(dtau, rel=0.015)
+    assert event.magnitude == pytest.approx(
+        (2.0 / 3.0) * (math.log10(event.moment_per_length * W) - 9.1), abs=1e-12
+    )
+    assert abs(event.magnitude - (2 / 3) * (math.log10(exact * W) - 9.1)) < 0.005
+    exact_max = cf.slip_profile(
+        np.array([A]), A, E, NU, "plane_strain", SIGMA0, 45.0, F
+    )[0]
+    assert event.max_slip == pytest.approx(abs(exact_max), rel=0.02)
+
+
+def test_shipped_seismic_event_case_against_its_closed_form(tmp_path):
+    """cases/seismic_event.toml: a 200 m fault at 60 degrees in (-25, -50)
+    MPa with friction 0.3 (dtau = 1.45 MPa), released in situ; `run` prints
+    M0' within 1.5 % of pi a^2 (kappa + 1) dtau / 4 and Mw for W = 500 m."""
+    from pathlib import Path
+
+    from click.testing import CliRunner
+
+    from xfemslip.cli import cli
+
+    case = Path(__file__).parents[2] / "cases" / "seismic_event.toml"
+    out = tmp_path / "out"
+    run = CliRunner().invoke(cli, ["run", str(case), "-o", str(out)])
+    assert run.exit_code == 0, run.output
+    angle, a, nu, friction, extent = 60.0, 100.0, 0.25, 0.3, 500.0
+    stress = (-25.0e6, -50.0e6, 0.0)
+    dtau = abs(cf.driving_shear(stress, angle, friction))
+    exact = math.pi * a**2 * (4.0 - 4.0 * nu) * dtau / 4.0
+    result = xfemslip.read_result(out)
+    ((event,),) = event_sizes(result, event_inputs(result))[-1:]
+    assert abs(event.moment_per_length / exact - 1.0) < 0.015  # measured 1.05 %
+    mw = (2 / 3) * (math.log10(event.moment_per_length * extent) - 9.1)
+    assert run.output.strip().endswith(f"Mw {mw:.2f} for W = 500 m (events.extent)")
+    assert abs(mw - (2 / 3) * (math.log10(exact * extent) - 9.1)) < 0.005

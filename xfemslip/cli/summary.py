@@ -1,0 +1,79 @@
+"""Command ``xfemslip summary``: what happened in a run, from its result.h5.
+
+The same per-fracture table and "what happened" line that end ``xfemslip
+run`` (:func:`event_report`), for any result read back through
+:func:`xfemslip.read_result` -- results written before the event sizes
+existed included: they are computed from the arrays and the case text.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import click
+
+from xfemslip.cli.common import debug_option, reported_errors
+
+__all__ = ["event_report", "summary"]
+
+
+def event_report(result, spec=None, every_step: bool = False) -> list[str]:
+    """The lines printed for ``result``: its final converged step, or every
+    one; ``spec`` the case when at hand, else rebuilt from the result's case
+    text.  None without a converged step (the status line before says so)."""
+    from xfemslip.post.events import event_inputs, event_sizes, summary_lines
+
+    if not result.steps:
+        return []
+    inputs = event_inputs(result, spec)
+    sizes = event_sizes(result, inputs)
+    shown = range(len(sizes)) if every_step else [len(sizes) - 1]
+    lines = []
+    for k in shown:
+        step = result.steps[k]
+        lines.append(
+            f"fractures at step {step.step} of {result.load_steps} "
+            f"(load factor {step.load_factor:.4g}), slip cumulative over the steps:"
+        )
+        lines += summary_lines(sizes[k], inputs)
+    return lines
+
+
+@click.command()
+@click.argument("result_path", metavar="RESULT", type=click.Path(path_type=Path))
+@click.option(
+    "--steps",
+    "every_step",
+    is_flag=True,
+    help="A table for every converged load step, not only the last.",
+)
+@debug_option
+def summary(result_path: Path, every_step: bool, debug: bool) -> None:
+    """Print what happened in the run that wrote RESULT (a result.h5 or its
+    folder): per fracture whether it slipped, max slip, slipping length,
+    moment per unit length, stress drop and magnitude with its extent W."""
+    with reported_errors(debug):
+        from xfemslip import read_result
+
+        result = read_result(result_path)
+        name = _case_name(result.attrs.get("case_toml", ""))
+        status = "converged" if result.converged else "did NOT converge"
+        click.echo(
+            f"{name or result_path}: {status}, {len(result.steps)} converged "
+            f"step(s), {result.newton_iterations} Newton iterations"
+        )
+        if not result.steps:
+            click.echo("no converged load step: nothing to report on the fractures")
+        for line in event_report(result, every_step=every_step):
+            click.echo(line)
+
+
+def _case_name(text: str) -> str:
+    """The case's ``name`` from its text ("" when it gives none)."""
+    import tomllib
+
+    try:
+        name = tomllib.loads(str(text)).get("name", "")
+    except tomllib.TOMLDecodeError:
+        return ""
+    return name if isinstance(name, str) else ""

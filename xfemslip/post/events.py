@@ -1,0 +1,251 @@
+"""How big an event the slip is: per fracture and load step, and in words.
+
+Per fracture and converged load step, from the slip of that step (cumulative
+from the in-situ state, as ``result.h5`` stores it): the seismic moment per
+unit out-of-plane length M0' = mu int |s| ds, the crack-model static stress
+drop, the max |slip|, the slipping length and the moment magnitude
+Mw = (2/3) (log10(M0' W) - 9.1) for an out-of-plane extent W
+(:mod:`xfemslip.post.seismic`).  W is ``events.extent`` when the case gives it,
+else the fracture's own slipping length; every magnitude is printed with the
+W it used.
+
+The integrals weigh each contact point with the stretch of fracture it stands
+for (:func:`xfemslip.post.metrics.point_stretches`), the ends reaching the
+part of the fracture inside the domain, like the sweep metrics.  mu is the
+shear modulus of ``[material]``, or of ``[reservoir]`` for a fracture whose
+middle contact point lies in the reservoir.
+
+Everything is computed from a :class:`~xfemslip.post.result.Result` and the
+case it ran (the ``case_toml`` a result carries), so a result written by any
+version gives its event sizes without new datasets.
+"""
+
+from __future__ import annotations
+
+import math
+import tomllib
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from xfemslip.case import loads_case
+from xfemslip.conventions import SLIP
+from xfemslip.errors import CaseError, XfemslipError
+from xfemslip.geometry.regions import in_region
+from xfemslip.post.metrics import arc_extent, point_stretches
+from xfemslip.post.result import Result
+from xfemslip.post.seismic import (
+    moment_magnitude,
+    moment_per_length,
+    shear_modulus,
+    stress_drop,
+)
+
+__all__ = [
+    "EventInputs",
+    "FractureEvent",
+    "event_inputs",
+    "event_sizes",
+    "summary_lines",
+]
+
+
+@dataclass(frozen=True)
+class FractureEvent:
+    """The event size of one fracture at one load step (SI units)."""
+
+    fracture: int  # case-file index
+    slipped: bool  # a contact point in state SLIP at this step
+    max_slip: float  # max |slip| [m]
+    slipping_length: float  # [m]
+    moment_per_length: float  # M0' [N m / m]
+    stress_drop: float  # crack model [Pa]; NaN without slip
+    extent: float  # the W of the magnitude [m] (0 without slip and extent)
+    magnitude: float  # Mw for M0' W; -inf without moment
+
+    @property
+    def moment(self) -> float:
+        """M0 = M0' W [N m]."""
+        return self.moment_per_length * self.extent
+
+
+@dataclass(frozen=True)
+class EventInputs:
+    """What the event sizes need beyond the result's arrays.
+
+    ``mu`` (F,) [Pa] per fracture, ``nu`` and ``model`` of the elastic law
+    around each, ``ends`` (F, 2) the arc-length range [m] of each fracture
+    inside the domain, ``extent`` W [m] or None (each fracture's slipping
+    length), ``note`` a caveat to print ("" when none).
+    """
+
+    mu: tuple[float, ...]
+    nu: tuple[float, ...]
+    model: str
+    ends: tuple[tuple[float, float], ...]
+    extent: float | None
+    note: str = ""
+
+
+def _from_spec(spec, result: Result) -> EventInputs:
+    m = spec.material
+    box = (
+        spec.origin[0],
+        spec.origin[0] + spec.size[0],
+        spec.origin[1],
+        spec.origin[1] + spec.size[1],
+    )
+    mus, nus = [], []
+    fields = result.final.fractures if result.steps else []
+    for k, _ in enumerate(spec.fractures):
+        E, nu = m.E, m.nu
+        r = spec.reservoir
+        if r is not None and k < len(fields) and fields[k].points.size:
+            middle = fields[k].points[len(fields[k].points) // 2][None, :]
+            if bool(in_region(middle, r)[0]):
+                E, nu = r.E, r.nu
+        mus.append(shear_modulus(E, nu))
+        nus.append(nu)
+    ends = tuple(arc_extent(f.points, box) for f in spec.fractures)
+    extent = spec.events.extent if spec.events is not None else None
+    return EventInputs(tuple(mus), tuple(nus), m.model, ends, extent)
+
+
+def _contact_ends(s: np.ndarray) -> tuple[float, float]:
+    """The ends of a fracture estimated from its contact points alone: half a
+    spacing beyond the first and the last."""
+    if s.size < 2:
+        return (float(s[0]), float(s[0])) if s.size else (0.0, 0.0)
+    return float(s[0] - 0.5 * (s[1] - s[0])), float(s[-1] + 0.5 * (s[-1] - s[-2]))
+
+
+def _from_text(text: str, result: Result, reason: str) -> EventInputs:
+    """Material and extent from the case text, fracture ends from the contact
+    points: when the case cannot be rebuilt (files it names are elsewhere)."""
+    try:
+        case = tomllib.loads(text)
+    except tomllib.TOMLDecodeError:
+        case = {}
+    material = case.get("material", {}) if isinstance(case, dict) else {}
+    E, nu = material.get("E"), material.get("nu")
+    if not isinstance(E, int | float) or not isinstance(nu, int | float):
+        raise CaseError(Path("case_toml"), [("material", "E and nu not found")])
+    model = material.get("model", "plane_strain")
+    events = case.get("events", {})
+    extent = events.get("extent") if isinstance(events, dict) else None
+    fields = result.final.fractures if result.steps else []
+    n = len(fields)
+    return EventInputs(
+        (shear_modulus(float(E), float(nu)),) * n,
+        (float(nu),) * n,
+        str(model),
+        tuple(_contact_ends(np.asarray(f.s, float)) for f in fields),
+        float(extent) if isinstance(extent, int | float) else None,
+        note=f"fracture ends estimated from the contact points ({reason})",
+    )
+
+
+def event_inputs(result: Result, spec=None) -> EventInputs:
+    """The :class:`EventInputs` of ``result``: from ``spec`` (the case it ran)
+    when given, else rebuilt from the case text the result carries."""
+    if spec is not None:
+        return _from_spec(spec, result)
+    text = str(result.attrs.get("case_toml", ""))
+    folder = result.out_dir if result.out_dir is not None else Path(".")
+    try:
+        return _from_spec(loads_case(text, folder / "case.toml"), result)
+    except XfemslipError as err:
+        problems = getattr(err, "problems", None)
+        where = problems[0][0] if problems else type(err).__name__
+        return _from_text(text, result, f"the case does not load here: {where}")
+
+
+def _fracture_event(index, ff, inputs: EventInputs) -> FractureEvent:
+    s, slip, state = np.asarray(ff.s, float), np.asarray(ff.slip, float), ff.state
+    stretch = point_stretches(s, *inputs.ends[index])
+    mu, nu = inputs.mu[index], inputs.nu[index]
+    m0 = moment_per_length(mu, stretch, slip)
+    length = float(np.sum(stretch[np.asarray(state) == SLIP]))
+    extent = inputs.extent if inputs.extent is not None else length
+    return FractureEvent(
+        fracture=index,
+        slipped=bool(np.any(np.asarray(state) == SLIP)),
+        max_slip=float(np.max(np.abs(slip))) if slip.size else 0.0,
+        slipping_length=length,
+        moment_per_length=m0,
+        stress_drop=stress_drop(m0, length, mu, nu, inputs.model),
+        extent=extent,
+        magnitude=moment_magnitude(m0 * extent),
+    )
+
+
+def event_sizes(result: Result, inputs: EventInputs) -> list[list[FractureEvent]]:
+    """Per converged load step, the :class:`FractureEvent` of every fracture."""
+    return [
+        [_fracture_event(i, ff, inputs) for i, ff in enumerate(step.fractures)]
+        for step in result.steps
+    ]
+
+
+# --------------------------------------------------------------------------- #
+# In words
+
+MOMENT_HEAD = "M0' [N m/m]"
+W_SOURCE = {True: "events.extent", False: "the slipping length"}
+# --------------------------------------------------------------------------- #
+
+
+def _w_text(event: FractureEvent, inputs: EventInputs) -> str:
+    return f"W = {event.extent:.3g} m ({W_SOURCE[inputs.extent is not None]})"
+
+
+def _mw_text(event: FractureEvent) -> str:
+    return f"{event.magnitude:.2f}" if math.isfinite(event.magnitude) else "-"
+
+
+def summary_lines(events: list[FractureEvent], inputs: EventInputs) -> list[str]:
+    """The per-fracture table of one step and the "what happened" line."""
+    if not events:
+        return ["no fracture in this result"]
+    head = (
+        f"{'fracture':>8}  {'slipped':>7}  {'max slip [mm]':>13}  "
+        f"{'slipping [m]':>12}  {MOMENT_HEAD:>12}  {'drop [MPa]':>10}  "
+        f"{'Mw':>6}  W [m] ({W_SOURCE[inputs.extent is not None]})"
+    )
+    lines = [head]
+    for e in events:
+        drop = f"{e.stress_drop / 1e6:.3g}" if math.isfinite(e.stress_drop) else "-"
+        w = f"{e.extent:.3g}" if e.extent > 0 else "-"
+        lines.append(
+            f"{e.fracture:>8}  {'yes' if e.slipped else 'no':>7}  "
+            f"{e.max_slip * 1e3:>13.4g}  {e.slipping_length:>12.4g}  "
+            f"{e.moment_per_length:>12.4g}  {drop:>10}  {_mw_text(e):>6}  {w}"
+        )
+    lines.append(what_happened(events, inputs))
+    if inputs.note:
+        lines.append(f"note: {inputs.note}")
+    return lines
+
+
+def what_happened(events: list[FractureEvent], inputs: EventInputs) -> str:
+    """One line: how many fractures slipped, the largest slip and magnitude."""
+    slipped = [e for e in events if e.slipped]
+    n = len(events)
+    if not slipped:
+        top = max(events, key=lambda e: e.max_slip)
+        return (
+            f"no fracture slipped ({n} in all); the largest jump, "
+            f"{top.max_slip * 1e3:.3g} mm on fracture {top.fracture}, is elastic"
+        )
+    top = max(slipped, key=lambda e: e.max_slip)
+    big = max(slipped, key=lambda e: e.moment)
+    noun = "fracture" if n == 1 else "fractures"
+    line = (
+        f"{len(slipped)} of {n} {noun} slipped; max slip {top.max_slip * 1e3:.3g} mm "
+        f"on fracture {top.fracture} over {top.slipping_length:.3g} m; "
+        f"Mw {_mw_text(big)} for {_w_text(big, inputs)}"
+    )
+    if big.fracture != top.fracture:
+        line += f" on fracture {big.fracture}"
+    return line
