@@ -41,10 +41,11 @@ import sys
 import time
 from pathlib import Path
 
-import bad_inputs
 import h5py
 import pytest
-from bad_input_base import Input, small, toml
+
+from tests.support import bad_inputs
+from tests.support.bad_inputs.base import Input, small, toml
 
 WORKER = Path(__file__).with_name("bad_input_worker.py")
 MEMORY_BOUND = 2 * 2**30  # peak resident memory an input may reach [bytes]

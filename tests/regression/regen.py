@@ -11,8 +11,9 @@ import sys
 import tempfile
 from pathlib import Path
 
-sys.path.insert(0, str(Path(__file__).resolve().parent))
-from golden_scalars import case_files, key_scalars, run, write_golden  # noqa: E402
+# a script: the project root on the path, for the tests.support package
+sys.path.insert(0, str(Path(__file__).resolve().parents[2]))
+from tests.support.golden import case_files, key_scalars, run, write_golden  # noqa: E402
 
 
 def main(argv: list[str]) -> int:

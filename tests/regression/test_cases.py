@@ -2,7 +2,7 @@
 
 Each case is run once (``run_case(load_case(case), out_dir)``, i.e.
 ``xfemslip run CASE -o OUT_DIR``) into a temporary folder.  Its key scalars
-(``golden_scalars.key_scalars``: max |slip|, min slip, number of contact and of
+(``tests.support.golden.key_scalars``: max |slip|, min slip, number of contact and of
 slipping points, Newton iterations per step, mean element sigma_yy -- standing
 in for the reaction, which is not in the output -- and the displacement of the
 top-centre node) are compared with ``golden/<stem>.json`` using the explicit
@@ -31,9 +31,9 @@ from pathlib import Path
 import h5py
 import numpy as np
 import pytest
-from golden_scalars import case_files, golden_path, key_scalars, read_golden, run
 
 import xfemslip
+from tests.support.golden import case_files, golden_path, key_scalars, read_golden, run
 
 # Explicit tolerances: the solver stops at eta <= 1e-8, so results agree to far
 # better than 1e-6 between runs and platforms; counts and iterations are exact.

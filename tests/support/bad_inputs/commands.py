@@ -6,7 +6,7 @@ from __future__ import annotations
 import copy
 import math
 
-from bad_input_base import (
+from tests.support.bad_inputs.base import (
     DEPLETION,
     OUT,
     RUN,

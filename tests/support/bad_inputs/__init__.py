@@ -6,14 +6,14 @@ command line, an environment, and what may come out: the allowed exit codes
 key the refusal must name.  The generators are deterministic (``random.Random``
 with a fixed seed), so a failing input is found again by its id.
 
-The families (``Input.family``) are generated in ``bad_input_keys.py`` (the
+The families (``Input.family``) are generated in ``keys.py`` (the
 keys of the shipped cases mutated one at a time through ``check``, those of a
-small case through ``check`` and ``run``, misspelt keys), ``bad_input_files.py``
+small case through ``check`` and ``run``, misspelt keys), ``files.py``
 (TOML nesting depth, special and oversized files in every place a file is
 read, bytes that are not clean UTF-8 TOML, boundary and network CSV files),
-``bad_input_studies.py`` (sweeps, random networks, depletion) and
-``bad_input_commands.py`` (command-line options, environment variables,
-sizes, geometry of many vertices); ``bad_input_base.py`` holds what they
+``studies.py`` (sweeps, random networks, depletion) and
+``commands.py`` (command-line options, environment variables,
+sizes, geometry of many vertices); ``base.py`` holds what they
 share.  This module assembles the two suites.
 """
 
@@ -21,27 +21,31 @@ from __future__ import annotations
 
 import random
 
-from bad_input_base import Input
-from bad_input_commands import (
+from tests.support.bad_inputs.base import Input
+from tests.support.bad_inputs.commands import (
     cli_inputs,
     environment_inputs,
     shape_inputs,
     size_inputs,
 )
-from bad_input_files import (
+from tests.support.bad_inputs.files import (
     boundary_csv_inputs,
     byte_inputs,
     nesting_inputs,
     network_csv_inputs,
     special_file_inputs,
 )
-from bad_input_keys import (
+from tests.support.bad_inputs.keys import (
     shipped_key_inputs,
     small_key_inputs,
     small_systematic_inputs,
     unknown_key_inputs,
 )
-from bad_input_studies import depletion_inputs, generate_inputs, sweep_inputs
+from tests.support.bad_inputs.studies import (
+    depletion_inputs,
+    generate_inputs,
+    sweep_inputs,
+)
 
 SEED = 20240613
 

@@ -18,7 +18,7 @@ from xfemslip.simulation import run_case
 
 ROOT = Path(__file__).resolve().parents[2]
 CASES_DIR = ROOT / "cases"
-GOLDEN_DIR = Path(__file__).resolve().parent / "golden"
+GOLDEN_DIR = ROOT / "tests" / "regression" / "golden"
 
 
 def case_files() -> list[Path]:

@@ -15,7 +15,7 @@ from pathlib import Path
 
 import tomli_w
 
-REPO = Path(__file__).resolve().parents[2]
+REPO = Path(__file__).resolve().parents[3]
 CASES = REPO / "cases"
 SHIPPED = sorted(CASES.glob("*.toml"))
 

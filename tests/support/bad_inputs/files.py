@@ -6,7 +6,7 @@ from __future__ import annotations
 
 import random
 
-from bad_input_base import (
+from tests.support.bad_inputs.base import (
     BIG_INT_TEXT,
     OUT,
     RUN,

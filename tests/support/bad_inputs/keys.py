@@ -9,7 +9,7 @@ import math
 import random
 import tomllib
 
-from bad_input_base import (
+from tests.support.bad_inputs.base import (
     BIG_INT_TEXT,
     OUT,
     RUN,
