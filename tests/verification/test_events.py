@@ -23,46 +23,25 @@ import pytest
 import tomli_w
 
 import xfemslip
+from tests.support.in_situ import NU, SIGMA0, A, E, F, crack_case, rollers
 from xfemslip.case import load_case
 from xfemslip.post.events import event_inputs, event_sizes
 from xfemslip.reference import closed_form as cf
-from xfemslip.reference import peer
 from xfemslip.simulation import run_case
 
 pytestmark = pytest.mark.verification
 
-A, E, NU, F = peer.A, peer.E, peer.NU, peer.F
-SIGMA0 = peer.STRESS  # (-20, -40, 0) MPa on a crack at 45 degrees
-HALF = 40.0  # half-width of the box [m]
+
 W = 250.0  # out-of-plane extent given as events.extent [m]
 
 
 def _case(h: float) -> dict:
-    coords = [float(v) for v in peer.graded(h, half=HALF)]
-    t = (math.cos(math.radians(45.0)), math.sin(math.radians(45.0)))
-    stress = dict(zip(("xx", "yy", "xy"), SIGMA0, strict=True))
-    return {
-        "name": "event",
-        "mesh": {"x": coords, "y": coords},
-        "material": {"E": E, "nu": NU, "model": "plane_strain"},
-        "fractures": [
-            {
-                "points": [[-A * t[0], -A * t[1]], [A * t[0], A * t[1]]],
-                "friction": F,
-                "cohesion": 0.0,
-                "kn": peer.PENALTY,
-                "kt": peer.PENALTY,
-            }
-        ],
-        "loading": {"stress": stress, "initial_stress": stress, "steps": 1},
-        # rollers, no displacement: nothing but the in-situ stress drives it
-        "boundary": {
-            e: {"uy" if e in ("top", "bottom") else "ux": 0.0}
-            for e in ("bottom", "top", "left", "right")
-        },
-        "events": {"extent": W},
-        "output": {"formats": ["h5"]},
-    }
+    """The in-situ release problem with rollers and no displacement, so
+    nothing but the in-situ stress drives the slip, and W = events.extent."""
+    doc = crack_case(h, initial=SIGMA0, boundary=rollers())
+    doc["name"] = "event"
+    doc["events"] = {"extent": W}
+    return doc
 
 
 def test_moment_of_the_released_crack_matches_the_closed_form(tmp_path):

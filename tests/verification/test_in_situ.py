@@ -26,7 +26,6 @@ edges (the rest of the error is the mesh and the finite box: 0.653 / 0.640 /
 
 from __future__ import annotations
 
-import math
 from pathlib import Path
 
 import numpy as np
@@ -34,6 +33,7 @@ import pytest
 from click.testing import CliRunner
 
 import xfemslip
+from tests.support.in_situ import NU, SIGMA0, A, E, F, crack_case, rollers
 from xfemslip.case import build, load_case
 from xfemslip.cli import cli
 from xfemslip.conventions import OPEN, SLIP, STICK
@@ -44,57 +44,6 @@ from xfemslip.simulation import build_model, newton_solver, run_case
 from xfemslip.studies.depletion import deplete
 
 pytestmark = pytest.mark.verification
-
-A, E, NU, F = peer.A, peer.E, peer.NU, peer.F
-SIGMA0 = peer.STRESS  # (-20, -40, 0) MPa: |tau| = 10 MPa > f |sigma_n| = 3 MPa
-HALF = 40.0  # half-width of the box [m]
-
-
-def _strain(stress):
-    """Plane-strain (exx, eyy) of a uniform stress (xy = 0)."""
-    sxx, syy, _ = stress
-    exx = ((1 - NU**2) * sxx - NU * (1 + NU) * syy) / E
-    eyy = ((1 - NU**2) * syy - NU * (1 + NU) * sxx) / E
-    return exx, eyy
-
-
-def _rollers(stress=None):
-    """Rollers on the four edges, imposing the uniform strain of ``stress``
-    (None: no displacement)."""
-    exx, eyy = _strain(stress) if stress is not None else (0.0, 0.0)
-    return {
-        "bottom": {"uy": -HALF * eyy},
-        "top": {"uy": HALF * eyy},
-        "left": {"ux": -HALF * exx},
-        "right": {"ux": HALF * exx},
-    }
-
-
-def _case(h, *, initial=None, stress=SIGMA0, boundary=None, steps=1, angle=45.0):
-    """The peer crack on the graded mesh as a case document (dict)."""
-    coords = [float(v) for v in peer.graded(h, half=HALF)]
-    t = (math.cos(math.radians(angle)), math.sin(math.radians(angle)))
-    loading = {"stress": dict(zip(("xx", "yy", "xy"), stress, strict=True))}
-    if initial is not None:
-        loading["initial_stress"] = dict(zip(("xx", "yy", "xy"), initial, strict=True))
-    loading["steps"] = steps
-    return {
-        "name": "in-situ",
-        "mesh": {"x": coords, "y": coords},
-        "material": {"E": E, "nu": NU, "model": "plane_strain"},
-        "fractures": [
-            {
-                "points": [[-A * t[0], -A * t[1]], [A * t[0], A * t[1]]],
-                "friction": F,
-                "cohesion": 0.0,
-                "kn": peer.PENALTY,
-                "kt": peer.PENALTY,
-            }
-        ],
-        "loading": loading,
-        "boundary": boundary if boundary is not None else _rollers(),
-        "output": {"formats": ["h5"]},
-    }
 
 
 def _write(tmp_path, name, doc):
@@ -124,9 +73,9 @@ def test_critically_stressed_crack_slips_as_if_loaded_from_zero(tmp_path):
     crack slips by the closed form to the error of the same crack loaded from
     zero; the two slips differ by the in-situ penalty jump only."""
     released = _write(
-        tmp_path, "released", _case(0.1, initial=SIGMA0, boundary=_rollers())
+        tmp_path, "released", crack_case(0.1, initial=SIGMA0, boundary=rollers())
     )
-    loaded = _write(tmp_path, "loaded", _case(0.1, boundary=_rollers(SIGMA0)))
+    loaded = _write(tmp_path, "loaded", crack_case(0.1, boundary=rollers(SIGMA0)))
     run_case(released, tmp_path / "released_out")
     run_case(loaded, tmp_path / "loaded_out")
     ((s, slip_r, _, state),) = _steps(tmp_path / "released_out")
@@ -212,7 +161,7 @@ def test_whole_system_is_in_equilibrium_with_the_bulk_initial_stress(
     Duffy rule: the in-situ traction and the bulk initial stress then differ
     by 6e-5 of the edge forces on this 8-cell crack, admissible or not
     (measured), hence the looser bound."""
-    doc = _case(
+    doc = crack_case(
         0.25,
         initial=SIGMA0,
         stress=final,
@@ -274,7 +223,7 @@ def test_further_load_steps_start_from_the_released_state(tmp_path):
     spec = _write(
         tmp_path,
         "further",
-        _case(0.1, initial=SIGMA0, stress=SIGMA0, boundary=_rollers(d), steps=3),
+        crack_case(0.1, initial=SIGMA0, stress=SIGMA0, boundary=rollers(d), steps=3),
     )
     run_case(spec, tmp_path / "further_out")
     rows = _steps(tmp_path / "further_out")
@@ -299,7 +248,7 @@ def test_in_situ_tension_opens_the_crack(tmp_path):
     spec = _write(
         tmp_path,
         "tension",
-        _case(0.1, initial=sigma0, stress=sigma0, boundary=_rollers(), angle=0.0),
+        crack_case(0.1, initial=sigma0, stress=sigma0, boundary=rollers(), angle=0.0),
     )
     run_case(spec, tmp_path / "tension_out")
     ((s, slip, opening, state),) = _steps(tmp_path / "tension_out")
@@ -319,7 +268,7 @@ def test_admissible_in_situ_traction_is_carried_as_before(tmp_path):
     """With friction 0.5 the same in-situ stress is admissible (|tau| /
     -sigma_n = 1/3): nothing is released, the faces stay stuck with zero
     jump, and the Newton solve takes no iteration."""
-    doc = _case(0.25, initial=SIGMA0, boundary=_rollers())
+    doc = crack_case(0.25, initial=SIGMA0, boundary=rollers())
     doc["fractures"][0]["friction"] = 0.5
     coords = [float(v) for v in peer.graded(0.25, half=3.0)]
     doc["mesh"] = {"x": coords, "y": coords}
