@@ -2,8 +2,12 @@
 
 K_ff, the bulk stiffness on the free dofs, is the same for the whole run; only
 K_c, the contact tangent on the enriched dofs along the fractures, changes
-between Newton iterations and load steps.  Two strategies (``[solver]
-linear_solver``), each keeping what does not change:
+between Newton iterations and load steps.  The strategies (``[solver]
+linear_solver``) each keep what does not change.  They stay in one module
+(about 750 lines) because LinearSolver switches between them within a run
+(a failed AMG or PARDISO solve falls back to the kept SuperLU path, checked
+by the same backward error) and shares its statistics and band masks among
+them; PARDISO's own machinery is in pardiso.py.
 
 - ``"superlu"``: sparse LU (scipy SuperLU, minimum degree on A^T + A in
   symmetric mode, a residual-checked fallback to COLAMD with partial pivoting).
@@ -272,11 +276,6 @@ def lu_factor(A, stats=None):
         return x
 
     return lu, solve
-
-
-def lu_solve(A, b):
-    """Solve A x = b with SuperLU (fast settings, safe ones if the residual is poor)."""
-    return lu_factor(A)[1](b)
 
 
 class _Stalled(Exception):

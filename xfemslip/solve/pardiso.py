@@ -1,6 +1,7 @@
 """MKL PARDISO for the Newton systems (K_ff + K_c) du = r (``linear_solver =
 "pardiso"``, the ``mkl`` extra: ``pip install 'xfemslip[mkl]'``, which brings
-pypardiso and with it Intel MKL).
+pypardiso and with it Intel MKL).  One module (about 550 lines): the ctypes
+calling convention, the two ways below and their shared analysis state.
 
 K_c only has entries among the contact dofs c (the rows and columns of the
 contact blocks, along the fractures), and the rest of the matrix is K_ff,
