@@ -97,7 +97,11 @@ def info() -> None:
     rows = [("xfemslip", __version__), ("python", platform.python_version())]
     rows += [
         (name, _dist_version(name))
-        for name in ("numpy", "scipy", "numba", "pyamg", "h5py", "meshio", "click")
+        for name in (
+            *("numpy", "scipy", "numba", "h5py", "meshio", "click", "tomli-w"),
+            # optional: AMG, figures, Dask sweeps, MKL PARDISO (the mkl extra)
+            *("pyamg", "matplotlib", "dask", "distributed", "pypardiso"),
+        )
     ]
     rows += numba_settings()
     rows += [("executable", sys.executable)]
