@@ -10,8 +10,10 @@ matplotlib is imported only when a figure is drawn, Dask only with
 
 from __future__ import annotations
 
+import contextlib
 import os
 import sys
+import time
 from pathlib import Path
 
 import click
@@ -97,18 +99,14 @@ def sweep(sweep_file, output, jobs, scheduler, force, verbose, debug) -> None:
         click.echo(
             f"{spec.name}: {len(spec.cases)} case(s) -> {folder} ({where})", err=True
         )
-        with click.progressbar(
-            length=len(spec.cases),
-            label=spec.name,
-            file=sys.stderr,  # click.get_text_stream is deprecated (Click 8.2)
-        ) as bar:
+        with _progress(spec.name, len(spec.cases)) as progress:
             rows = run_sweep(
                 spec,
                 folder,
                 jobs=n_jobs,
                 scheduler=scheduler,
                 force=force,
-                progress=lambda row: bar.update(1),
+                progress=progress,
             )
         click.echo(format_table(spec.keys, rows))
         _print_dfn_aggregate(spec.keys, rows)
@@ -123,6 +121,33 @@ def sweep(sweep_file, output, jobs, scheduler, force, verbose, debug) -> None:
         )
         if failed or refused:
             raise click.exceptions.Exit(EXIT_FAILURE)
+
+
+@contextlib.contextmanager
+def _progress(label: str, total: int):
+    """A callback per finished case: a progress bar on a terminal; elsewhere
+    (a pipe, a log file, CI) one line per case, so a long sweep reports as it
+    goes instead of one line and then silence."""
+    if sys.stderr.isatty():
+        with click.progressbar(
+            length=total,
+            label=label,
+            file=sys.stderr,  # click.get_text_stream is deprecated (Click 8.2)
+        ) as bar:
+            yield lambda row: bar.update(1)
+        return
+    start, done = time.monotonic(), 0
+
+    def line(row) -> None:
+        nonlocal done
+        done += 1
+        elapsed = time.monotonic() - start
+        click.echo(
+            f"[{done}/{total}] {row.case_id}: {row.status} ({elapsed:.1f} s)",
+            err=True,
+        )
+
+    yield line
 
 
 def _print_dfn_aggregate(keys, rows) -> None:

@@ -547,3 +547,21 @@ def test_a_sweep_of_too_much_case_text_is_refused(tmp_path, base):
     assert key == "vary"
     assert message.startswith("gives 10000 cases of a ")
     assert "more than the limit of 0.256 GB" in message
+
+
+def test_cli_sweep_in_a_pipe_reports_each_case(tmp_path, base, runner):
+    """Outside a terminal (CliRunner's streams, like a pipe or CI), each
+    finished case is one line on stderr, numbered, with its id, status and
+    elapsed time."""
+    path = _sweep(
+        tmp_path,
+        'base = "base.toml"\n[vary]\n"material.E" = [5e9, 6e9]\n',
+    )
+    out = tmp_path / "out"
+    result = runner.invoke(cli, ["sweep", str(path), "-o", str(out), "-j", "1"])
+    assert result.exit_code == 0, result.stderr
+    lines = [ln for ln in result.stderr.splitlines() if ln.startswith("[")]
+    assert [ln.split(" ", 1)[0] for ln in lines] == ["[1/2]", "[2/2]"]
+    ids = {r.case_id for r in run_sweep(load_sweep(path), out)}  # skipped: done
+    assert {ln.split(" ")[1].rstrip(":") for ln in lines} == ids
+    assert all(": ok (" in ln and ln.endswith(" s)") for ln in lines)
