@@ -36,6 +36,15 @@ class MaterialSpec:
 # (0.42 % at a/20) and the Newton iterations (2 per step on the plate case up
 # to 1e5) do not change.  A stiffer penalty only worsens the conditioning.
 AUTO_PENALTY = 1.0e3
+# The penalty range kn h/E where Newton was measured to converge on every
+# shipped case, kn = kt = 10^k E/h for k = -1..9 (benchmarks/penalty_range.py,
+# docs/robustness.md "Known limits"): 0.1 to 1e6.  Above it the contact
+# stiffness swamps the bulk stiffness by that ratio and the residual stalls at
+# round-off (eta 1e-8 to 6e-8, stick/slip states settled), just above the
+# default tolerance; every Newton failure then names the penalty and the top
+# of the range, and `check` and `run` warn outside it.
+PENALTY_RATIO_MEASURED = 1.0e6
+PENALTY_RATIO_LOWEST = 0.1
 
 # Length of a contact patch in local cell sizes ([solver] contact_patch): the
 # penalty law acts on the jump averaged over each patch (contact.ContactSet).

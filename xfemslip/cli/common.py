@@ -124,7 +124,9 @@ def reported_errors(debug: bool) -> Iterator[None]:
 
 
 def load_case_file(case: Path):
-    """Load and validate a case file (``CaseError`` on any problem)."""
+    """Load and validate a case file (``CaseError`` on any problem); values
+    that are valid but look like a mistake are logged as warnings
+    (xfemslip.case.plausibility)."""
     from xfemslip.case import load_case
 
     problem = path_problem(case)
@@ -134,7 +136,12 @@ def load_case_file(case: Path):
         raise UsageError(f"{case}: no such file")
     if case.is_dir():
         raise UsageError(f"{case}: is a directory, expected a case file (.toml)")
-    return load_case(case)
+    spec = load_case(case)
+    from xfemslip.case.plausibility import plausibility_warnings
+
+    for warning in plausibility_warnings(spec):
+        logging.getLogger("xfemslip.case").warning("%s: %s", shown_path(case), warning)
+    return spec
 
 
 def shown_path(path) -> str:

@@ -81,6 +81,7 @@ def check(case: Path, debug: bool) -> None:
     boundary corners); nothing is assembled or solved.
     """
     with reported_errors(debug):
+        configure_logging(False, True)  # warnings only: check prints the rest
         spec = load_case_file(case)
         from xfemslip.case import describe
         from xfemslip.simulation import check_geometry

@@ -41,7 +41,7 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.sparse as sp
 
-from xfemslip.case.specs import AUTO_PENALTY
+from xfemslip.case.specs import AUTO_PENALTY, PENALTY_RATIO_MEASURED
 from xfemslip.contact.branches import force_branches
 from xfemslip.contact.interface import ContactResult, ContactSet
 from xfemslip.contact.predictor import predict_state, predicted_law
@@ -61,13 +61,6 @@ logger = logging.getLogger(__name__)
 
 # kn*h/E above this is named in the message of a Newton failure as a likely cause.
 PENALTY_RATIO_HIGH = 1.0e5
-# Top of the penalty range where Newton was measured to converge on every
-# shipped case, kn = kt = 10^k E/h for k = -1..9 (benchmarks/penalty_range.py,
-# README "Known limits"): 0.1 to 1e6.  Above it the contact stiffness swamps
-# the bulk stiffness by that ratio and the residual stalls at round-off (eta
-# 1e-8 to 6e-8, stick/slip states settled), just above the default
-# tolerance; every Newton failure then names the penalty and this value.
-PENALTY_RATIO_MEASURED = 1.0e6
 # Step halvings tried by the line search before keeping the best trial.
 LINE_SEARCH_CUTS = 6
 # Load-step bisection: a load step that does not converge is cut in halves, at

@@ -169,6 +169,10 @@ def fake(monkeypatch) -> FakeSimulation:
     module.run_case = sim.run_case
     monkeypatch.setitem(sys.modules, "xfemslip.simulation", module)
     monkeypatch.setattr("xfemslip.case.load_case", sim.load_case, raising=False)
+    # the fake spec has only what run reads; it has nothing to warn about
+    monkeypatch.setattr(
+        "xfemslip.case.plausibility.plausibility_warnings", lambda spec: []
+    )
     return sim
 
 
