@@ -341,6 +341,7 @@ def screen(
         stress, fractures = _screen_inputs(case, stress, friction, cohesion, angles)
         if pore_pressure is None:
             pore_pressure = _case_pore_pressure(case)
+        _warn_depletion_path(case)
         f0 = friction if friction is not None else fractures[0][2]
         c0 = cohesion if cohesion is not None else fractures[0][3]
         screened = [
@@ -390,6 +391,23 @@ def _case_pore_pressure(case) -> float:
     if pp is None:
         return 0.0
     return pp.initial + (pp.change if pp.region == "all" else 0.0)
+
+
+def _warn_depletion_path(case) -> None:
+    """A case that depletes a region has a stress path the closed-form screen
+    does not follow (the region's contraction loads the fractures around
+    it): say so, and what answers it."""
+    spec = load_case_file(case) if case is not None else None
+    pp = None if spec is None else spec.pore_pressure
+    if pp is None or pp.region == "all" or pp.change == 0.0:
+        return
+    click.echo(
+        f"WARNING: {case}: the case changes the pore pressure by {pp.change:g} Pa "
+        "in its reservoir only; this screen keeps the total stress fixed and uses "
+        "the far-field pore pressure, so its dp to slip is not the case's "
+        f"(xfemslip deplete {case} solves the poroelastic path)",
+        err=True,
+    )
 
 
 def _screen_inputs(case, stress, friction, cohesion, angles):

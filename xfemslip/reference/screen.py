@@ -206,6 +206,9 @@ def format_report(stress, pore_pressure, friction, cohesion, step, fractures) ->
         f"effective principal stresses (compression): sigma1' = {band.sigma1:.6g} "
         f"at {band.dir1:.2f} deg from +x, sigma3' = {band.sigma3:.6g}",
         f"friction f = {friction:g} (phi = {phi:.2f} deg), cohesion c = {cohesion:g}",
+        "stress path: the total stress stays as given while the pore pressure "
+        "changes (the dp to slip below); the stress a depleting reservoir "
+        "transfers is not included (xfemslip deplete solves it)",
     ]
     if band.beta is None:
         lines.append("slip band: no orientation slips")

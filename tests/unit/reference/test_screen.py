@@ -180,3 +180,20 @@ def test_cli_screen_needs_a_stress_and_a_friction(runner):
     result = runner.invoke(cli, ["screen", "--stress", "-1e6", "-2e6", "0"])
     assert result.exit_code == 2
     assert "needs --friction" in result.stderr
+
+
+def test_cli_screen_states_its_stress_path(runner):
+    """The report says which stress path it assumes; a case that depletes a
+    reservoir region (whose contraction loads the fractures, a path the
+    closed form does not follow) gets a warning naming deplete, a case
+    without one does not."""
+    plain = runner.invoke(cli, ["screen", "cases/reservoir_depletion.toml"])
+    assert plain.exit_code == 0, plain.stderr
+    assert "stress path: the total stress stays as given" in plain.stdout
+    assert "WARNING" not in plain.stderr
+    case = "cases/depleting_reservoir.toml"
+    depleting = runner.invoke(cli, ["screen", case])
+    assert depleting.exit_code == 0, depleting.stderr
+    (line,) = [ln for ln in depleting.stderr.splitlines() if "WARNING" in ln]
+    assert "-2e+07 Pa in its reservoir only" in line
+    assert f"xfemslip deplete {case}" in line
