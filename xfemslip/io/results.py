@@ -22,7 +22,7 @@ from pathlib import Path
 from xfemslip import interrupt
 from xfemslip.io import hdf5
 from xfemslip.io.folder import output_folder
-from xfemslip.post.fields import VisMesh
+from xfemslip.post.fields import VisMesh, stress_for_paraview
 from xfemslip.post.result import Result
 
 __all__ = ["OUTPUT_FILES", "run_folder", "write_results"]
@@ -80,6 +80,7 @@ def _write_vtu(folder, result, vis_mesh, fracture_ids) -> None:
             "stress": f.stress,
             "stress_zz": f.stress_zz,
             "principal_stress": f.principal_stress,
+            **stress_for_paraview(f.stress, f.stress_zz),
         }
         if f.effective_stress is not None:
             cell_data["effective_stress"] = f.effective_stress

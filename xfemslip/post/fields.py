@@ -259,6 +259,27 @@ def step_fields(model, r) -> StepFields:
     )
 
 
+def stress_for_paraview(stress, stress_zz) -> dict[str, np.ndarray]:
+    """The element stress as ParaView reads it: ``stress_tensor`` (M, 6) in
+    VTK's symmetric-tensor order XX, YY, ZZ, XY, YZ, XZ (so ParaView's tensor
+    filters and its component names apply), ``mean_stress`` (M,) = trace / 3
+    and ``von_mises`` (M,) = sqrt(3 J2) [Pa], tension positive.
+
+    ``stress`` (M, 3) is sxx, syy, sxy; ``stress_zz`` (M,) the out-of-plane
+    stress (zero in plane stress)."""
+    sxx, syy, sxy = (np.asarray(stress, float)[:, k] for k in range(3))
+    szz = np.asarray(stress_zz, float)
+    zero = np.zeros_like(sxx)
+    tensor = np.column_stack([sxx, syy, szz, sxy, zero, zero])
+    mean = (sxx + syy + szz) / 3.0
+    j2 = ((sxx - syy) ** 2 + (syy - szz) ** 2 + (szz - sxx) ** 2) / 6.0 + sxy**2
+    return {
+        "stress_tensor": tensor,
+        "mean_stress": mean,
+        "von_mises": np.sqrt(3.0 * j2),
+    }
+
+
 def first_non_finite(steps) -> tuple[int, str] | None:
     """(index, field name) of the first of ``steps`` (StepFields) holding NaN
     or inf, or None: such a step is never written."""
