@@ -186,8 +186,9 @@ def _default_figure_dir(results: list[Path]) -> Path:
     "--figure",
     "kinds",
     multiple=True,
-    type=click.Choice(KINDS),
-    help="Draw only this figure (repeatable) [default: all].",
+    type=click.Choice((*KINDS, "network")),
+    help="Draw only this figure (repeatable) [default: all but network]; "
+    "network: slip and contact state of every fracture of the first result.",
 )
 @click.option(
     "--format",

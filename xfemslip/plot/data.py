@@ -9,6 +9,7 @@ deformed mesh show the displacement jump.  No matplotlib here.
 
 from __future__ import annotations
 
+import logging
 import math
 import re
 import tomllib
@@ -19,6 +20,8 @@ import numpy as np
 
 from xfemslip.errors import UsageError
 from xfemslip.io.read import read_result
+
+logger = logging.getLogger(__name__)
 
 
 @dataclass
@@ -100,11 +103,61 @@ def _far_pore_pressure(case: dict) -> float:
     return float(pp.get("initial", 0.0)) + float(change)
 
 
-def _fracture_data(result, case: dict) -> list[FractureData]:
-    """The fractures of the case's [[fractures]] tables, final step."""
+def _fracture_laws(result, case: dict, path: Path) -> list[tuple[float, float, float]]:
+    """(theta [deg], friction, cohesion) of every fracture of the result, in
+    its order: from the case the result carries, rebuilt beside the result
+    (so [network] fractures, generated or from a CSV file, get their own
+    values), else from the [[fractures]] tables and the [network] defaults,
+    with a warning that says so."""
+    from xfemslip.case import loads_case
+    from xfemslip.errors import XfemslipError
+
+    n = len(result.fractures)
+    try:
+        spec = loads_case(str(result.attrs.get("case_toml", "")), path)
+        tables = case.get("fractures", [])
+        laws = [
+            (
+                _chord_angle(tables[i] if i < len(tables) else {"points": fr.points}),
+                fr.friction,
+                fr.cohesion,
+            )
+            for i, fr in enumerate(spec.fractures)
+        ]
+        if len(laws) == n:
+            return laws
+    except XfemslipError as err:
+        logger.warning(
+            "%s: the case does not load here (%s); the network fractures' "
+            "friction and cohesion are the [network] defaults",
+            path,
+            " ".join(str(err).split())[:120],
+        )
     tables = case.get("fractures", [])
+    net = case.get("network", {}) if isinstance(case.get("network"), dict) else {}
+    laws = [
+        (
+            _chord_angle(t),
+            float(t.get("friction", 0.0)),
+            float(t.get("cohesion", 0.0)),
+        )
+        for t in tables[:n]
+    ]
+    for ff in result.fractures[len(laws) :]:
+        theta = _chord_angle({"points": np.asarray(ff.points)[[0, -1]]})
+        laws.append(
+            (theta, float(net.get("friction", 0.0)), float(net.get("cohesion", 0.0)))
+        )
+    return laws
+
+
+def _fracture_data(result, case: dict, path: Path) -> list[FractureData]:
+    """Every fracture of the result ([[fractures]] and [network]), final step."""
+    laws = _fracture_laws(result, case, path)
     out = []
-    for i, (table, ff) in enumerate(zip(tables, result.fractures, strict=False)):
+    for i, (ff, (theta, friction, cohesion)) in enumerate(
+        zip(result.fractures, laws, strict=True)
+    ):
         out.append(
             FractureData(
                 index=i,
@@ -118,9 +171,9 @@ def _fracture_data(result, case: dict) -> list[FractureData]:
                 ),
                 shear_traction=ff.shear_traction,
                 state=ff.state,
-                theta=_chord_angle(table),
-                friction=float(table.get("friction", 0.0)),
-                cohesion=float(table.get("cohesion", 0.0)),
+                theta=theta,
+                friction=float(friction),
+                cohesion=float(cohesion),
             )
         )
     return out
@@ -225,7 +278,7 @@ def figure_data(path: str | Path, label: str | None = None) -> ResultData:
         stress_state=state,
         stress_source=source,
         pore_pressure=_far_pore_pressure(case),
-        fractures=_fracture_data(result, case),
+        fractures=_fracture_data(result, case, path.with_name("case.toml")),
     )
     vtu = path.with_name("result.vtu")
     if vtu.is_file():

@@ -201,3 +201,37 @@ def test_run_and_sweep_do_not_import_matplotlib(tmp_path):
     )
     assert done.returncode == 0, done.stderr
     assert done.stdout.strip() == "[]"
+
+
+def test_generated_network_gets_its_slip_mohr_and_network_figures(tmp_path, runner):
+    """A result whose fractures come from [network.generate] (no [[fractures]]
+    tables): every fracture is in the figure data with the friction of the
+    network and the angle of its own chord, and slip, mohr and network are
+    drawn (they were skipped as 'no fracture')."""
+    import math
+
+    from tests.support.casegen import sweep_member
+    from xfemslip.case import loads_case
+
+    text = sweep_member(
+        index=0, **{"network.generate.count": 8, "mesh.elements": [30, 30]}
+    )
+    case = tmp_path / "net.toml"
+    case.write_text(text)
+    out = tmp_path / "out"
+    assert runner.invoke(cli, ["run", "-q", str(case), "-o", str(out)]).exit_code == 0
+    spec = loads_case(text, case)
+    data = figure_data(out / "result.h5")
+    assert len(data.fractures) == len(spec.fractures) > 0
+    for fd, fr in zip(data.fractures, spec.fractures, strict=True):
+        d = fr.points[-1] - fr.points[0]
+        assert fd.theta == pytest.approx(math.degrees(math.atan2(d[1], d[0])))
+        assert fd.friction == fr.friction and fd.cohesion == fr.cohesion
+    figs = tmp_path / "figs"
+    kinds = ["--figure", "slip", "--figure", "mohr", "--figure", "network"]
+    result = runner.invoke(
+        cli, ["plot", str(out), "-o", str(figs), "--format", "png", *kinds]
+    )
+    assert result.exit_code == 0, result.stderr
+    for name in ("slip", "mohr", "network"):
+        assert (figs / f"{name}.png").stat().st_size > 10_000
