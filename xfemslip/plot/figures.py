@@ -99,33 +99,39 @@ def _norm(values: np.ndarray):
 
 
 def figure_displacement(results: Sequence[ResultData]) -> Figure:
-    """u_x (top row) and u_y (bottom row) contours [m], one column per result."""
+    """u_x (top row) and u_y (bottom row) contours [mm], one column per
+    result; each row shares one colour scale, so the columns of a study
+    compare by colour."""
     fig, axes = _grid(2, len(results))
-    for j, data in enumerate(results):
-        tri, u = _triangulation(data)
-        for i, (comp, word) in enumerate(((0, "horizontal"), (1, "vertical"))):
+    fields = [_triangulation(data) for data in results]
+    for i, (comp, word) in enumerate(((0, "horizontal"), (1, "vertical"))):
+        values = [1e3 * u[:, comp] for _, u in fields]
+        lo = min(float(v.min()) for v in values)
+        hi = max(float(v.max()) for v in values)
+        levels = np.linspace(lo, hi, 21) if hi > lo else 20
+        for j, data in enumerate(results):
             ax = axes[i, j]
-            cs = ax.tricontourf(tri, u[:, comp], levels=20, cmap="viridis")
-            fig.colorbar(cs, ax=ax, label=f"$u_{'xy'[comp]}$ [m]", shrink=0.8)
-            _frame(ax, data, f"{data.label}\n{word} displacement $u_{'xy'[comp]}$ [m]")
+            cs = ax.tricontourf(fields[j][0], values[j], levels=levels, cmap="viridis")
+            fig.colorbar(cs, ax=ax, label=f"$u_{'xy'[comp]}$ [mm]", shrink=0.8)
+            _frame(ax, data, f"{data.label}\n{word} displacement $u_{'xy'[comp]}$ [mm]")
     return fig
 
 
 def figure_principal(results: Sequence[ResultData]) -> Figure:
-    """Principal stresses per element [Pa], tension positive."""
+    """Principal stresses per element [MPa], tension positive; each row
+    shares one colour scale across the results."""
     fig, axes = _grid(2, len(results))
     rows = (
-        (1, r"$\sigma_{min}$ (most compressive) [Pa]"),
-        (0, r"$\sigma_{max}$ (least compressive) [Pa]"),
+        (1, r"$\sigma_{min}$ (most compressive) [MPa]"),
+        (0, r"$\sigma_{max}$ (least compressive) [MPa]"),
     )
-    for j, data in enumerate(results):
-        polys = data.points[data.cells]
-        for i, (col, title) in enumerate(rows):
-            values = data.principal[:, col]
-            norm, cmap = _norm(values)
+    for i, (col, title) in enumerate(rows):
+        values = [1e-6 * data.principal[:, col] for data in results]
+        norm, cmap = _norm(np.concatenate(values))
+        for j, data in enumerate(results):
             coll = PolyCollection(
-                polys,
-                array=values,
+                data.points[data.cells],
+                array=values[j],
                 cmap=cmap,
                 norm=norm,
                 edgecolors="face",
@@ -135,7 +141,7 @@ def figure_principal(results: Sequence[ResultData]) -> Figure:
             ax.add_collection(coll)
             ax.margins(0.0)
             ax.autoscale_view()
-            fig.colorbar(coll, ax=ax, label="[Pa], tension positive", shrink=0.8)
+            fig.colorbar(coll, ax=ax, label="[MPa], tension positive", shrink=0.8)
             _frame(ax, data, f"{data.label}\n{title}")
     return fig
 

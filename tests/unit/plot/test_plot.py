@@ -235,3 +235,25 @@ def test_generated_network_gets_its_slip_mohr_and_network_figures(tmp_path, runn
     assert result.exit_code == 0, result.stderr
     for name in ("slip", "mohr", "network"):
         assert (figs / f"{name}.png").stat().st_size > 10_000
+
+
+def test_panels_of_a_study_share_their_colour_scale(two_runs):
+    """The columns of one figure compare by colour: each row's panels have
+    the same limits, which span every result's values (MPa and mm)."""
+    from xfemslip.plot.figures import figure_displacement, figure_principal
+
+    results = [figure_data(out / "result.h5") for out in two_runs]
+    fig = figure_principal(results)
+    axes = fig.axes[:4]  # the 2 x 2 panels, row by row; the colour bars follow
+    for row, col in ((0, 1), (1, 0)):  # sigma_min, then sigma_max
+        norms = [ax.collections[0].norm for ax in axes[2 * row : 2 * row + 2]]
+        assert norms[0].vmin == norms[1].vmin and norms[0].vmax == norms[1].vmax
+        values = np.concatenate([1e-6 * r.principal[:, col] for r in results])
+        assert norms[0].vmin <= values.min() and norms[0].vmax >= values.max()
+    fig = figure_displacement(results)
+    panels = fig.axes[:4]
+    for row in range(2):
+        levels = [ax.collections[0].levels for ax in panels[2 * row : 2 * row + 2]]
+        np.testing.assert_array_equal(levels[0], levels[1])
+        u = np.concatenate([1e3 * r.displacement[:, row] for r in results])
+        assert levels[0][0] <= u.min() + 1e-12 and levels[0][-1] >= u.max() - 1e-12
