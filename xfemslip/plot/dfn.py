@@ -16,6 +16,7 @@ import numpy as np
 from matplotlib.collections import LineCollection
 from matplotlib.colors import Normalize
 from matplotlib.figure import Figure
+from matplotlib.ticker import MaxNLocator
 
 from xfemslip.conventions import SLIP
 from xfemslip.errors import OutputError, UsageError
@@ -111,6 +112,9 @@ def _draw_counts(ax, counts: np.ndarray, totals: np.ndarray) -> None:
     total = f"{int(totals[0])}" if totals.size and np.ptp(totals) == 0 else "varies"
     ax.set_xlabel(f"slipping fractures (of {total})")
     ax.set_ylabel("realizations")
+    # both axes count: no fractional ticks
+    ax.xaxis.set_major_locator(MaxNLocator(integer=True))
+    ax.yaxis.set_major_locator(MaxNLocator(integer=True))
     if counts.size:
         ax.set_title(
             f"{counts.size} realizations: mean {counts.mean():.1f}, "

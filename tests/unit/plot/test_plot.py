@@ -257,3 +257,20 @@ def test_panels_of_a_study_share_their_colour_scale(two_runs):
         np.testing.assert_array_equal(levels[0], levels[1])
         u = np.concatenate([1e3 * r.displacement[:, row] for r in results])
         assert levels[0][0] <= u.min() + 1e-12 and levels[0][-1] >= u.max() - 1e-12
+
+
+def test_realization_histogram_has_whole_number_ticks(tmp_path):
+    """Counts of fractures and of realizations are whole numbers, and so are
+    the histogram's ticks (matplotlib's default locator gives 0.5 steps
+    for a handful of realizations)."""
+    from xfemslip.case import load_case
+    from xfemslip.plot.dfn import figure_network
+
+    summary = tmp_path / "summary.csv"
+    rows = ["case_id,status,slipping_fractures,fractures"]
+    rows += [f"{i:03d},ok,{n},15" for i, n in enumerate([1, 2, 2, 3])]
+    summary.write_text("\n".join(rows) + "\n")
+    spec = load_case(ROOT / "cases" / "fracture_network.toml")
+    hist = figure_network(spec, None, summary).axes[1]
+    for ticks in (hist.get_xticks(), hist.get_yticks()):
+        assert len(ticks) >= 2 and np.all(ticks == np.round(ticks))
