@@ -26,6 +26,7 @@ import logging
 from collections.abc import Sequence
 from pathlib import Path
 
+import matplotlib
 import numpy as np
 from matplotlib.collections import LineCollection, PolyCollection
 from matplotlib.colors import Normalize
@@ -215,9 +216,13 @@ def figure_deformed(
 
 
 def figure_slip(results: Sequence[ResultData]) -> Figure:
-    """|slip| [m] along every fracture against arc length, results overlaid."""
+    """|slip| [mm] along every fracture against arc length, results overlaid;
+    one colour per result (or per fracture of a single result), distinct for
+    any number of them."""
     fig = Figure(figsize=(6.4, 4.2), layout="constrained")
     ax = fig.subplots()
+    many = len(results) if len(results) > 1 else max(len(results[0].fractures), 1)
+    colours = _distinct_colours(many)
     for k, data in enumerate(results):
         for fr in data.fractures:
             label = (
@@ -227,19 +232,27 @@ def figure_slip(results: Sequence[ResultData]) -> Figure:
             )
             s = fr.s - fr.s.min() if fr.s.size else fr.s
             # one result with several fractures (a network): one colour each
-            colour = f"C{(k if len(results) > 1 else fr.index) % 10}"
-            (line,) = ax.plot(s, np.abs(fr.slip), lw=1.4, color=colour, label=label)
+            colour = colours[(k if len(results) > 1 else fr.index) % len(colours)]
+            mm = 1e3 * np.abs(fr.slip)
+            (line,) = ax.plot(s, mm, lw=1.4, color=colour, label=label)
             in_slip = fr.state == SLIP
-            ax.plot(
-                s[in_slip], np.abs(fr.slip[in_slip]), ".", ms=3, color=line.get_color()
-            )
+            ax.plot(s[in_slip], mm[in_slip], ".", ms=3, color=line.get_color())
     ax.set_xlabel("distance from the first tip along the fracture x_0 [m]")
-    ax.set_ylabel("slip |[[u]] . t| [m]")
+    ax.set_ylabel("slip |[[u]] . t| [mm]")
     ax.set_title("Slip along the fracture (dots: points in slip)", fontsize=10)
-    ax.ticklabel_format(axis="y", style="sci", scilimits=(-3, 3))
     ax.grid(alpha=0.3)
     ax.legend(fontsize=8)
     return fig
+
+
+def _distinct_colours(n: int) -> list:
+    """n colours that can be told apart: matplotlib's ten-colour cycle up to
+    10, then tab20, then evenly spaced hues of the turbo map."""
+    if n <= 10:
+        return [f"C{i}" for i in range(10)]
+    if n <= 20:
+        return [matplotlib.colormaps["tab20"](i) for i in range(20)]
+    return list(matplotlib.colormaps["turbo"](np.linspace(0.0, 1.0, n)))
 
 
 STATE_COLOURS = {0: "0.6", 1: "tab:blue", 2: "tab:red"}  # open, stick, slip

@@ -10,6 +10,7 @@ import sys
 from pathlib import Path
 
 import h5py
+import matplotlib
 import numpy as np
 import pytest
 from click.testing import CliRunner
@@ -74,7 +75,7 @@ def test_slip_figure_draws_the_result_data(two_runs):
         with h5py.File(out / "result.h5") as f:
             s, slip = f["fractures/0/s"][()], f["fractures/0/slip"][()]
         np.testing.assert_array_equal(line.get_xdata(), s - s.min())
-        np.testing.assert_array_equal(line.get_ydata(), np.abs(slip))
+        np.testing.assert_array_equal(line.get_ydata(), 1e3 * np.abs(slip))  # mm
         assert line.get_label() == out.name.split("_", 1)[1]
 
 
@@ -274,3 +275,13 @@ def test_realization_histogram_has_whole_number_ticks(tmp_path):
     hist = figure_network(spec, None, summary).axes[1]
     for ticks in (hist.get_xticks(), hist.get_yticks()):
         assert len(ticks) >= 2 and np.all(ticks == np.round(ticks))
+
+
+def test_slip_figure_colours_tell_many_fractures_apart():
+    """One colour per fracture of a network, all different up to any count
+    (the ten-colour cycle repeated from the eleventh)."""
+    from xfemslip.plot.figures import _distinct_colours
+
+    for n in (3, 10, 15, 20, 40):
+        colours = {matplotlib.colors.to_rgba(c) for c in _distinct_colours(n)[:n]}
+        assert len(colours) == n
