@@ -1,8 +1,9 @@
 """A signal always ends the command (xfemslip.interrupt).
 
 An exception raised inside a destructor is printed as "Exception ignored" and
-dropped by Python: that is how a Ctrl-C in the first milliseconds of writing
-result.h5 (inside h5py's ``__dealloc__``) used to end in exit 0.  These tests
+dropped by Python: a Ctrl-C in the first milliseconds of writing result.h5
+(inside h5py's ``__dealloc__``) would end in exit 0 if the signal were acted
+on there instead of held back until the data set is written.  These tests
 send real signals to this process in the same situations.
 """
 

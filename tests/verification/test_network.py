@@ -338,8 +338,8 @@ DFN = build.case_text(
 
 def test_random_network_with_crossings_converges_with_friction_everywhere():
     """Slip next to a junction reverses across a stick band of width
-    2 f |p_N| / k_T; the Newton step used to jump over it back and forth
-    (this realization failed even after 5 load-step cuts).  Patches whose
+    2 f |p_N| / k_T; a plain Newton step jumps over it back and forth (this
+    realization then fails even after 5 load-step cuts).  Patches whose
     slip the step reverses are held in stick until convergence
     (remedies.slip_reversals).  Measured: 4 iterations (1 hold) with the
     stick/slip predictor, 9 (4 holds, the per-patch limit reached) without.

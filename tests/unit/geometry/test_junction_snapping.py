@@ -1,5 +1,5 @@
 """Snapping rules of the junction search (geometry.find_junctions) on the
-inputs that used to lay one fracture onto another: near-parallel pairs, X
+inputs where snapping could lay one fracture onto another: near-parallel pairs, X
 crossings at a fraction of a degree, narrow V's, both ends of a fracture
 within half a cell of another's ends, stacks of parallel fractures, dense
 generated networks.

@@ -208,7 +208,7 @@ def test_generated_network_gets_its_slip_mohr_and_network_figures(tmp_path, runn
     """A result whose fractures come from [network.generate] (no [[fractures]]
     tables): every fracture is in the figure data with the friction of the
     network and the angle of its own chord, and slip, mohr and network are
-    drawn (they were skipped as 'no fracture')."""
+    drawn."""
     import math
 
     from tests.support.casegen import sweep_member
