@@ -1,4 +1,6 @@
-"""Shared pytest configuration: the ``--run-slow`` opt-in for ``slow`` tests."""
+"""Shared pytest configuration: the ``--run-slow`` opt-in for ``slow`` tests,
+the ``xfemslip`` logger put back after each test, and ``runner``, the CLI
+runner of the command tests."""
 
 from __future__ import annotations
 
@@ -6,6 +8,7 @@ import contextlib
 import logging
 
 import pytest
+from click.testing import CliRunner
 
 
 def pytest_addoption(parser: pytest.Parser) -> None:
@@ -55,3 +58,12 @@ def _package_logging_per_module():
 def _package_logging_per_test():
     with _package_logging_kept():
         yield
+
+
+@pytest.fixture
+def runner() -> CliRunner:
+    """A CliRunner whose result keeps stdout and stderr apart."""
+    try:  # click < 8.2 mixes stderr into stdout unless told otherwise
+        return CliRunner(mix_stderr=False)
+    except TypeError:
+        return CliRunner()

@@ -222,7 +222,7 @@ def case_footprint(spec) -> Footprint:
         n_cells=n_cells,
         n_dofs=n_dofs,
         # the band of the enriched dofs is not known yet: AMG if large enough
-        linear=_linear(spec, spec.mesh.x, spec.mesh.y, n_dofs, 0.0),
+        linear=_linear(spec, spec.mesh.x, spec.mesh.y, n_dofs),
         nnz=NNZ_PER_ENTRY * entries + 20.0 * (n_dofs - 2 * n_nodes),
         steps=spec.loading.steps,
         entries=entries,
@@ -279,7 +279,9 @@ def enriched_footprint(spec, mesh, fractures, cand) -> Footprint:
         n_nodes=mesh.n_nodes,
         n_cells=mesh.n_cells,
         n_dofs=n_dofs,
-        linear=_linear(spec, mesh.x, mesh.y, n_dofs, _band_share(mesh, cand, n_dofs)),
+        linear=_linear(
+            spec, mesh.x, mesh.y, n_dofs, lambda: _band_share(mesh, cand, n_dofs)
+        ),
         nnz=NNZ_PER_ENTRY * entries,
         steps=spec.loading.steps,
         # the points are estimated up to 20 % low (QP_CELL ...): near the
@@ -316,7 +318,13 @@ def model_footprint(model) -> Footprint:
         n_nodes=model.mesh.n_nodes,
         n_cells=model.mesh.n_cells,
         n_dofs=p.n_dofs,
-        linear=_linear(model.spec, model.mesh.x, model.mesh.y, p.n_dofs, p),
+        linear=_linear(
+            model.spec,
+            model.mesh.x,
+            model.mesh.y,
+            p.n_dofs,
+            lambda: _problem_band_share(p),
+        ),
         nnz=float(model.problem.K.nnz),
         steps=model.spec.loading.steps,
         numba=contact.kernels == "numba",
@@ -387,11 +395,11 @@ def configure_allocator() -> bool:
     return True
 
 
-def _linear(spec, x, y, n_dofs, band) -> str:
+def _linear(spec, x, y, n_dofs, band_share=None) -> str:
     """The linear solver (linsolve.choose) for a mesh with grid lines x, y
-    and about n_dofs free dofs; band: the share of them in the AMG band, or
-    the Problem to take it from (only computed where the other conditions
-    hold)."""
+    and about n_dofs free dofs; ``band_share()`` gives the share of them in
+    the AMG band, and is called only when that decides between AMG and
+    SuperLU (None: taken as 0, not known yet)."""
     from xfemslip.solve import linear as linsolve
 
     method = spec.solver.linear_solver
@@ -403,11 +411,21 @@ def _linear(spec, x, y, n_dofs, band) -> str:
     lines = np.zeros((x.size + y.size, 2))
     lines[: x.size, 0], lines[x.size :, 1] = x, y
     lines[: x.size, 1], lines[x.size :, 0] = y[0], x[0]
-    if not isinstance(band, float):  # the Problem: its band as "auto" forms it
-        enr = np.arange(band.n_dofs) >= 2 * band.node_xy.shape[0]
-        mask = linsolve.band_mask(band.K, enr, linsolve.AMG_BAND_LAYERS)
-        band = float(mask.sum()) / band.n_dofs
-    return linsolve.choose(method, n_dofs, lines, band)
+    # the band only narrows AMG down to SuperLU: with no band, anything but
+    # "amg" is the answer already
+    choice = linsolve.choose(method, n_dofs, lines, 0.0)
+    if choice != "amg" or band_share is None:
+        return choice
+    return linsolve.choose(method, n_dofs, lines, band_share())
+
+
+def _problem_band_share(problem) -> float:
+    """Share of the Problem's dofs in the AMG band, as "auto" forms it."""
+    from xfemslip.solve import linear as linsolve
+
+    enr = np.arange(problem.n_dofs) >= 2 * problem.node_xy.shape[0]
+    mask = linsolve.band_mask(problem.K, enr, linsolve.AMG_BAND_LAYERS)
+    return float(mask.sum()) / problem.n_dofs
 
 
 def _band_share(mesh, cand, n_dofs) -> float:

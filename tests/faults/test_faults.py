@@ -18,7 +18,6 @@ from pathlib import Path
 import h5py
 import numpy as np
 import pytest
-from click.testing import CliRunner
 
 import xfemslip.simulation as simulation
 from xfemslip.case import build
@@ -37,14 +36,6 @@ def case_file(folder: Path, *, n=10, steps=3, formats=("h5", "vtu")) -> Path:
     path = folder / "case.toml"
     path.write_text(text)
     return path
-
-
-@pytest.fixture
-def runner() -> CliRunner:
-    try:  # click < 8.2 mixes stderr into stdout unless told otherwise
-        return CliRunner(mix_stderr=False)
-    except TypeError:
-        return CliRunner()
 
 
 def _error_line(result) -> str:
@@ -195,8 +186,8 @@ def test_output_under_a_file_is_a_clear_error(tmp_path, runner):
 
 
 def test_existing_output_is_refused_untouched(tmp_path, runner):
-    """README: an output folder holding results is refused (exit 2) unless
-    --overwrite; the earlier files stay byte for byte."""
+    """docs/output-format.md: an output folder holding results is refused
+    (exit 2) unless --overwrite; the earlier files stay byte for byte."""
     case = case_file(tmp_path, steps=1, formats=["h5"])
     out = tmp_path / "out"
     first = runner.invoke(cli, ["run", "-q", str(case), "-o", str(out)])

@@ -21,7 +21,6 @@ from pathlib import Path
 
 import h5py
 import pytest
-from click.testing import CliRunner
 
 from tests.faults import harness
 from xfemslip.case import build
@@ -36,14 +35,6 @@ def scenario(tmp_path_factory) -> harness.Scenario:
     """Case A (10 x 10, 3 steps) complete in ref-a; case B (24 x 24, 6 steps)
     in ref-b; both signatures."""
     return harness.Scenario(tmp_path_factory.mktemp("sets"), n=(10, 24), steps=(3, 6))
-
-
-@pytest.fixture
-def runner() -> CliRunner:
-    try:  # click < 8.2 mixes stderr into stdout unless told otherwise
-        return CliRunner(mix_stderr=False)
-    except TypeError:
-        return CliRunner()
 
 
 def _start(scenario, out: Path, point: str, *extra: str) -> subprocess.Popen:

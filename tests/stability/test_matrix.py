@@ -128,7 +128,7 @@ def test_cohesion_up_to_no_slip(fraction, tangent):
     """Cohesion from 0 to twice the no-slip value c* = |tau| - f |sigma_n|
     (crack at 50 degrees, f = 0.3): below c* the slip is the closed form's;
     from 1.2 c* no point slips.  Just above c* (1.01 .. 1.1 c*) the discrete
-    tractions, which deviate near the tips (README, known limitation), let
+    tractions, which deviate near the tips (docs/robustness.md, known limits), let
     some points slip (measured SLIP share 38 % at 1.01 c*, 4 % at 1.05, 2 % at
     1.1), but by no more than the elastic penalty jump: max |slip| 0.29 % of
     that of the cohesionless crack."""

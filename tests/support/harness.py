@@ -15,18 +15,9 @@ import numpy as np
 import xfemslip
 from xfemslip.case import build, load_case
 from xfemslip.conventions import OPEN, SLIP, STICK  # noqa: F401 (re-exported)
+from xfemslip.io.read import FRACTURE_ARRAYS
 from xfemslip.simulation import run_case
 from xfemslip.verify.problems import box_edges, write_edge_csv  # noqa: F401 (re-exported)
-
-FRACTURE_KEYS = (
-    "s",
-    "points",
-    "slip",
-    "opening",
-    "normal_traction",
-    "shear_traction",
-    "state",
-)
 
 
 @dataclass
@@ -94,7 +85,7 @@ def read_result(path: Path, summary=None) -> Result:
         cells=read.cells,
         displacement=read.displacement,
         stress=read.stress,
-        fractures=[{k: getattr(f, k) for k in FRACTURE_KEYS} for f in read.fractures],
+        fractures=[{k: getattr(f, k) for k in FRACTURE_ARRAYS} for f in read.fractures],
     )
 
 

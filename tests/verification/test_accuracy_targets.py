@@ -38,7 +38,7 @@ def a20(tmp_path_factory):
 
 def test_slip_error_at_a_over_20(a20):
     row = V.measure(a20, INCLINED, 20)
-    # target 1 %; measured 0.42 % (README accuracy table)
+    # target 1 %; measured 0.42 % (docs/verification.md)
     assert row.slip_error <= V.SLIP_TARGET
 
 

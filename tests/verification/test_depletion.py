@@ -219,7 +219,7 @@ def test_critical_depletion_against_stress_path():
     tol = 1.0e3  # Pa
     onsets, results = critical_depletion(newton_solver(model), model, 4, tol)
     ref = critical_change_uniaxial((-44.0e6, -62.0e6, 0.0), 30.0e6, 0.2, 60.0, 0.5)
-    assert ref == pytest.approx(-13.7325e6, rel=1e-4)  # hand value (README)
+    assert ref == pytest.approx(-13.7325e6, rel=1e-4)  # hand value (docs/depletion.md)
     o = onsets[0]
     assert o.dp_lower > o.dp_upper  # bracket: stuck above, slipping below
     assert abs(o.dp_upper - o.dp_lower) <= tol

@@ -11,6 +11,7 @@ matplotlib is imported only when a figure is drawn, Dask only with
 from __future__ import annotations
 
 import contextlib
+import logging
 import os
 import sys
 import time
@@ -339,10 +340,12 @@ def screen(
     with reported_errors(debug):
         from xfemslip.reference import screen as scr
 
-        stress, fractures = _screen_inputs(case, stress, friction, cohesion, angles)
+        configure_logging(False, True)  # the warnings; the report is printed
+        spec = load_case_file(case) if case is not None else None
+        stress, fractures = _screen_inputs(spec, stress, friction, cohesion, angles)
         if pore_pressure is None:
-            pore_pressure = _case_pore_pressure(case)
-        _warn_depletion_path(case)
+            pore_pressure = _case_pore_pressure(spec)
+        _warn_depletion_path(spec, case)
         f0 = friction if friction is not None else fractures[0][2]
         c0 = cohesion if cohesion is not None else fractures[0][3]
         screened = [
@@ -384,37 +387,36 @@ def _angles(step: float):
     return np.arange(0.0, 180.0, step)
 
 
-def _case_pore_pressure(case) -> float:
+def _case_pore_pressure(spec) -> float:
     """Final far-field pore pressure of CASE's [pore_pressure] (initial, plus
     the change when it acts in the whole model), else 0 [Pa]."""
-    spec = load_case_file(case) if case is not None else None
     pp = None if spec is None else spec.pore_pressure
     if pp is None:
         return 0.0
     return pp.initial + (pp.change if pp.region == "all" else 0.0)
 
 
-def _warn_depletion_path(case) -> None:
+def _warn_depletion_path(spec, case) -> None:
     """A case that depletes a region has a stress path the closed-form screen
     does not follow (the region's contraction loads the fractures around
     it): say so, and what answers it."""
-    spec = load_case_file(case) if case is not None else None
     pp = None if spec is None else spec.pore_pressure
     if pp is None or pp.region == "all" or pp.change == 0.0:
         return
-    click.echo(
-        f"WARNING: {case}: the case changes the pore pressure by {pp.change:g} Pa "
-        "in its reservoir only; this screen keeps the total stress fixed and uses "
-        "the far-field pore pressure, so its dp to slip is not the case's "
-        f"(xfemslip deplete {case} solves the poroelastic path)",
-        err=True,
+    logging.getLogger("xfemslip.reference.screen").warning(
+        "%s: the case changes the pore pressure by %g Pa in its reservoir only; "
+        "this screen keeps the total stress fixed and uses the far-field pore "
+        "pressure, so its dp to slip is not the case's (xfemslip deplete %s "
+        "solves the poroelastic path)",
+        case,
+        pp.change,
+        case,
     )
 
 
-def _screen_inputs(case, stress, friction, cohesion, angles):
-    """(stress, [(label, theta, f, c)]) from CASE and the options; a
-    fracture-less entry (label "") carries the defaults of f and c."""
-    spec = load_case_file(case) if case is not None else None
+def _screen_inputs(spec, stress, friction, cohesion, angles):
+    """(stress, [(label, theta, f, c)]) from the case's spec (or None) and the
+    options; a fracture-less entry (label "") carries the defaults of f and c."""
     if stress is None:
         if spec is None or spec.loading.stress is None:
             raise UsageError(

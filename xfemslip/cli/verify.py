@@ -48,7 +48,7 @@ from xfemslip.errors import UsageError
 @debug_option
 def verify(quick, tip, plot, csv_path, penalty, debug) -> None:
     """Run the verification problems against closed forms; exit 1 if a target
-    is missed (see README, Verification)."""
+    is missed (see docs/verification.md)."""
     with reported_errors(debug):
         ratio = _checked_options(tip, plot, penalty)
         # the library is imported here: `xfemslip --help` does not load NumPy

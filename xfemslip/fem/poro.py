@@ -17,7 +17,7 @@ m = [1, 1, 0], moves the pressure term to the right-hand side as the body load
 Under depletion (dp < 0) F_body pulls every boundary of the depleting region
 inwards: the region contracts.
 
-Uniaxial strain (the check of the sign of (1), README "Depletion"): a layer
+Uniaxial strain (the check of the sign of (1), docs/depletion.md): a layer
 with rollers on its sides (eps_xx = 0) under a constant overburden
 (Delta sigma_yy = 0).  With D of plane strain,
 Delta sigma_yy = (lambda_L + 2 mu) eps_yy - alpha dp = 0, so

@@ -5,7 +5,7 @@ Pure NumPy.  The parameters arrive validated (``[network.generate]`` is read
 by :mod:`xfemslip.case.network`); ``generate`` returns the segments, and the
 case reader turns them into ``FractureSpec`` entries.
 
-The model (README, *Random fracture networks*):
+The model (docs/networks.md, *Random networks*):
 
 - **centres**: uniform in the region (a box, default the domain), i.e. a
   Poisson process conditioned on its count;

@@ -28,9 +28,10 @@ logger = logging.getLogger(__name__)
 # end points closer than this to the domain boundary are taken to lie on it.
 GEOMETRY_TOL = 1.0e-9
 
-# Fracture geometry below the mesh resolution (README, Method), in local cell
-# sizes h (the smaller side of the cell holding a vertex).  A clipped polyline
-# with a segment shorter than SIMPLIFY_MIN_SEGMENT h is simplified by
+# Fracture geometry below the mesh resolution (docs/method.md, *Fracture
+# geometry*), in local cell sizes h (the smaller side of the cell holding a
+# vertex).  A clipped polyline with a segment shorter than
+# SIMPLIFY_MIN_SEGMENT h is simplified by
 # Douglas-Peucker with a shortest segment (polyline.simplify): it keeps the
 # vertices more than SIMPLIFY_DEVIATION h off the simplified line that lie at
 # least SIMPLIFY_MIN_SEGMENT h from their neighbours in it, and the end points

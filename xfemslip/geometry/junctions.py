@@ -325,7 +325,7 @@ def find_junctions(polylines, free_ends, names, h, tol):
         logger.info(
             "%d fracture end(s) within %.3g m (h/2) of another fracture left as "
             "tips: the snap would meet it at under %g deg, part a crossing or "
-            "leave an end segment under h/10 (README, Fracture networks)",
+            "leave an end segment under h/10 (docs/networks.md)",
             apart,
             snap,
             JUNCTION_MIN_ANGLE,

@@ -2,7 +2,7 @@
 of vertices (pure NumPy).
 
 - ``simplify``: the vertices of a polyline that a mesh of cell size h can
-  resolve (the rule is in the README, *Method*: fracture geometry below the
+  resolve (the rule is in docs/method.md, *Fracture geometry*: geometry below the
   mesh resolution);
 - ``first_meeting``: the first pair of segments of a polyline or polygon that
   touch, cross or fold back, from a sweep over the segments' bounding boxes

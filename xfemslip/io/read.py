@@ -21,7 +21,7 @@ from xfemslip.errors import UsageError
 from xfemslip.post.fields import FractureFields, StepFields
 from xfemslip.post.result import Result
 
-__all__ = ["read_attrs", "read_result"]
+__all__ = ["FRACTURE_ARRAYS", "read_attrs", "read_result"]
 
 # Datasets of each fracture group read into FractureFields (contact_pressure
 # is derived from normal_traction and not kept).

@@ -31,7 +31,7 @@ METRICS = (
     "slip_share",
     "newton_iterations",
     "wall_time_s",
-    # per fracture (networks, README "Random fracture networks"):
+    # per fracture (networks, docs/networks.md "Random networks"):
     "fractures",
     "slipping_fractures",
     "slipping_fraction",

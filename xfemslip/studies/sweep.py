@@ -1,6 +1,6 @@
 """Sweep files: a base case plus the parameters to vary -> validated cases.
 
-A sweep file is TOML (README, *Sweeps*)::
+A sweep file is TOML (docs/sweep-format.md)::
 
     name = "young-modulus"                # optional; default: the file's stem
     base = "../reservoir_depletion.toml"  # the base case, relative to this file,

@@ -32,14 +32,6 @@ VALID_CASE = build.case_text(VALID)
 
 
 @pytest.fixture
-def runner() -> CliRunner:
-    try:  # click < 8.2 mixes stderr into stdout unless told otherwise
-        return CliRunner(mix_stderr=False)
-    except TypeError:
-        return CliRunner()
-
-
-@pytest.fixture
 def case_file(tmp_path: Path) -> Path:
     path = tmp_path / "tiny.toml"
     path.write_text(VALID_CASE)

@@ -12,7 +12,6 @@ import math
 
 import numpy as np
 import pytest
-from click.testing import CliRunner
 
 from xfemslip.cli import cli
 from xfemslip.reference.closed_form import crack_tractions, slip_window
@@ -29,14 +28,6 @@ from xfemslip.reference.screen import (
 
 MPA = 1e6
 PAPER = (-20 * MPA, -40 * MPA, 0.0)
-
-
-@pytest.fixture
-def runner() -> CliRunner:
-    try:  # click < 8.2 mixes stderr into stdout unless told otherwise
-        return CliRunner(mix_stderr=False)
-    except TypeError:
-        return CliRunner()
 
 
 def test_hand_numbers_at_45_degrees():

@@ -12,7 +12,6 @@ from pathlib import Path
 import h5py
 import numpy as np
 import pytest
-from click.testing import CliRunner
 
 from tests.support.casegen import SWEEP_BASE as BASE
 from tests.support.casegen import SWEEP_CASE as CASE
@@ -31,14 +30,6 @@ from xfemslip.studies.sweep import (
     set_key_path,
 )
 from xfemslip.studies.vary import _check_overlaps, case_count, read_vary
-
-
-@pytest.fixture
-def runner() -> CliRunner:
-    try:  # click < 8.2 mixes stderr into stdout unless told otherwise
-        return CliRunner(mix_stderr=False)
-    except TypeError:
-        return CliRunner()
 
 
 @pytest.fixture
@@ -300,7 +291,7 @@ def test_paper_sweep_files_are_valid():
         "friction",
         "dfn_realizations",
     }
-    realizations = found["dfn_realizations"].cases  # README, random networks
+    realizations = found["dfn_realizations"].cases  # docs/networks.md, random networks
     assert [dict(c.params)["network.generate.seed"] for c in realizations] == list(
         range(1, 21)
     )
