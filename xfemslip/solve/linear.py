@@ -79,6 +79,7 @@ import scipy.sparse as sp
 from xfemslip.fem.assembly import coo_block
 from xfemslip.solve import pardiso
 from xfemslip.solve.backward import backward_error
+from xfemslip.solve.guess import PreviousSolutions
 
 logger = logging.getLogger(__name__)
 
@@ -290,8 +291,8 @@ def _projected(iterations, reduction):
     return iterations * np.log(KRYLOV_RTOL) / np.log(max(reduction, 1e-300))
 
 
-def _gmres(A, b, M, restart, maxiter, give_up=False):
-    """GMRES from zero until ||A x - b|| <= KRYLOV_RTOL ||b|| (the true
+def _gmres(A, b, M, restart, maxiter, give_up=False, x0=None):
+    """GMRES from `x0` (default zero) until ||A x - b|| <= KRYLOV_RTOL ||b|| (the true
     residual: scipy's test is on the preconditioned one), at most `maxiter`
     iterations: one scipy call runs as many whole restart cycles as the cap
     leaves, and is repeated from its answer while the true residual is too
@@ -322,7 +323,7 @@ def _gmres(A, b, M, restart, maxiter, give_up=False):
                     first.append(ratio)
                     raise _Stalled
 
-    x = np.zeros_like(b)
+    x = np.zeros_like(b) if x0 is None else np.array(x0, dtype=b.dtype)
     norm_b = np.linalg.norm(b)
     target = KRYLOV_RTOL * norm_b
     ok = False
@@ -433,6 +434,7 @@ class LinearSolver:
             "setup_time": 0.0,
             "solves": 0,
             "krylov_iterations": 0,
+            "guesses_exact": 0,
             "solve_time": 0.0,
             "refinements": 0,
             "fallbacks": 0,
@@ -452,6 +454,10 @@ class LinearSolver:
         self._pardiso_key = None
         self._lu = None  # (SuperLU object, checked solve, K_c it factors)
         self._amg = None  # V-cycle on the standard dofs
+        # the Krylov solves start from the best combination of the last
+        # solutions (solve/guess.py)
+        self._previous = PreviousSolutions()
+        self._band_lu = None  # (band, Kc, SuperLU of the band's matrix)
         # the AMG band of "auto"'s facts is the one the AMG path solves on
         self._bands = (
             {AMG_BAND_LAYERS: self.facts["band"]} if "band" in self.facts else {}
@@ -588,23 +594,38 @@ class LinearSolver:
             self._bands[layers] = np.nonzero(band_mask(self.K, seed, layers))[0]
         return self._bands[layers]
 
-    def _schwarz_gmres(self, A, r, coarse, band, cycles, restart, cap, give_up=False):
-        """GMRES on A x = r, preconditioned by one multiplicative Schwarz sweep:
-        `coarse` (an approximate inverse: the kept factorization, or the AMG
-        V-cycle on the standard dofs), an exact LU solve on the dofs `band`
-        with the current matrix, and (cycles == 2) `coarse` again.  None when
+    def _schwarz_gmres(
+        self, A, Kc, r, coarse, band, cycles, restart, cap, give_up=False
+    ):
+        """GMRES on A = K_ff + Kc, A x = r, preconditioned by one
+        multiplicative Schwarz sweep: `coarse` (an approximate inverse: the
+        kept factorization, or the AMG V-cycle on the standard dofs), an exact
+        LU solve on the dofs `band` with the current matrix (kept while Kc,
+        which lives on the band, does not change), and (cycles == 2) `coarse`
+        again.  None when
         GMRES does not converge or the band matrix is singular (then
         self._krylov_end holds the iterations and relative residual reached).
         `give_up`: see _gmres."""
         from scipy.sparse.linalg import LinearOperator
 
-        t = time.perf_counter()
-        try:
-            band_lu, _ = lu_factor(A[band][:, band], self.stats)
-        except RuntimeError:  # singular band: let SuperLU judge the whole matrix
-            self._krylov_end = (0, np.inf)
-            return None
-        self.stats["factor_time"] += time.perf_counter() - t
+        x0, res0 = self._previous.guess(A, r)
+        if x0 is not None and res0 <= KRYLOV_RTOL * np.linalg.norm(r):
+            self.stats["guesses_exact"] += 1
+            self._krylov_end = (0, res0 / max(np.linalg.norm(r), 1e-300))
+            logger.debug("linear solve: the earlier solutions span this one")
+            return x0
+        kept = self._band_lu
+        if kept is not None and kept[0] is band and _same(Kc, kept[1]):
+            band_lu = kept[2]
+        else:
+            t = time.perf_counter()
+            try:
+                band_lu, _ = lu_factor(A[band][:, band], self.stats)
+            except RuntimeError:  # singular band: let SuperLU judge the whole matrix
+                self._krylov_end = (0, np.inf)
+                return None
+            self.stats["factor_time"] += time.perf_counter() - t
+            self._band_lu = (band, Kc, band_lu)
 
         def sweep(v):
             x = coarse(v)
@@ -614,8 +635,10 @@ class LinearSolver:
             return x
 
         M = LinearOperator(A.shape, matvec=sweep, dtype=float)
-        x, ok, its, rel = _gmres(A, r, M, restart, cap, give_up)
+        x, ok, its, rel = _gmres(A, r, M, restart, cap, give_up, x0)
         self.stats["krylov_iterations"] += its
+        if ok:
+            self._previous.add(x)
         self._krylov_end = (its, rel)
         logger.debug("linear solve: Schwarz-GMRES, %d iterations (%s)", its, ok)
         return x if ok else None
@@ -638,6 +661,7 @@ class LinearSolver:
             if 0 < band.size <= LU_BAND_MAX_FRACTION * A.shape[0]:
                 x = self._schwarz_gmres(
                     A.tocsr(),
+                    Kc,
                     r,
                     lu.solve,
                     band,
@@ -690,9 +714,11 @@ class LinearSolver:
                 count[0] += 1
 
             M = LinearOperator(A.shape, matvec=self._amg, dtype=float)
+            x0, _ = self._previous.guess(A, r)
             x, info = cg(
                 A,
                 r,
+                x0=x0,
                 M=M,
                 rtol=KRYLOV_RTOL,
                 atol=0.0,
@@ -701,12 +727,14 @@ class LinearSolver:
             )
             self.stats["krylov_iterations"] += count[0]
             if info == 0 and np.all(np.isfinite(x)):
+                self._previous.add(x)
                 return x
             its = count[0]
             rel = np.linalg.norm(A @ x - r) / max(np.linalg.norm(r), 1e-300)
         else:
             x = self._schwarz_gmres(
                 A,
+                Kc,
                 r,
                 self._amg,
                 band,
