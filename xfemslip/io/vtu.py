@@ -1,4 +1,4 @@
-"""ParaView output via meshio: ``result.vtu``, ``fractures.vtu``, ``result.pvd``.
+"""ParaView output: ``result.vtu``, ``fractures.vtu``, ``result.pvd``.
 
 - ``write_bulk``: the bulk mesh with cut elements split along the fractures
   (:class:`~xfemslip.post.fields.VisMesh`), so that "Warp By Vector" on the point
@@ -8,17 +8,16 @@
   integration points, with the contact fields as point data.
 - ``write_pvd``: a ParaView collection (time series over load steps).
 
-Every file is written atomically (:mod:`xfemslip.io.atomic`).  meshio is
-given ``file_format="vtu"`` explicitly because the temporary name has another
-suffix.  Given a ``run_id``, each file carries it: the VTU files as the field
-data array ``run_id`` (1,) int64, the PVD as a comment.
+Every file is written atomically (:mod:`xfemslip.io.atomic`); the VTU files
+by :mod:`xfemslip.io.vtkxml` (meshio's ``Mesh`` only holds the data).  Given a
+``run_id``, each file carries it: the VTU files as the field data array
+``run_id`` (1,) int64, the PVD as a comment.
 """
 
 from __future__ import annotations
 
 import logging
 import re
-import shutil
 from collections.abc import Mapping, Sequence
 from pathlib import Path
 from xml.sax.saxutils import quoteattr
@@ -27,6 +26,7 @@ import meshio
 import numpy as np
 
 from xfemslip.io.atomic import atomic_path, refuse_non_finite
+from xfemslip.io.vtkxml import write_vtu
 from xfemslip.post.fields import FractureFields, VisMesh
 
 logger = logging.getLogger(__name__)
@@ -264,34 +264,14 @@ def _write_vtu(path: Path | str, mesh: meshio.Mesh) -> None:
             refuse_non_finite(value, f"{path}: {name}")
     run_id = mesh.field_data.get("run_id")
     with atomic_path(Path(path)) as tmp:
-        if run_id is None:
-            meshio.write(tmp, mesh, file_format="vtu")
-            return
-        raw = tmp.with_name(f"{tmp.name}.raw")
-        try:
-            meshio.write(raw, mesh, file_format="vtu")
-            _add_field_data(raw, tmp, int(run_id[0]))
-        finally:
-            raw.unlink(missing_ok=True)
-
-
-# meshio (5.3) does not write field data; VTK reads it as a child of the grid.
-_FIELD_DATA = (
-    '\n<FieldData>\n<DataArray type="Int64" Name="run_id" NumberOfTuples="1" '
-    'format="ascii">\n{}\n</DataArray>\n</FieldData>'
-)
-_GRID_TAG = b"<UnstructuredGrid>"
-
-
-def _add_field_data(src: Path, dst: Path, run_id: int) -> None:
-    """Copy the VTU ``src`` to ``dst`` with the ``run_id`` field data array
-    inserted after the grid's opening tag (which meshio writes in its first
-    lines)."""
-    with open(src, "rb") as fin, open(dst, "wb") as fout:
-        head = fin.read(4096)
-        at = head.index(_GRID_TAG) + len(_GRID_TAG)
-        fout.write(head[:at] + _FIELD_DATA.format(run_id).encode() + head[at:])
-        shutil.copyfileobj(fin, fout, 1 << 20)
+        write_vtu(
+            tmp,
+            mesh.points,
+            [(block.type, block.data) for block in mesh.cells],
+            mesh.point_data,
+            mesh.cell_data,
+            None if run_id is None else {"run_id": int(run_id[0])},
+        )
 
 
 _VTU_RUN_ID = re.compile(rb'Name="run_id" NumberOfTuples="1" format="ascii">\s*(\d+)')
