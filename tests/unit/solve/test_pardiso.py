@@ -326,3 +326,31 @@ def test_schur_complement_of_the_bulk_matrix():
     S = systems.handle.schur_matrix
     np.testing.assert_allclose(S, ref, rtol=0, atol=1e-11 * abs(ref).max())
     systems.release()
+
+
+@needs_mkl
+def test_the_library_is_found_without_walking_the_environment(monkeypatch):
+    """MKL's library comes from the mkl distribution's file list, and the
+    entry point loaded from it solves like the one pypardiso loads: a small
+    SPD system through both, the same answer to round-off."""
+    path = pardiso._mkl_rt_path()
+    assert path is not None and "mkl_rt" in Path(path).name and Path(path).is_file()
+    monkeypatch.setenv("PYPARDISO_MKL_RT", "/nowhere/libmkl_rt.so")
+    assert pardiso._mkl_rt_path() == "/nowhere/libmkl_rt.so"
+    monkeypatch.delenv("PYPARDISO_MKL_RT")
+    n = 40
+    K = sp.diags([-1.0, 2.5, -1.0], [-1, 0, 1], shape=(n, n), format="csr")
+    b = np.linspace(1.0, 2.0, n)
+    x_ref = spla.spsolve(K.tocsc(), b)
+    answers = []
+    for fresh in (True, False):
+        monkeypatch.setattr(pardiso, "_LIB", None)
+        if not fresh:  # the library not where the distribution says
+            monkeypatch.setattr(pardiso, "_mkl_rt_path", lambda: None)
+        upper = sp.triu(K, format="csr")
+        h = pardiso.Handle(2, upper.indptr, upper.indices)
+        h.factor(upper.data)
+        answers.append(h.solve(b))
+        h.release()
+    for x in answers:
+        assert np.linalg.norm(x - x_ref) <= 1e-12 * np.linalg.norm(x_ref)
