@@ -26,8 +26,9 @@ The peak resident memory of a run is modelled from the sizes that set it
   (PARDISO_BYTES per non-zero and per log2, measured on the reservoir case
   from 324k to 2.0M dofs) and the dense Schur complement of the contact dofs
   with its LU (16 B per entry, up to SCHUR_MAX_DOFS of them); with AMG
-  (linsolve.choose), its hierarchy and set-up (AMG_BYTES per non-zero) and
-  the GMRES basis (AMG_RESTART + 1 vectors).
+  (linsolve.choose), its hierarchy and set-up (AMG_BYTES per non-zero),
+  the GMRES basis (AMG_RESTART + 1 vectors) and the kept solutions that
+  start each solve (solve.guess.KEEP vectors).
   A run whose AMG solve fails over to SuperLU may need more than estimated;
 - ``contact tangents``, during the Newton iterations: the contact tangent
   blocks of every patch, padded to the widest (8 B per entry), NEWTON_BLOCKS
@@ -153,10 +154,11 @@ def estimate_terms(fp: Footprint) -> dict[str, float]:
     assembly = fp.enriched_cells * (8 + 2 * fp.slots) ** 2 * 8.0
     assembly += max(gradients, triplets)  # one after the other
     if fp.linear == "amg":
+        from xfemslip.solve.guess import KEEP
         from xfemslip.solve.linear import AMG_RESTART
 
         solver = fp.nnz * (MATRIX_BYTES + AMG_BYTES)
-        solver += (AMG_RESTART + 1) * 8.0 * fp.n_dofs
+        solver += (AMG_RESTART + 1 + KEEP) * 8.0 * fp.n_dofs
     elif fp.linear == "pardiso":
         from xfemslip.solve.pardiso import SCHUR_MAX_DOFS
 
