@@ -15,9 +15,10 @@ part of the fracture inside the domain, like the sweep metrics.  mu is the
 shear modulus of ``[material]``, or of ``[reservoir]`` for a fracture whose
 middle contact point lies in the reservoir.
 
-Everything is computed from a :class:`~xfemslip.post.result.Result` and the
-case it ran (the ``case_toml`` a result carries), so a result written by any
-version gives its event sizes without new datasets.
+A run keeps them (:func:`event_table`, ``Result.events``, the ``/events``
+group of ``result.h5``), and :func:`event_sizes` reads them from there; a
+result written without them has them computed from its arrays and the case
+it ran (the ``case_toml`` every result carries).
 """
 
 from __future__ import annotations
@@ -34,7 +35,7 @@ from xfemslip.conventions import SLIP
 from xfemslip.errors import CaseError, XfemslipError
 from xfemslip.geometry.regions import in_region
 from xfemslip.post.metrics import arc_extent, point_stretches
-from xfemslip.post.result import Result
+from xfemslip.post.result import EventTable, Result
 from xfemslip.post.seismic import (
     moment_magnitude,
     moment_per_length,
@@ -47,6 +48,8 @@ __all__ = [
     "FractureEvent",
     "event_inputs",
     "event_sizes",
+    "event_table",
+    "stored_inputs",
     "summary_lines",
 ]
 
@@ -110,6 +113,14 @@ def _from_spec(spec, result: Result) -> EventInputs:
     ends = tuple(arc_extent(f.points, box) for f in spec.fractures)
     extent = spec.events.extent if spec.events is not None else None
     return EventInputs(tuple(mus), tuple(nus), m.model, ends, extent)
+
+
+def stored_inputs(table: EventTable) -> EventInputs:
+    """What the printout needs of the inputs when the event sizes are read
+    from ``table``: whether W is events.extent."""
+    given = table.extent_given and table.extent.size
+    extent = float(table.extent.flat[0]) if given else None
+    return EventInputs((), (), "", (), extent)
 
 
 def _contact_ends(s: np.ndarray) -> tuple[float, float]:
@@ -180,12 +191,69 @@ def _fracture_event(index, ff, inputs: EventInputs) -> FractureEvent:
     )
 
 
-def event_sizes(result: Result, inputs: EventInputs) -> list[list[FractureEvent]]:
-    """Per converged load step, the :class:`FractureEvent` of every fracture."""
+def _computed(result: Result, inputs: EventInputs) -> list[list[FractureEvent]]:
     return [
         [_fracture_event(i, ff, inputs) for i, ff in enumerate(step.fractures)]
         for step in result.steps
     ]
+
+
+def _stored(table: EventTable) -> list[list[FractureEvent]]:
+    steps, n = table.max_slip.shape
+    out = []
+    for k in range(steps):
+        row = []
+        for i in range(n):
+            m0, w = float(table.moment_per_length[k, i]), float(table.extent[k, i])
+            row.append(
+                FractureEvent(
+                    fracture=i,
+                    slipped=bool(table.slipped[k, i]),
+                    max_slip=float(table.max_slip[k, i]),
+                    slipping_length=float(table.slipping_length[k, i]),
+                    moment_per_length=m0,
+                    stress_drop=float(table.stress_drop[k, i]),
+                    extent=w,
+                    magnitude=moment_magnitude(m0 * w),
+                )
+            )
+        out.append(row)
+    return out
+
+
+def event_sizes(result: Result, inputs: EventInputs) -> list[list[FractureEvent]]:
+    """Per converged load step, the :class:`FractureEvent` of every fracture:
+    those the result keeps (``result.events``) when it has them, else
+    computed from its fields."""
+    if result.events is not None and result.events.max_slip.shape[0] == len(
+        result.steps
+    ):
+        return _stored(result.events)
+    return _computed(result, inputs)
+
+
+def event_table(result: Result, inputs: EventInputs) -> EventTable | None:
+    """The :class:`~xfemslip.post.result.EventTable` of ``result``'s steps
+    (None without a converged step)."""
+    if not result.steps:
+        return None
+    sizes = _computed(result, inputs)
+    n = len(result.steps[0].fractures)
+
+    def column(name, dtype=float):
+        return np.array(
+            [[getattr(e, name) for e in row] for row in sizes], dtype=dtype
+        ).reshape(len(sizes), n)
+
+    return EventTable(
+        slipped=column("slipped", bool),
+        max_slip=column("max_slip"),
+        slipping_length=column("slipping_length"),
+        moment_per_length=column("moment_per_length"),
+        stress_drop=column("stress_drop"),
+        extent=column("extent"),
+        extent_given=inputs.extent is not None,
+    )
 
 
 # --------------------------------------------------------------------------- #
@@ -204,8 +272,11 @@ def _mw_text(event: FractureEvent) -> str:
     return f"{event.magnitude:.2f}" if math.isfinite(event.magnitude) else "-"
 
 
-def summary_lines(events: list[FractureEvent], inputs: EventInputs) -> list[str]:
-    """The per-fracture table of one step and the "what happened" line."""
+def summary_lines(
+    events: list[FractureEvent], inputs: EventInputs, also: str = ""
+) -> list[str]:
+    """The per-fracture table of one step and the "what happened" line
+    (``also`` appended to it after a semicolon, e.g. the permeability)."""
     if not events:
         return ["no fracture in this result"]
     head = (
@@ -222,7 +293,7 @@ def summary_lines(events: list[FractureEvent], inputs: EventInputs) -> list[str]
             f"{e.max_slip * 1e3:>13.4g}  {e.slipping_length:>12.4g}  "
             f"{e.moment_per_length:>12.4g}  {drop:>10}  {_mw_text(e):>6}  {w}"
         )
-    lines.append(what_happened(events, inputs))
+    lines.append(what_happened(events, inputs) + (f"; {also}" if also else ""))
     if inputs.note:
         lines.append(f"note: {inputs.note}")
     return lines

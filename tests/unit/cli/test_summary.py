@@ -176,13 +176,15 @@ def test_events_extent_is_the_w_of_every_magnitude(tmp_path):
 
 
 def test_summary_of_a_result_whose_case_files_are_elsewhere(ran, tmp_path):
-    """A [network] CSV next to the original case is not next to the result:
-    the fracture ends come from the contact points, and the summary says so."""
+    """A result without stored event sizes (written before they were kept)
+    whose [network] CSV is not next to it: the fracture ends come from the
+    contact points, and the summary says so."""
     _, out = ran
     (tmp_path / "seg.csv").write_text("x0,y0,x1,y1\n0.4,1.5,1.6,1.5\n")
     copy = tmp_path / "copy"
     shutil.copytree(out, copy)
     with h5py.File(copy / "result.h5", "r+") as h5:
+        del h5["events"]
         text = h5.attrs["case_toml"]
         text = text.decode() if isinstance(text, bytes) else text
         # the third fracture as a network.file member instead
@@ -217,3 +219,46 @@ def test_summary_of_a_missing_file_or_not_a_result_exits_2(tmp_path):
     assert result.exit_code == 2
     assert len(result.output.strip().splitlines()) == 1
     assert "not a result.h5 of xfemslip" in result.output
+
+
+def test_result_h5_keeps_the_event_sizes_of_every_step(ran):
+    """/events holds, per step and fracture, the numbers computed here from
+    the arrays (the final step against _expected; the step numbers)."""
+    _, out = ran
+    result = xfemslip.read_result(out)
+    with h5py.File(out / "result.h5", "r") as h5:
+        group = h5["events"]
+        assert list(group["step"][()]) == [1, 2]
+        assert group["moment"].attrs["units"] == "N m"
+        assert group["max_slip"].shape == (2, len(FRACTURES))
+        moment = group["moment"][()]
+    events = result.events
+    assert not events.extent_given
+    for i, exp in enumerate(_expected(result)):
+        slipped, max_mm, lslip, m0, _, w = exp
+        assert bool(events.slipped[-1, i]) == slipped
+        assert events.max_slip[-1, i] * 1e3 == pytest.approx(max_mm, rel=1e-12)
+        assert events.slipping_length[-1, i] == pytest.approx(lslip, rel=1e-12)
+        assert events.moment_per_length[-1, i] == pytest.approx(m0, rel=1e-12)
+        assert moment[-1, i] == pytest.approx(m0 * w, rel=1e-12)
+        # the stress drop is undefined (NaN in memory, 0 in the file) without slip
+        assert math.isnan(events.stress_drop[-1, i]) == (lslip == 0.0)
+
+
+def test_summary_reads_the_stored_event_sizes(ran, tmp_path):
+    """The table comes from /events when the file has it: a number changed
+    there shows; the same file without /events gives the recomputed table."""
+    _, out = ran
+    edited, stripped = tmp_path / "edited", tmp_path / "stripped"
+    shutil.copytree(out, edited)
+    shutil.copytree(out, stripped)
+    with h5py.File(edited / "result.h5", "r+") as h5:
+        h5["events/max_slip"][-1, 1] = 0.123456  # m
+    with h5py.File(stripped / "result.h5", "r+") as h5:
+        del h5["events"]
+    runner = CliRunner()
+    original = runner.invoke(cli, ["summary", str(out)])
+    assert "123.5" in runner.invoke(cli, ["summary", str(edited)]).output
+    again = runner.invoke(cli, ["summary", str(stripped)])
+    assert again.exit_code == 0, again.output
+    assert _table(again.output) == _table(original.output)
