@@ -20,6 +20,9 @@ after the step.
   inside the block, so a straight fracture is cut at the block's edges
   exactly (a polyline leaving and re-entering the block is counted over the
   whole range between).
+- The opening adds to the aperture only where the contact point is open
+  (state OPEN); in contact, the normal jump is the elastic give of the
+  penalty law, a numerical device that the closure law replaces.
 - The tangent at a contact point is that of the polyline segment it lies on.
 """
 
@@ -27,6 +30,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from xfemslip.conventions import OPEN
 from xfemslip.post.metrics import arc_extent, point_stretches
 from xfemslip.post.permeability import ApertureLaw, oda_tensor, transmissivity
 from xfemslip.post.result import PermeabilityHistory, Result
@@ -135,7 +139,10 @@ def add_permeability(result: Result, spec) -> None:
                 if ff.effective_normal_traction is not None
                 else ff.normal_traction
             )
-            ff.aperture = law.aperture(ff.slip, sn, sn0, ff.opening)
+            # only an open fracture's jump opens it: in contact, the normal
+            # jump is the penalty's elastic give, which the closure law stands for
+            opening = np.where(ff.state == OPEN, ff.opening, 0.0)
+            ff.aperture = law.aperture(ff.slip, sn, sn0, opening)
             ff.transmissivity = transmissivity(ff.aperture)
             parts.append((wk, t, ff.aperture))
         tensors.append(oda_tensor(parts, area, p.matrix))
