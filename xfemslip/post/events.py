@@ -44,11 +44,15 @@ from xfemslip.post.seismic import (
 )
 
 __all__ = [
+    "CASE_COLUMNS",
+    "FRACTURE_COLUMNS",
+    "MAX_FRACTURE_COLUMNS",
     "EventInputs",
     "FractureEvent",
     "event_inputs",
     "event_sizes",
     "event_table",
+    "fracture_metrics",
     "stored_inputs",
     "summary_lines",
 ]
@@ -320,3 +324,59 @@ def what_happened(events: list[FractureEvent], inputs: EventInputs) -> str:
     if big.fracture != top.fracture:
         line += f" on fracture {big.fracture}"
     return line
+
+
+# --------------------------------------------------------------------------- #
+# Sweep columns
+
+# per fracture i, up to MAX_FRACTURE_COLUMNS fractures: fracture<i>_<name>
+FRACTURE_COLUMNS = (
+    "slipped",
+    "max_slip_m",
+    "slip_length_m",
+    "moment_per_length_Nm_per_m",
+    "Mw",
+)
+MAX_FRACTURE_COLUMNS = 10
+# per case: the largest magnitude, the W it used, the block's permeability
+# ratios (k over in situ, with [permeability])
+CASE_COLUMNS = ("max_Mw", "Mw_extent", "k_xx_ratio", "k_yy_ratio")
+
+
+def _number(value: float):
+    """A finite float, or "" (no magnitude, no in-situ value)."""
+    return float(value) if math.isfinite(value) else ""
+
+
+def fracture_metrics(result: Result, spec) -> dict:
+    """The sweep columns of the final step of ``result`` (the case ``spec``):
+    CASE_COLUMNS, and FRACTURE_COLUMNS of each fracture when there are at
+    most MAX_FRACTURE_COLUMNS of them (a network's realizations have their
+    own summary, :mod:`xfemslip.studies.dfn_summary`)."""
+    if not result.steps:
+        return {}
+    stored = result.events is not None
+    inputs = stored_inputs(result.events) if stored else event_inputs(result, spec)
+    events = event_sizes(result, inputs)[-1]
+    magnitudes = [e.magnitude for e in events if math.isfinite(e.magnitude)]
+    out = {
+        "max_Mw": max(magnitudes) if magnitudes else "",
+        "Mw_extent": f"{inputs.extent:g} m" if inputs.extent else "slipping length",
+        "k_xx_ratio": "",
+        "k_yy_ratio": "",
+    }
+    if result.permeability is not None:
+        rx, ry = result.permeability.ratio()
+        out["k_xx_ratio"], out["k_yy_ratio"] = _number(rx), _number(ry)
+    if len(events) <= MAX_FRACTURE_COLUMNS:
+        for e in events:
+            values = (
+                e.slipped,
+                e.max_slip,
+                e.slipping_length,
+                e.moment_per_length,
+                _number(e.magnitude),
+            )
+            for name, value in zip(FRACTURE_COLUMNS, values, strict=True):
+                out[f"fracture{e.fracture}_{name}"] = value
+    return out
