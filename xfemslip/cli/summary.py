@@ -24,6 +24,7 @@ def event_report(result, spec=None, every_step: bool = False) -> list[str]:
     from xfemslip.post.events import (
         event_inputs,
         event_sizes,
+        increment_line,
         stored_inputs,
         summary_lines,
     )
@@ -45,6 +46,8 @@ def event_report(result, spec=None, every_step: bool = False) -> list[str]:
         perm = result.permeability
         lines += summary_lines(sizes[k], inputs, ratio_phrase(perm, k) if perm else "")
         lines += permeability_lines(result, k)
+        if every_step:
+            lines.append(increment_line(sizes[k], inputs))
     return lines
 
 
@@ -54,7 +57,8 @@ def event_report(result, spec=None, every_step: bool = False) -> list[str]:
     "--steps",
     "every_step",
     is_flag=True,
-    help="A table for every converged load step, not only the last.",
+    help="A table for every converged load step, not only the last, with "
+    "what the step's own slip adds.",
 )
 @debug_option
 def summary(result_path: Path, every_step: bool, debug: bool) -> None:

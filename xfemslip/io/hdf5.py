@@ -25,8 +25,10 @@ or for the derived quantities ``"m^2"``, ``"m^3"``, ``"N m/m"``, ``"N m"``)::
                               steps by F fractures: step (S,), slipped (S, F)
                               int8, max_slip, slipping_length, extent [m],
                               moment_per_length [N m/m], moment [N m],
-                              stress_drop [Pa] (0 without slipping length);
-                              attr extent_given
+                              stress_drop [Pa] (0 without slipping length),
+                              max_slip_increment [m] and
+                              moment_per_length_increment [N m/m] of the
+                              step's own slip; attr extent_given
     with [permeability] (xfemslip.post.hydraulics) also: per fracture aperture
     [m] and transmissivity [m^3], and /permeability/ with step (S,), in_situ
     (2, 2) and tensor (S, 2, 2) [m^2], initial_aperture (F,) [m], attrs block,
@@ -279,6 +281,8 @@ EVENT_DATASETS = (
     ("moment_per_length", "N m/m"),
     ("stress_drop", "Pa"),
     ("extent", "m"),
+    ("max_slip_increment", "m"),
+    ("moment_per_length_increment", "N m/m"),
 )
 
 

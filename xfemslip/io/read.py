@@ -155,6 +155,8 @@ def _events(h5: h5py.File) -> EventTable | None:
         stress_drop=np.where((length > 0.0) & (moment > 0.0), drop, np.nan),
         extent=g["extent"][()],
         extent_given=bool(g.attrs["extent_given"]),
+        max_slip_increment=g["max_slip_increment"][()],
+        moment_per_length_increment=g["moment_per_length_increment"][()],
     )
 
 

@@ -53,6 +53,7 @@ __all__ = [
     "event_sizes",
     "event_table",
     "fracture_metrics",
+    "increment_line",
     "stored_inputs",
     "summary_lines",
 ]
@@ -70,11 +71,19 @@ class FractureEvent:
     stress_drop: float  # crack model [Pa]; NaN without slip
     extent: float  # the W of the magnitude [m] (0 without slip and extent)
     magnitude: float  # Mw for M0' W; -inf without moment
+    # of this step alone: the slip it added (s_k - s_k-1, s_0 = 0 in situ)
+    max_slip_increment: float = 0.0  # max |ds| [m]
+    moment_per_length_increment: float = 0.0  # mu int |ds| ds [N m / m]
 
     @property
     def moment(self) -> float:
         """M0 = M0' W [N m]."""
         return self.moment_per_length * self.extent
+
+    @property
+    def magnitude_increment(self) -> float:
+        """Mw of this step's slip alone, for the same W; -inf without."""
+        return moment_magnitude(self.moment_per_length_increment * self.extent)
 
 
 @dataclass(frozen=True)
@@ -176,8 +185,10 @@ def event_inputs(result: Result, spec=None) -> EventInputs:
         return _from_text(text, result, f"the case does not load here: {where}")
 
 
-def _fracture_event(index, ff, inputs: EventInputs) -> FractureEvent:
+def _fracture_event(index, ff, inputs: EventInputs, before=None) -> FractureEvent:
+    """``before``: the fracture's slip at the step before (None: in situ)."""
     s, slip, state = np.asarray(ff.s, float), np.asarray(ff.slip, float), ff.state
+    step_slip = slip - (np.asarray(before, float) if before is not None else 0.0)
     stretch = point_stretches(s, *inputs.ends[index])
     mu, nu = inputs.mu[index], inputs.nu[index]
     m0 = moment_per_length(mu, stretch, slip)
@@ -192,14 +203,22 @@ def _fracture_event(index, ff, inputs: EventInputs) -> FractureEvent:
         stress_drop=stress_drop(m0, length, mu, nu, inputs.model),
         extent=extent,
         magnitude=moment_magnitude(m0 * extent),
+        max_slip_increment=float(np.max(np.abs(step_slip))) if slip.size else 0.0,
+        moment_per_length_increment=moment_per_length(mu, stretch, step_slip),
     )
 
 
 def _computed(result: Result, inputs: EventInputs) -> list[list[FractureEvent]]:
-    return [
-        [_fracture_event(i, ff, inputs) for i, ff in enumerate(step.fractures)]
-        for step in result.steps
-    ]
+    out, before = [], None
+    for step in result.steps:
+        out.append(
+            [
+                _fracture_event(i, ff, inputs, before[i].slip if before else None)
+                for i, ff in enumerate(step.fractures)
+            ]
+        )
+        before = step.fractures
+    return out
 
 
 def _stored(table: EventTable) -> list[list[FractureEvent]]:
@@ -219,6 +238,10 @@ def _stored(table: EventTable) -> list[list[FractureEvent]]:
                     stress_drop=float(table.stress_drop[k, i]),
                     extent=w,
                     magnitude=moment_magnitude(m0 * w),
+                    max_slip_increment=float(table.max_slip_increment[k, i]),
+                    moment_per_length_increment=float(
+                        table.moment_per_length_increment[k, i]
+                    ),
                 )
             )
         out.append(row)
@@ -257,6 +280,8 @@ def event_table(result: Result, inputs: EventInputs) -> EventTable | None:
         stress_drop=column("stress_drop"),
         extent=column("extent"),
         extent_given=inputs.extent is not None,
+        max_slip_increment=column("max_slip_increment"),
+        moment_per_length_increment=column("moment_per_length_increment"),
     )
 
 
@@ -301,6 +326,25 @@ def summary_lines(
     if inputs.note:
         lines.append(f"note: {inputs.note}")
     return lines
+
+
+def increment_line(events: list[FractureEvent], inputs: EventInputs) -> str:
+    """One line: the slip this step added on each fracture that slips in it
+    (max, M0' and Mw of the increment, same W as the step's table)."""
+    parts = [
+        f"fracture {e.fracture} +{e.max_slip_increment * 1e3:.3g} mm, "
+        f"M0' +{e.moment_per_length_increment:.4g} N m/m, "
+        f"Mw {_mw(e.magnitude_increment)}"
+        for e in events
+        if e.slipped
+    ]
+    if not parts:
+        return "this step alone: no fracture slips"
+    return "this step alone: " + "; ".join(parts)
+
+
+def _mw(value: float) -> str:
+    return f"{value:.2f}" if math.isfinite(value) else "-"
 
 
 def what_happened(events: list[FractureEvent], inputs: EventInputs) -> str:

@@ -48,6 +48,9 @@ class EventTable:
     stress_drop: np.ndarray  # crack model [Pa]; NaN without slipping length
     extent: np.ndarray  # the W of the magnitude [m]
     extent_given: bool  # W is events.extent (else each slipping length)
+    # of each step alone (its slip minus the step before's; in situ: 0)
+    max_slip_increment: np.ndarray  # [m]
+    moment_per_length_increment: np.ndarray  # [N m / m]
 
 
 @dataclass

@@ -156,6 +156,13 @@ def test_summary_steps_prints_a_table_per_load_step(ran):
         rows = _table("\n".join(block.splitlines()[1:]))
         for row, ff in zip(rows, step.fractures, strict=True):
             assert float(row[2]) == pytest.approx(np.abs(ff.slip).max() * 1e3, 1e-3)
+    # each step ends with what its own slip added (fracture 0 slips in both)
+    grow = np.abs(read.steps[1].fractures[0].slip - read.steps[0].fractures[0].slip)
+    last = blocks[1].splitlines()[-1]
+    assert last.startswith("this step alone: fracture 0 +")
+    assert float(last.split("+", 1)[1].split(" mm")[0]) == pytest.approx(
+        grow.max() * 1e3, rel=1e-2
+    )
 
 
 def test_quiet_run_leaves_the_table_out(tmp_path):
@@ -243,6 +250,19 @@ def test_result_h5_keeps_the_event_sizes_of_every_step(ran):
         assert moment[-1, i] == pytest.approx(m0 * w, rel=1e-12)
         # the stress drop is undefined (NaN in memory, 0 in the file) without slip
         assert math.isnan(events.stress_drop[-1, i]) == (lslip == 0.0)
+    # the increments of step 2: mu int |s2 - s1| ds, and step 1's are its own
+    for i, (points, _) in enumerate(FRACTURES):
+        s1, s2 = (step.fractures[i] for step in result.steps)
+        mid = 0.5 * (s2.s[1:] + s2.s[:-1])
+        stretch = np.diff(np.concatenate([[0.0], mid, [math.dist(*points)]]))
+        inc = MU * float(np.sum(stretch * np.abs(s2.slip - s1.slip)))
+        assert events.moment_per_length_increment[1, i] == pytest.approx(inc, 1e-12)
+        assert events.max_slip_increment[1, i] == pytest.approx(
+            np.abs(s2.slip - s1.slip).max(), rel=1e-12
+        )
+        assert events.moment_per_length_increment[0, i] == pytest.approx(
+            events.moment_per_length[0, i], rel=1e-12
+        )
 
 
 def test_summary_reads_the_stored_event_sizes(ran, tmp_path):
