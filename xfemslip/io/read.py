@@ -138,11 +138,26 @@ def _steps(h5: h5py.File, attrs: dict) -> list[StepFields]:
     return steps
 
 
+EVENT_ARRAYS = (
+    "slipped",
+    "max_slip",
+    "slipping_length",
+    "moment_per_length",
+    "stress_drop",
+    "extent",
+    "max_slip_increment",
+    "moment_per_length_increment",
+)
+
+
 def _events(h5: h5py.File) -> EventTable | None:
-    """``/events`` (None in a file written without it)."""
+    """``/events`` (None in a file written without it, or without one of its
+    datasets: the event sizes are then computed from the steps)."""
     if "events" not in h5:
         return None
     g = h5["events"]
+    if any(name not in g for name in EVENT_ARRAYS) or "extent_given" not in g.attrs:
+        return None
     length = g["slipping_length"][()]
     moment = g["moment_per_length"][()]
     drop = g["stress_drop"][()]

@@ -282,3 +282,11 @@ def test_summary_reads_the_stored_event_sizes(ran, tmp_path):
     again = runner.invoke(cli, ["summary", str(stripped)])
     assert again.exit_code == 0, again.output
     assert _table(again.output) == _table(original.output)
+    # a group lacking one of its datasets is not trusted: recomputed as well
+    partial = tmp_path / "partial"
+    shutil.copytree(out, partial)
+    with h5py.File(partial / "result.h5", "r+") as h5:
+        del h5["events/moment_per_length_increment"]
+    assert xfemslip.read_result(partial).events is None
+    third = runner.invoke(cli, ["summary", str(partial)])
+    assert _table(third.output) == _table(original.output)
