@@ -39,7 +39,9 @@ from xfemslip.fem.quadrature import InterfacePoints, interface_points
 from xfemslip.geometry.junctions import build_fractures
 from xfemslip.io.results import run_folder, write_results
 from xfemslip.memory import check_memory, enriched_footprint, model_footprint
+from xfemslip.post.events import event_inputs, event_table
 from xfemslip.post.fields import first_non_finite, step_fields, vis_mesh
+from xfemslip.post.hydraulics import add_permeability
 from xfemslip.post.result import Result, run_id
 from xfemslip.solve.newton import NewtonSolver, Problem
 
@@ -391,6 +393,9 @@ def collect_result(model: Model, results, *, converged, wall):
     }
     attrs["run_id"] = run_id(attrs, model.mesh.nodes, model.mesh.cells, fields)
     result = Result(attrs, model.mesh.nodes, model.mesh.cells, fields)
+    # derived from the fields and the case, so outside run_id
+    result.events = event_table(result, event_inputs(result, spec))
+    add_permeability(result, spec)
     if bad is None:
         return result, None
     step = bad[0] + 1

@@ -46,7 +46,7 @@ def key_scalars(out_dir: Path) -> dict:
     x_mid = 0.5 * (points[:, 0].min() + points[:, 0].max())
     top = points[:, 1] == points[:, 1].max()
     top_centre = np.nonzero(top)[0][np.argmin(np.abs(points[top, 0] - x_mid))]
-    return {
+    scalars = {
         "max_abs_slip": float(np.max(np.abs(slip))) if slip.size else 0.0,
         "min_slip": float(np.min(slip)) if slip.size else 0.0,
         "n_contact_points": int(slip.size),
@@ -57,6 +57,9 @@ def key_scalars(out_dir: Path) -> dict:
         "top_centre_point": [float(v) for v in points[top_centre]],
         "top_centre_displacement": [float(v) for v in u[top_centre]],
     }
+    if result.permeability is not None:  # k_xx, k_yy over in situ, final step
+        scalars["permeability_ratio"] = [float(v) for v in result.permeability.ratio()]
+    return scalars
 
 
 def write_golden(case: Path, scalars: dict) -> Path:

@@ -15,7 +15,8 @@ nesting cap, path checks), ``grid`` (``[domain]``, ``[mesh]``), ``fractures``
 (``[[fractures]]`` and polyline checks), ``boundary`` (``[boundary]`` and its
 CSV files), ``network``, ``segments`` and ``generate`` (``[network]``: a CSV
 file of segments, random networks), ``pore`` (``[pore_pressure]``,
-``[reservoir]``), ``events`` (``[events]``), ``describe`` (the ``xfemslip
+``[reservoir]``), ``events`` (``[events]``), ``hydraulics``
+(``[permeability]``, a fracture's ``hydraulic`` table), ``describe`` (the ``xfemslip
 check`` printout) and ``build`` (case text from Python values, for tests and
 benchmarks).
 """
@@ -38,6 +39,7 @@ from xfemslip.case.files import (
 )
 from xfemslip.case.fractures import FRACTURE_KEYS, TIP_KEYS, TIP_KINDS
 from xfemslip.case.grid import BYTES_PER_ELEMENT, DOMAIN_RTOL, MAX_ELEMENTS
+from xfemslip.case.hydraulics import HYDRAULIC_KEYS, PERMEABILITY_KEYS
 from xfemslip.case.load import load_case, loads_case
 from xfemslip.case.options import (
     MATERIAL_MODELS,
@@ -61,10 +63,12 @@ from xfemslip.case.specs import (
     EdgeSpec,
     EventsSpec,
     FractureSpec,
+    HydraulicSpec,
     LoadingSpec,
     MaterialSpec,
     MeshSpec,
     OutputSpec,
+    PermeabilitySpec,
     PorePressureSpec,
     ReservoirSpec,
     SolverSpec,
@@ -83,6 +87,7 @@ __all__ = [
     "EDGE_WORDS",
     "EVENTS_KEYS",
     "FRACTURE_KEYS",
+    "HYDRAULIC_KEYS",
     "MATERIAL_MODELS",
     "MAX_CSV_BYTES",
     "MAX_CSV_PROBLEMS",
@@ -92,6 +97,7 @@ __all__ = [
     "MAX_TOML_BYTES",
     "MAX_TOML_DEPTH",
     "OUTPUT_FORMATS",
+    "PERMEABILITY_KEYS",
     "PORE_PRESSURE_KEYS",
     "PORE_PRESSURE_REGIONS",
     "RESERVOIR_KEYS",
@@ -105,11 +111,13 @@ __all__ = [
     "EdgeSpec",
     "EventsSpec",
     "FractureSpec",
+    "HydraulicSpec",
     "LoadingSpec",
     "MaterialSpec",
     "MeshSpec",
     "Option",
     "OutputSpec",
+    "PermeabilitySpec",
     "PorePressureSpec",
     "Range",
     "ReservoirSpec",

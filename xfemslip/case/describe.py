@@ -14,9 +14,11 @@ from xfemslip.case.specs import (
     CaseSpec,
     EdgeSpec,
     FractureSpec,
+    HydraulicSpec,
     LoadingSpec,
     MaterialSpec,
     MeshSpec,
+    PermeabilitySpec,
     SolverSpec,
 )
 from xfemslip.case.tables import fmt
@@ -207,6 +209,52 @@ def _describe_events(spec: CaseSpec) -> str:
     return f"events: moment magnitudes for an out-of-plane extent W = {fmt(extent)} m"
 
 
+def _law_text(law) -> str:
+    """One fracture's aperture law, keys with their units."""
+    units = HydraulicSpec.UNITS
+    parts = [f"aperture = {_with_unit(law.aperture, units['aperture'])}"]
+    if law.dilation_angle:
+        cap = (
+            "no cap"
+            if math.isinf(law.dilation_slip)
+            else f"up to {_with_unit(law.dilation_slip, units['dilation_slip'])}"
+        )
+        parts.append(f"dilation_angle = {fmt(law.dilation_angle)} deg ({cap})")
+    if law.max_closure:
+        parts.append(
+            f"max_closure = {_with_unit(law.max_closure, units['max_closure'])}, "
+            f"normal_stiffness = "
+            f"{_with_unit(law.normal_stiffness, units['normal_stiffness'])}"
+        )
+    return ", ".join(parts)
+
+
+def _describe_permeability(spec: CaseSpec) -> list[str]:
+    """[permeability]: the block, the matrix and the law of each fracture
+    (one line per distinct law)."""
+    p = spec.permeability
+    if p is None:
+        return []
+    x0, y0, x1, y1 = p.block
+    where = "" if p.block_given else " (the domain)"
+    lines = [
+        f"permeability: Oda tensor of the block [{fmt(x0)}, {fmt(x1)}] x "
+        f"[{fmt(y0)}, {fmt(y1)}] m{where}, matrix "
+        f"{_with_unit(p.matrix, PermeabilitySpec.UNITS['matrix'])}"
+    ]
+    laws: dict = {}
+    for fracture, law in zip(spec.fractures, p.laws, strict=True):
+        laws.setdefault(law, []).append(fracture.index)
+    for law, indices in laws.items():
+        which = (
+            "every fracture"
+            if len(laws) == 1
+            else "fracture " + ", ".join(str(i) for i in indices)
+        )
+        lines.append(f"  {which}: {_law_text(law)}")
+    return lines
+
+
 def _network_count(spec: CaseSpec) -> str:
     """`` ([[fractures]] 1, network.file 3, network.generate 40)`` or ""."""
     sources = [
@@ -256,6 +304,7 @@ def describe(spec: CaseSpec) -> str:
     lines += [_describe_edge(e, getattr(spec.boundary, e)) for e in EDGES]
     lines += _describe_pore(spec)
     lines.append(_describe_events(spec))
+    lines += _describe_permeability(spec)
     lines.append("solver:")
     for option in SOLVER_OPTIONS:
         value = getattr(spec.solver, option.name)

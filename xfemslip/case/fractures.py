@@ -11,6 +11,7 @@ import math
 import numpy as np
 
 from xfemslip.case.grid import Grid
+from xfemslip.case.hydraulics import read_hydraulic
 from xfemslip.case.specs import FractureSpec
 from xfemslip.case.tables import (
     MAX_COORDINATE,
@@ -36,6 +37,7 @@ FRACTURE_KEYS = (
     "kn",
     "kt",
     "tip",
+    "hydraulic",
 )
 TIP_KINDS = ("branch", "ramp")
 TIP_KEYS = ("kind", "radius")
@@ -130,6 +132,7 @@ def _read_fracture(table: Table, index: int, grid: Grid | None) -> FractureSpec 
     kn = table.number("kn", None, rule=POSITIVE)
     kt = table.number("kt", None, rule=POSITIVE)
     tip, radius = read_tip(table)
+    hydraulic = read_hydraulic(table)
     if points is not None and np.abs(points).max() > MAX_COORDINATE:
         table.error(
             "points" if table.has("points") else "length",
@@ -150,6 +153,7 @@ def _read_fracture(table: Table, index: int, grid: Grid | None) -> FractureSpec 
         kt=kt,
         tip=tip,
         tip_radius=radius,
+        hydraulic=hydraulic,
     )
 
 

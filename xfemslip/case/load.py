@@ -32,6 +32,7 @@ from xfemslip.case.events import read_events
 from xfemslip.case.files import MAX_NAME_BYTES, parse_toml, path_problem, read_text
 from xfemslip.case.fractures import read_fractures
 from xfemslip.case.grid import read_grid
+from xfemslip.case.hydraulics import read_permeability
 from xfemslip.case.network import read_network
 from xfemslip.case.options import (
     MATERIAL_MODELS,
@@ -262,6 +263,7 @@ def loads_case(text: str, path: str | Path = "<string>") -> CaseSpec:
     pore_pressure = read_pore_pressure(root)
     reservoir = read_reservoir(root, grid)
     events = read_events(root)
+    permeability = read_permeability(root, grid, fractures)
     if problems:
         raise CaseError(path, problems)
     return CaseSpec(
@@ -280,4 +282,5 @@ def loads_case(text: str, path: str | Path = "<string>") -> CaseSpec:
         pore_pressure=pore_pressure,
         reservoir=reservoir,
         events=events,
+        permeability=permeability,
     )

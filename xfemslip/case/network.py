@@ -17,11 +17,21 @@ import numpy as np
 from xfemslip.case.fractures import read_tip
 from xfemslip.case.generate import GENERATE_KEYS, read_generate, realize
 from xfemslip.case.grid import Grid
+from xfemslip.case.hydraulics import read_hydraulic
 from xfemslip.case.segments import PROPERTY_RULES, read_segments_file
 from xfemslip.case.specs import FractureSpec
 from xfemslip.case.tables import Table, frozen
 
-NETWORK_KEYS = ("file", "generate", "friction", "cohesion", "kn", "kt", "tip")
+NETWORK_KEYS = (
+    "file",
+    "generate",
+    "friction",
+    "cohesion",
+    "kn",
+    "kt",
+    "tip",
+    "hydraulic",
+)
 
 
 def network_table(root: Table) -> Table | None:
@@ -52,6 +62,7 @@ def read_network(
         name: table.number(name, None, rule) for name, rule in PROPERTY_RULES.items()
     }
     tip, radius = read_tip(table)
+    hydraulic = read_hydraulic(table)
     if not table.has("file") and not table.has("generate"):
         table.error(None, 'expected file = "segments.csv" and/or a generate table')
     found: list[tuple[np.ndarray, dict, str]] = []
@@ -93,6 +104,7 @@ def read_network(
             tip=tip,
             tip_radius=radius,
             source=source,
+            hydraulic=hydraulic,
         )
         for k, (points, props, source) in enumerate(found)
     )

@@ -39,6 +39,7 @@ TOP_KEYS = (
     "pore_pressure",
     "reservoir",
     "events",
+    "permeability",
 )
 STRESS_KEYS = ("xx", "yy", "xy")
 MATERIAL_MODELS = ("plane_strain", "plane_stress")

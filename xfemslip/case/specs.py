@@ -56,6 +56,43 @@ CONTACT_PATCH_CELLS = 1.5
 
 
 @dataclass(frozen=True, kw_only=True)
+class HydraulicSpec:
+    """The aperture law of a fracture (xfemslip.post.permeability.ApertureLaw).
+
+    In ``[permeability]`` (the defaults) and in a fracture's ``hydraulic``
+    table (its overrides) a key may be left out (None); the laws that
+    ``PermeabilitySpec.laws`` holds per fracture are complete: ``aperture``
+    given, ``dilation_slip`` inf without a cap, ``normal_stiffness`` inf
+    without closure.
+    """
+
+    aperture: float | None = None  # a0 [m] > 0
+    dilation_angle: float | None = None  # psi [deg], 0 <= psi < 90
+    dilation_slip: float | None = None  # slip at which dilation stops [m]
+    max_closure: float | None = None  # V_m [m], 0 <= V_m <= a0
+    normal_stiffness: float | None = None  # K_ni [Pa/m] > 0
+    UNITS: ClassVar[dict[str, str]] = {
+        "aperture": "m",
+        "dilation_angle": "deg",
+        "dilation_slip": "m",
+        "max_closure": "m",
+        "normal_stiffness": "Pa/m",
+    }
+
+
+@dataclass(frozen=True, kw_only=True)
+class PermeabilitySpec:
+    """[permeability]: the aperture law of every fracture and the block whose
+    equivalent permeability tensor is reported (xfemslip.post.hydraulics)."""
+
+    laws: tuple[HydraulicSpec, ...]  # complete, one per fracture (case order)
+    matrix: float  # matrix permeability k_m [m^2] >= 0
+    block: tuple[float, float, float, float]  # x0, y0, x1, y1 [m]
+    block_given: bool = False  # False: the block is the domain
+    UNITS: ClassVar[dict[str, str]] = {"matrix": "m^2", "block": "m"}
+
+
+@dataclass(frozen=True, kw_only=True)
 class FractureSpec:
     index: int  # [[fractures]] position; [network] ones follow (network.py)
     points: np.ndarray  # (k, 2) float64 polyline vertices, k >= 2 [m]
@@ -66,6 +103,7 @@ class FractureSpec:
     tip: str = "branch"  # crack-tip treatment: "branch" | "ramp"
     tip_radius: float | None = None  # branch enrichment radius [m]; None = automatic
     source: str = ""  # "" = [[fractures]]; else where [network] took it from
+    hydraulic: HydraulicSpec | None = None  # overrides of [permeability]
     UNITS: ClassVar[dict[str, str]] = {
         "points": "m",
         "tip_radius": "m",
@@ -210,3 +248,4 @@ class CaseSpec:
     pore_pressure: PorePressureSpec | None = None  # None: no pore pressure
     reservoir: ReservoirSpec | None = None  # None: one material everywhere
     events: EventsSpec | None = None  # None: no [events] table
+    permeability: PermeabilitySpec | None = None  # None: no [permeability] table

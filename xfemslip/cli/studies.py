@@ -187,9 +187,11 @@ def _default_figure_dir(results: list[Path]) -> Path:
     "--figure",
     "kinds",
     multiple=True,
-    type=click.Choice((*KINDS, "network")),
-    help="Draw only this figure (repeatable) [default: all but network]; "
-    "network: slip and contact state of every fracture of the first result.",
+    type=click.Choice((*KINDS, "network", "permeability")),
+    help="Draw only this figure (repeatable) [default: all but network and "
+    "permeability]; network: slip and contact state of every fracture of the "
+    "first result; permeability: apertures and the permeability ratio of the "
+    "first result (a case with [permeability]).",
 )
 @click.option(
     "--format",

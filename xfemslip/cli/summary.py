@@ -21,11 +21,19 @@ def event_report(result, spec=None, every_step: bool = False) -> list[str]:
     """The lines printed for ``result``: its final converged step, or every
     one; ``spec`` the case when at hand, else rebuilt from the result's case
     text.  None without a converged step (the status line before says so)."""
-    from xfemslip.post.events import event_inputs, event_sizes, summary_lines
+    from xfemslip.post.events import (
+        event_inputs,
+        event_sizes,
+        increment_line,
+        stored_inputs,
+        summary_lines,
+    )
+    from xfemslip.post.hydraulics import permeability_lines, ratio_phrase
 
     if not result.steps:
         return []
-    inputs = event_inputs(result, spec)
+    stored = result.events is not None and spec is None
+    inputs = stored_inputs(result.events) if stored else event_inputs(result, spec)
     sizes = event_sizes(result, inputs)
     shown = range(len(sizes)) if every_step else [len(sizes) - 1]
     lines = []
@@ -35,7 +43,11 @@ def event_report(result, spec=None, every_step: bool = False) -> list[str]:
             f"fractures at step {step.step} of {result.load_steps} "
             f"(load factor {step.load_factor:.4g}), slip cumulative over the steps:"
         )
-        lines += summary_lines(sizes[k], inputs)
+        perm = result.permeability
+        lines += summary_lines(sizes[k], inputs, ratio_phrase(perm, k) if perm else "")
+        lines += permeability_lines(result, k)
+        if every_step:
+            lines.append(increment_line(sizes[k], inputs))
     return lines
 
 
@@ -45,13 +57,15 @@ def event_report(result, spec=None, every_step: bool = False) -> list[str]:
     "--steps",
     "every_step",
     is_flag=True,
-    help="A table for every converged load step, not only the last.",
+    help="A table for every converged load step, not only the last, with "
+    "what the step's own slip adds.",
 )
 @debug_option
 def summary(result_path: Path, every_step: bool, debug: bool) -> None:
     """Print what happened in the run that wrote RESULT (a result.h5 or its
     folder): per fracture whether it slipped, max slip, slipping length,
-    moment per unit length, stress drop and magnitude with its extent W."""
+    moment per unit length, stress drop and magnitude with its extent W; with
+    [permeability], the apertures and the block's permeability change."""
     with reported_errors(debug):
         from xfemslip import read_result
 

@@ -1,6 +1,7 @@
 """``result.h5``: the complete result of a run (``output-format.md``, version 1).
 
-Layout (every dataset carries ``attrs["units"]``: ``"m"``, ``"Pa"`` or ``"-"``)::
+Layout (every dataset carries ``attrs["units"]``: ``"m"``, ``"Pa"``, ``"-"``,
+or for the derived quantities ``"m^2"``, ``"m^3"``, ``"N m/m"``, ``"N m"``)::
 
     /                         attrs: format_version, xfemslip_version, case_toml,
                                      converged, load_steps, newton_iterations,
@@ -20,6 +21,18 @@ Layout (every dataset carries ``attrs["units"]``: ``"m"``, ``"Pa"`` or ``"-"``):
     /steps/<kkkk>/            only when load_steps > 1; attrs load_factor,
                               newton_iterations; holds fields/displacement and
                               fractures/<i>/* of that step
+    /events/                  event sizes (xfemslip.post.events), S converged
+                              steps by F fractures: step (S,), slipped (S, F)
+                              int8, max_slip, slipping_length, extent [m],
+                              moment_per_length [N m/m], moment [N m],
+                              stress_drop [Pa] (0 without slipping length),
+                              max_slip_increment [m] and
+                              moment_per_length_increment [N m/m] of the
+                              step's own slip; attr extent_given
+    with [permeability] (xfemslip.post.hydraulics) also: per fracture aperture
+    [m] and transmissivity [m^3], and /permeability/ with step (S,), in_situ
+    (2, 2) and tensor (S, 2, 2) [m^2], initial_aperture (F,) [m], attrs block,
+    matrix [m^2]
 
 ``<i>`` is the fracture's index in the case file (its position in
 ``StepFields.fractures``).  ``contact_pressure`` is an extra dataset for readers
@@ -48,6 +61,7 @@ from xfemslip import __version__, interrupt
 from xfemslip.conventions import STATE_CODES
 from xfemslip.io.atomic import atomic_path, refuse_non_finite
 from xfemslip.post.fields import FractureFields, StepFields
+from xfemslip.post.result import EventTable, PermeabilityHistory
 
 logger = logging.getLogger(__name__)
 
@@ -76,6 +90,8 @@ def write_result(
     steps: Sequence[StepFields],
     attrs: Mapping[str, object],
     load_steps: int,
+    events: EventTable | None = None,
+    permeability: PermeabilityHistory | None = None,
 ) -> None:
     """Write ``result.h5`` atomically.
 
@@ -98,6 +114,8 @@ def write_result(
         are written as given.
     load_steps : int
         Number of load steps of the case; ``/steps/`` is written when > 1.
+    events, permeability : optional
+        The derived tables ``/events`` and ``/permeability`` of the steps.
 
     Raises
     ------
@@ -118,6 +136,8 @@ def write_result(
         image = io.BytesIO()
         with h5py.File(image, "w", track_order=True) as h5:
             _fill(h5, root_attrs, points, cells, steps, load_steps)
+            if steps:
+                _write_derived(h5, steps, events, permeability)
         with open(tmp, "wb") as fh:
             fh.write(image.getbuffer())
 
@@ -240,10 +260,77 @@ def _write_fracture(group: h5py.Group, fracture: FractureFields) -> None:
     )
     # + 0.0 turns the -0.0 of max(-0.0, 0.0) into 0.0.
     _dataset(group, "contact_pressure", np.maximum(-normal, 0.0) + 0.0, "Pa")
-    for name in ("fluid_pressure", "effective_normal_traction"):  # pore pressure
+    optional = (
+        ("fluid_pressure", "Pa"),  # with pore pressure
+        ("effective_normal_traction", "Pa"),
+        ("aperture", "m"),  # with [permeability]
+        ("transmissivity", "m^3"),
+    )
+    for name, units in optional:
         value = getattr(fracture, name, None)
         if value is not None:
-            _dataset(group, name, _as_array(value, np.float64, (n_points,), name), "Pa")
+            _dataset(
+                group, name, _as_array(value, np.float64, (n_points,), name), units
+            )
+
+
+# (name, units) of the event datasets, each (S, F)
+EVENT_DATASETS = (
+    ("max_slip", "m"),
+    ("slipping_length", "m"),
+    ("moment_per_length", "N m/m"),
+    ("stress_drop", "Pa"),
+    ("extent", "m"),
+    ("max_slip_increment", "m"),
+    ("moment_per_length_increment", "N m/m"),
+)
+
+
+def _write_derived(h5, steps, events, permeability) -> None:
+    """``/events`` and ``/permeability`` (module docstring)."""
+    numbers = np.array([int(step.step) for step in steps], dtype=np.int64)
+    if events is not None:
+        group = h5.create_group("events", track_order=True)
+        group.attrs["extent_given"] = np.bool_(events.extent_given)
+        _dataset(group, "step", numbers, "-")
+        shape = (len(steps), None)
+        _dataset(
+            group,
+            "slipped",
+            _as_array(events.slipped, np.int8, shape, "slipped"),
+            "-",
+        )
+        for name, units in EVENT_DATASETS:
+            value = _as_array(getattr(events, name), np.float64, shape, name)
+            if name == "stress_drop":  # undefined without slipping length
+                value = np.where(np.isfinite(value), value, 0.0)
+            _dataset(group, name, value, units)
+        moment = events.moment_per_length * events.extent
+        _dataset(group, "moment", _as_array(moment, np.float64, shape, "moment"), "N m")
+    if permeability is not None:
+        group = h5.create_group("permeability", track_order=True)
+        group.attrs["block"] = np.array(permeability.block, dtype=np.float64)
+        group.attrs["matrix"] = float(permeability.matrix)
+        _dataset(group, "step", numbers, "-")
+        _dataset(
+            group,
+            "in_situ",
+            _as_array(permeability.in_situ, np.float64, (2, 2), "in_situ"),
+            "m^2",
+        )
+        _dataset(
+            group,
+            "tensor",
+            _as_array(permeability.tensors, np.float64, (len(steps), 2, 2), "tensor"),
+            "m^2",
+        )
+        a0 = permeability.initial_aperture
+        _dataset(
+            group,
+            "initial_aperture",
+            _as_array(a0, np.float64, (len(a0),), "initial_aperture"),
+            "m",
+        )
 
 
 def _dataset(

@@ -19,7 +19,7 @@ import numpy as np
 
 from xfemslip.errors import UsageError
 from xfemslip.post.fields import FractureFields, StepFields
-from xfemslip.post.result import Result
+from xfemslip.post.result import EventTable, PermeabilityHistory, Result
 
 __all__ = ["FRACTURE_ARRAYS", "read_attrs", "read_result"]
 
@@ -34,7 +34,12 @@ FRACTURE_ARRAYS = (
     "shear_traction",
     "state",
 )
-OPTIONAL_FRACTURE_ARRAYS = ("fluid_pressure", "effective_normal_traction")
+OPTIONAL_FRACTURE_ARRAYS = (
+    "fluid_pressure",
+    "effective_normal_traction",
+    "aperture",
+    "transmissivity",
+)
 BULK_ARRAYS = ("stress", "stress_zz", "principal_stress")
 OPTIONAL_BULK_ARRAYS = ("effective_stress", "pore_pressure")
 
@@ -133,6 +138,57 @@ def _steps(h5: h5py.File, attrs: dict) -> list[StepFields]:
     return steps
 
 
+EVENT_ARRAYS = (
+    "slipped",
+    "max_slip",
+    "slipping_length",
+    "moment_per_length",
+    "stress_drop",
+    "extent",
+    "max_slip_increment",
+    "moment_per_length_increment",
+)
+
+
+def _events(h5: h5py.File) -> EventTable | None:
+    """``/events`` (None in a file written without it, or without one of its
+    datasets: the event sizes are then computed from the steps)."""
+    if "events" not in h5:
+        return None
+    g = h5["events"]
+    if any(name not in g for name in EVENT_ARRAYS) or "extent_given" not in g.attrs:
+        return None
+    length = g["slipping_length"][()]
+    moment = g["moment_per_length"][()]
+    drop = g["stress_drop"][()]
+    return EventTable(
+        slipped=g["slipped"][()].astype(bool),
+        max_slip=g["max_slip"][()],
+        slipping_length=length,
+        moment_per_length=moment,
+        # written as 0 where the crack model has no slipping length or moment
+        stress_drop=np.where((length > 0.0) & (moment > 0.0), drop, np.nan),
+        extent=g["extent"][()],
+        extent_given=bool(g.attrs["extent_given"]),
+        max_slip_increment=g["max_slip_increment"][()],
+        moment_per_length_increment=g["moment_per_length_increment"][()],
+    )
+
+
+def _permeability(h5: h5py.File) -> PermeabilityHistory | None:
+    """``/permeability`` (None without [permeability])."""
+    if "permeability" not in h5:
+        return None
+    g = h5["permeability"]
+    return PermeabilityHistory(
+        block=tuple(float(v) for v in g.attrs["block"]),
+        matrix=float(g.attrs["matrix"]),
+        in_situ=g["in_situ"][()],
+        tensors=g["tensor"][()],
+        initial_aperture=g["initial_aperture"][()],
+    )
+
+
 def read_result(path: str | Path) -> Result:
     """Read a ``result.h5`` (or ``path/result.h5``) into a Result.
 
@@ -153,6 +209,8 @@ def read_result(path: str | Path) -> Result:
                 cells=h5["mesh/cells"][()],
                 steps=_steps(h5, attrs),
                 out_dir=path.parent,
+                events=_events(h5),
+                permeability=_permeability(h5),
             )
         except KeyError:  # a dataset or attribute of the format is missing
             raise UsageError(

@@ -59,6 +59,8 @@ def write_results(
         steps=result.steps,
         attrs=result.attrs,
         load_steps=result.load_steps,
+        events=result.events,
+        permeability=result.permeability,
     )
     if "vtu" in formats and result.steps:
         _write_vtu(folder, result, vis_mesh, fracture_ids)

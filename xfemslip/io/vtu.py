@@ -32,6 +32,7 @@ from xfemslip.post.fields import FractureFields, VisMesh
 logger = logging.getLogger(__name__)
 
 FRACTURE_POINT_DATA = ("slip", "opening", "normal_traction", "shear_traction")
+OPTIONAL_FRACTURE_POINT_DATA = ("aperture", "transmissivity")
 
 
 def write_bulk(
@@ -128,7 +129,8 @@ def write_fractures(
     Point data: ``slip``, ``opening`` [m], ``normal_traction``,
     ``shear_traction``, ``contact_pressure`` = max(0, -normal_traction) [Pa],
     ``state`` (int32: 0 open, 1 stick, 2 slip), ``s`` [m] and ``fracture``
-    (the index).  Points are 3D with z = 0.
+    (the index); with ``[permeability]`` also ``aperture`` [m] and
+    ``transmissivity`` [m^3].  Points are 3D with z = 0.
 
     Returns
     -------
@@ -243,6 +245,10 @@ def _fracture_part(index: int, fields: FractureFields) -> dict[str, np.ndarray]:
     part["state"] = np.asarray(fields.state, dtype=np.int32).reshape(n_points)
     part["s"] = s
     part["fracture"] = np.full(n_points, index, dtype=np.int32)
+    for name in OPTIONAL_FRACTURE_POINT_DATA:  # [permeability]: a [m], a^3/12 [m^3]
+        value = getattr(fields, name, None)
+        if value is not None:
+            part[name] = np.asarray(value, dtype=np.float64).reshape(n_points)
     return {name: value[order] for name, value in part.items()}
 
 

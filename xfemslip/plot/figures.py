@@ -15,6 +15,9 @@ side (one column per result):
   (Fig. 13); the contact points of the run are drawn too;
 - ``network`` (only when asked for, first result only): |slip| along every
   fracture of a network over the deformed split mesh, and the contact state.
+- ``permeability`` (only when asked for, first result only, a case with
+  ``[permeability]``): aperture and transmissivity along each fracture and
+  the block's permeability ratio against the load (:mod:`xfemslip.plot.permeability`).
 
 Every figure is saved as PNG and PDF.  Only the object-oriented API
 (``matplotlib.figure.Figure``) is used: no pyplot, no GUI backend.
@@ -37,6 +40,7 @@ from xfemslip.conventions import SLIP
 from xfemslip.errors import UsageError
 from xfemslip.plot.data import ResultData, figure_data
 from xfemslip.plot.mohr import add_legend, draw_mohr, mohr_figsize
+from xfemslip.plot.permeability import figure_permeability
 
 logger = logging.getLogger(__name__)
 
@@ -496,6 +500,9 @@ def plot_results(
         # not in KINDS (asked for by name): one figure per result
         "network": lambda: figure_network(results[0], scale),
     }
+    if "permeability" in kinds:  # drawn now: a result without one is refused
+        figure = figure_permeability(paths[0], results[0].label)
+        makers["permeability"] = lambda: figure
     drawn = {}
     for kind in kinds:
         if kind in ("slip", "mohr") and not any(r.fractures for r in results):

@@ -15,9 +15,10 @@ part of the fracture inside the domain, like the sweep metrics.  mu is the
 shear modulus of ``[material]``, or of ``[reservoir]`` for a fracture whose
 middle contact point lies in the reservoir.
 
-Everything is computed from a :class:`~xfemslip.post.result.Result` and the
-case it ran (the ``case_toml`` a result carries), so a result written by any
-version gives its event sizes without new datasets.
+A run keeps them (:func:`event_table`, ``Result.events``, the ``/events``
+group of ``result.h5``), and :func:`event_sizes` reads them from there; a
+result written without them has them computed from its arrays and the case
+it ran (the ``case_toml`` every result carries).
 """
 
 from __future__ import annotations
@@ -34,7 +35,7 @@ from xfemslip.conventions import SLIP
 from xfemslip.errors import CaseError, XfemslipError
 from xfemslip.geometry.regions import in_region
 from xfemslip.post.metrics import arc_extent, point_stretches
-from xfemslip.post.result import Result
+from xfemslip.post.result import EventTable, Result
 from xfemslip.post.seismic import (
     moment_magnitude,
     moment_per_length,
@@ -43,10 +44,17 @@ from xfemslip.post.seismic import (
 )
 
 __all__ = [
+    "CASE_COLUMNS",
+    "FRACTURE_COLUMNS",
+    "MAX_FRACTURE_COLUMNS",
     "EventInputs",
     "FractureEvent",
     "event_inputs",
     "event_sizes",
+    "event_table",
+    "fracture_metrics",
+    "increment_line",
+    "stored_inputs",
     "summary_lines",
 ]
 
@@ -63,11 +71,19 @@ class FractureEvent:
     stress_drop: float  # crack model [Pa]; NaN without slip
     extent: float  # the W of the magnitude [m] (0 without slip and extent)
     magnitude: float  # Mw for M0' W; -inf without moment
+    # of this step alone: the slip it added (s_k - s_k-1, s_0 = 0 in situ)
+    max_slip_increment: float = 0.0  # max |ds| [m]
+    moment_per_length_increment: float = 0.0  # mu int |ds| ds [N m / m]
 
     @property
     def moment(self) -> float:
         """M0 = M0' W [N m]."""
         return self.moment_per_length * self.extent
+
+    @property
+    def magnitude_increment(self) -> float:
+        """Mw of this step's slip alone, for the same W; -inf without."""
+        return moment_magnitude(self.moment_per_length_increment * self.extent)
 
 
 @dataclass(frozen=True)
@@ -110,6 +126,14 @@ def _from_spec(spec, result: Result) -> EventInputs:
     ends = tuple(arc_extent(f.points, box) for f in spec.fractures)
     extent = spec.events.extent if spec.events is not None else None
     return EventInputs(tuple(mus), tuple(nus), m.model, ends, extent)
+
+
+def stored_inputs(table: EventTable) -> EventInputs:
+    """What the printout needs of the inputs when the event sizes are read
+    from ``table``: whether W is events.extent."""
+    given = table.extent_given and table.extent.size
+    extent = float(table.extent.flat[0]) if given else None
+    return EventInputs((), (), "", (), extent)
 
 
 def _contact_ends(s: np.ndarray) -> tuple[float, float]:
@@ -161,8 +185,10 @@ def event_inputs(result: Result, spec=None) -> EventInputs:
         return _from_text(text, result, f"the case does not load here: {where}")
 
 
-def _fracture_event(index, ff, inputs: EventInputs) -> FractureEvent:
+def _fracture_event(index, ff, inputs: EventInputs, before=None) -> FractureEvent:
+    """``before``: the fracture's slip at the step before (None: in situ)."""
     s, slip, state = np.asarray(ff.s, float), np.asarray(ff.slip, float), ff.state
+    step_slip = slip - (np.asarray(before, float) if before is not None else 0.0)
     stretch = point_stretches(s, *inputs.ends[index])
     mu, nu = inputs.mu[index], inputs.nu[index]
     m0 = moment_per_length(mu, stretch, slip)
@@ -177,15 +203,86 @@ def _fracture_event(index, ff, inputs: EventInputs) -> FractureEvent:
         stress_drop=stress_drop(m0, length, mu, nu, inputs.model),
         extent=extent,
         magnitude=moment_magnitude(m0 * extent),
+        max_slip_increment=float(np.max(np.abs(step_slip))) if slip.size else 0.0,
+        moment_per_length_increment=moment_per_length(mu, stretch, step_slip),
     )
 
 
+def _computed(result: Result, inputs: EventInputs) -> list[list[FractureEvent]]:
+    out, before = [], None
+    for step in result.steps:
+        out.append(
+            [
+                _fracture_event(i, ff, inputs, before[i].slip if before else None)
+                for i, ff in enumerate(step.fractures)
+            ]
+        )
+        before = step.fractures
+    return out
+
+
+def _stored(table: EventTable) -> list[list[FractureEvent]]:
+    steps, n = table.max_slip.shape
+    out = []
+    for k in range(steps):
+        row = []
+        for i in range(n):
+            m0, w = float(table.moment_per_length[k, i]), float(table.extent[k, i])
+            row.append(
+                FractureEvent(
+                    fracture=i,
+                    slipped=bool(table.slipped[k, i]),
+                    max_slip=float(table.max_slip[k, i]),
+                    slipping_length=float(table.slipping_length[k, i]),
+                    moment_per_length=m0,
+                    stress_drop=float(table.stress_drop[k, i]),
+                    extent=w,
+                    magnitude=moment_magnitude(m0 * w),
+                    max_slip_increment=float(table.max_slip_increment[k, i]),
+                    moment_per_length_increment=float(
+                        table.moment_per_length_increment[k, i]
+                    ),
+                )
+            )
+        out.append(row)
+    return out
+
+
 def event_sizes(result: Result, inputs: EventInputs) -> list[list[FractureEvent]]:
-    """Per converged load step, the :class:`FractureEvent` of every fracture."""
-    return [
-        [_fracture_event(i, ff, inputs) for i, ff in enumerate(step.fractures)]
-        for step in result.steps
-    ]
+    """Per converged load step, the :class:`FractureEvent` of every fracture:
+    those the result keeps (``result.events``) when it has them, else
+    computed from its fields."""
+    if result.events is not None and result.events.max_slip.shape[0] == len(
+        result.steps
+    ):
+        return _stored(result.events)
+    return _computed(result, inputs)
+
+
+def event_table(result: Result, inputs: EventInputs) -> EventTable | None:
+    """The :class:`~xfemslip.post.result.EventTable` of ``result``'s steps
+    (None without a converged step)."""
+    if not result.steps:
+        return None
+    sizes = _computed(result, inputs)
+    n = len(result.steps[0].fractures)
+
+    def column(name, dtype=float):
+        return np.array(
+            [[getattr(e, name) for e in row] for row in sizes], dtype=dtype
+        ).reshape(len(sizes), n)
+
+    return EventTable(
+        slipped=column("slipped", bool),
+        max_slip=column("max_slip"),
+        slipping_length=column("slipping_length"),
+        moment_per_length=column("moment_per_length"),
+        stress_drop=column("stress_drop"),
+        extent=column("extent"),
+        extent_given=inputs.extent is not None,
+        max_slip_increment=column("max_slip_increment"),
+        moment_per_length_increment=column("moment_per_length_increment"),
+    )
 
 
 # --------------------------------------------------------------------------- #
@@ -204,8 +301,11 @@ def _mw_text(event: FractureEvent) -> str:
     return f"{event.magnitude:.2f}" if math.isfinite(event.magnitude) else "-"
 
 
-def summary_lines(events: list[FractureEvent], inputs: EventInputs) -> list[str]:
-    """The per-fracture table of one step and the "what happened" line."""
+def summary_lines(
+    events: list[FractureEvent], inputs: EventInputs, also: str = ""
+) -> list[str]:
+    """The per-fracture table of one step and the "what happened" line
+    (``also`` appended to it after a semicolon, e.g. the permeability)."""
     if not events:
         return ["no fracture in this result"]
     head = (
@@ -222,10 +322,29 @@ def summary_lines(events: list[FractureEvent], inputs: EventInputs) -> list[str]
             f"{e.max_slip * 1e3:>13.4g}  {e.slipping_length:>12.4g}  "
             f"{e.moment_per_length:>12.4g}  {drop:>10}  {_mw_text(e):>6}  {w}"
         )
-    lines.append(what_happened(events, inputs))
+    lines.append(what_happened(events, inputs) + (f"; {also}" if also else ""))
     if inputs.note:
         lines.append(f"note: {inputs.note}")
     return lines
+
+
+def increment_line(events: list[FractureEvent], inputs: EventInputs) -> str:
+    """One line: the slip this step added on each fracture that slips in it
+    (max, M0' and Mw of the increment, same W as the step's table)."""
+    parts = [
+        f"fracture {e.fracture} +{e.max_slip_increment * 1e3:.3g} mm, "
+        f"M0' +{e.moment_per_length_increment:.4g} N m/m, "
+        f"Mw {_mw(e.magnitude_increment)}"
+        for e in events
+        if e.slipped
+    ]
+    if not parts:
+        return "this step alone: no fracture slips"
+    return "this step alone: " + "; ".join(parts)
+
+
+def _mw(value: float) -> str:
+    return f"{value:.2f}" if math.isfinite(value) else "-"
 
 
 def what_happened(events: list[FractureEvent], inputs: EventInputs) -> str:
@@ -249,3 +368,59 @@ def what_happened(events: list[FractureEvent], inputs: EventInputs) -> str:
     if big.fracture != top.fracture:
         line += f" on fracture {big.fracture}"
     return line
+
+
+# --------------------------------------------------------------------------- #
+# Sweep columns
+
+# per fracture i, up to MAX_FRACTURE_COLUMNS fractures: fracture<i>_<name>
+FRACTURE_COLUMNS = (
+    "slipped",
+    "max_slip_m",
+    "slip_length_m",
+    "moment_per_length_Nm_per_m",
+    "Mw",
+)
+MAX_FRACTURE_COLUMNS = 10
+# per case: the largest magnitude, the W it used, the block's permeability
+# ratios (k over in situ, with [permeability])
+CASE_COLUMNS = ("max_Mw", "Mw_extent", "k_xx_ratio", "k_yy_ratio")
+
+
+def _number(value: float):
+    """A finite float, or "" (no magnitude, no in-situ value)."""
+    return float(value) if math.isfinite(value) else ""
+
+
+def fracture_metrics(result: Result, spec) -> dict:
+    """The sweep columns of the final step of ``result`` (the case ``spec``):
+    CASE_COLUMNS, and FRACTURE_COLUMNS of each fracture when there are at
+    most MAX_FRACTURE_COLUMNS of them (a network's realizations have their
+    own summary, :mod:`xfemslip.studies.dfn_summary`)."""
+    if not result.steps:
+        return {}
+    stored = result.events is not None
+    inputs = stored_inputs(result.events) if stored else event_inputs(result, spec)
+    events = event_sizes(result, inputs)[-1]
+    magnitudes = [e.magnitude for e in events if math.isfinite(e.magnitude)]
+    out = {
+        "max_Mw": max(magnitudes) if magnitudes else "",
+        "Mw_extent": f"{inputs.extent:g} m" if inputs.extent else "slipping length",
+        "k_xx_ratio": "",
+        "k_yy_ratio": "",
+    }
+    if result.permeability is not None:
+        rx, ry = result.permeability.ratio()
+        out["k_xx_ratio"], out["k_yy_ratio"] = _number(rx), _number(ry)
+    if len(events) <= MAX_FRACTURE_COLUMNS:
+        for e in events:
+            values = (
+                e.slipped,
+                e.max_slip,
+                e.slipping_length,
+                e.moment_per_length,
+                _number(e.magnitude),
+            )
+            for name, value in zip(FRACTURE_COLUMNS, values, strict=True):
+                out[f"fracture{e.fracture}_{name}"] = value
+    return out

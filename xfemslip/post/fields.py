@@ -37,6 +37,9 @@ class FractureFields:
     # with [pore_pressure] only (xfemslip.fem.poro); normal_traction is then total
     fluid_pressure: np.ndarray | None = None  # (K,) p_f [Pa]
     effective_normal_traction: np.ndarray | None = None  # (K,) p_N + p_f [Pa]
+    # with [permeability] only (xfemslip.post.hydraulics)
+    aperture: np.ndarray | None = None  # (K,) hydraulic aperture a [m]
+    transmissivity: np.ndarray | None = None  # (K,) a^3 / 12 [m^3]
 
 
 @dataclass

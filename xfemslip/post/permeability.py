@@ -102,4 +102,4 @@ def oda_tensor(fractures, area: float, matrix_permeability: float = 0.0):
         t = np.asarray(t, float)
         c = np.asarray(w, float) * transmissivity(a)
         k = k + np.einsum("k,ki,kj->ij", c, t, t) / area
-    return k
+    return 0.5 * (k + k.T)  # symmetric to the last bit (einsum's order is not)

@@ -33,7 +33,43 @@ import numpy as np
 
 from xfemslip.post.fields import FractureFields, StepFields
 
-__all__ = ["TIMED_ATTRS", "Result", "run_id"]
+__all__ = ["TIMED_ATTRS", "EventTable", "PermeabilityHistory", "Result", "run_id"]
+
+
+@dataclass
+class EventTable:
+    """The event size of every fracture at every converged step
+    (:mod:`xfemslip.post.events`): arrays (S, F), S steps by F fractures."""
+
+    slipped: np.ndarray  # bool: a contact point in state slip
+    max_slip: np.ndarray  # max |slip| [m]
+    slipping_length: np.ndarray  # [m]
+    moment_per_length: np.ndarray  # M0' [N m / m]
+    stress_drop: np.ndarray  # crack model [Pa]; NaN without slipping length
+    extent: np.ndarray  # the W of the magnitude [m]
+    extent_given: bool  # W is events.extent (else each slipping length)
+    # of each step alone (its slip minus the step before's; in situ: 0)
+    max_slip_increment: np.ndarray  # [m]
+    moment_per_length_increment: np.ndarray  # [N m / m]
+
+
+@dataclass
+class PermeabilityHistory:
+    """The equivalent permeability tensor of the block
+    (:mod:`xfemslip.post.hydraulics`): in situ and after each converged step."""
+
+    block: tuple[float, float, float, float]  # x0, y0, x1, y1 [m]
+    matrix: float  # k_m [m^2]
+    in_situ: np.ndarray  # (2, 2) [m^2]
+    tensors: np.ndarray  # (S, 2, 2) [m^2]
+    initial_aperture: np.ndarray  # (F,) a0 of each fracture [m]
+
+    def ratio(self, step: int = -1) -> np.ndarray:
+        """(k_xx, k_yy) after ``step`` over their in-situ values."""
+        k = np.array([self.tensors[step][0, 0], self.tensors[step][1, 1]])
+        k0 = np.diag(self.in_situ)
+        # NaN where the in-situ value is 0 (no matrix, no fracture along x)
+        return np.divide(k, k0, out=np.full(2, np.nan), where=k0 > 0.0)
 
 
 @dataclass
@@ -51,6 +87,10 @@ class Result:
     steps: list[StepFields] = field(default_factory=list)
     # the folder the output set was written to (None: nothing written)
     out_dir: Path | None = None
+    # derived from the steps and the case (not in run_id): the event sizes,
+    # and the block's permeability with [permeability]
+    events: EventTable | None = None
+    permeability: PermeabilityHistory | None = None
 
     @property
     def converged(self) -> bool:

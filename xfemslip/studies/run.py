@@ -21,7 +21,11 @@ is reported in its row and the others go on; so is a case the sweep refused
 slipping length [m], share of contact points in slip, converged, Newton
 iterations, wall time [s], the number of fractures, how many have a point in
 slip, that fraction, the mean over those of their length-weighted mean |slip|
-[m], status (ok, skipped, failed, refused) and error. A sweep that varies a
+[m], the largest moment magnitude with the W it used, the block's k_xx and
+k_yy over their in-situ values (cases with ``[permeability]``), per fracture
+(up to ten) whether it slipped, its max |slip|, slipping length, moment per
+unit length and magnitude (``fracture<i>_...``), status (ok, skipped, failed,
+refused) and error. A sweep that varies a
 ``network.*`` key also gets ``dfn_summary.csv`` (:mod:`xfemslip.studies.dfn_summary`).
 """
 
@@ -41,6 +45,7 @@ from xfemslip.io.csv import write_rows
 from xfemslip.io.fileset import replace_files
 from xfemslip.io.lock import folder_lock
 from xfemslip.io.read import read_attrs, read_result
+from xfemslip.post.events import CASE_COLUMNS, fracture_metrics
 from xfemslip.post.metrics import METRICS, result_metrics
 from xfemslip.studies.dfn_summary import DFN_SUMMARY, is_dfn_sweep, write_dfn_summary
 
@@ -122,6 +127,12 @@ def _vtu_set_whole(out_dir: Path, spec, run_id: int) -> bool:
 # --------------------------------------------------------------------------- #
 
 
+def case_metrics(result, spec) -> dict:
+    """The summary columns of one case: METRICS, then the event sizes (and
+    permeability ratios) of :func:`xfemslip.post.events.fracture_metrics`."""
+    return result_metrics(result, spec) | fracture_metrics(result, spec)
+
+
 def run_task(task: CaseTask) -> tuple[str, str, dict, str]:
     """Run one case; never raises.  Returns (case_id, status, metrics, error).
 
@@ -136,7 +147,7 @@ def run_task(task: CaseTask) -> tuple[str, str, dict, str]:
     try:
         spec = loads_case(task.text, Path(task.path))
         result = run_case(spec, out_dir, overwrite=True)
-        return task.case_id, "ok", result_metrics(result, spec), ""
+        return task.case_id, "ok", case_metrics(result, spec), ""
     except XfemslipError as err:
         error = " ".join(str(err).split())
     except Exception:  # a bug: keep the other cases, show where it happened
@@ -144,7 +155,7 @@ def run_task(task: CaseTask) -> tuple[str, str, dict, str]:
     metrics = {}
     if spec is not None and (out_dir / "result.h5").is_file():
         try:  # the converged steps of a failed run
-            metrics = result_metrics(read_result(out_dir), spec)
+            metrics = case_metrics(read_result(out_dir), spec)
         except UsageError:
             metrics = {}
     return task.case_id, "failed", metrics, error
@@ -171,7 +182,7 @@ def _prepare(sweep, directory: Path, force: bool) -> tuple[list, list[CaseRow]]:
             continue
         if not force and is_done(out_dir, case.text, case.spec):
             row = CaseRow(case.case_id, case.params, "skipped")
-            row.metrics = result_metrics(read_result(out_dir), case.spec)
+            row.metrics = case_metrics(read_result(out_dir), case.spec)
             skipped.append(row)
             continue
         _write_case(sweep, out_dir, case.text)
@@ -335,14 +346,32 @@ def _cell(value) -> str:
     return str(value)
 
 
-def summary_table(keys, rows: list[CaseRow]) -> tuple[list[str], list[list[str]]]:
-    """Header and text cells of the summary (CSV and printout alike)."""
-    header = ["case", *keys, *METRICS, "status", "error"]
+def _extra_columns(rows: list[CaseRow], per_fracture: bool) -> list[str]:
+    """The columns after METRICS: CASE_COLUMNS, then (``per_fracture``) the
+    per-fracture ones that any row has, in the order they first appear."""
+    extra = list(CASE_COLUMNS)
+    if per_fracture:
+        seen = dict.fromkeys(
+            name for row in rows for name in row.metrics if name.startswith("fracture")
+        )
+        extra += [name for name in seen if name not in METRICS]
+    return extra
+
+
+def summary_table(
+    keys, rows: list[CaseRow], per_fracture: bool = True
+) -> tuple[list[str], list[list[str]]]:
+    """Header and text cells of the summary (CSV and printout alike): the
+    parameters, METRICS, the event and permeability columns, status, error.
+    The columns of METRICS keep their names and meaning; the others follow
+    them (read a summary.csv by column name)."""
+    columns = [*METRICS, *_extra_columns(rows, per_fracture)]
+    header = ["case", *keys, *columns, "status", "error"]
     body = []
     for row in rows:
         values = dict(row.params)
         cells = [row.case_id, *(_cell(values[k]) for k in keys)]
-        cells += [_cell(row.metrics[m]) if m in row.metrics else "" for m in METRICS]
+        cells += [_cell(row.metrics[m]) if m in row.metrics else "" for m in columns]
         body.append([*cells, row.status, row.error])
     return header, body
 
@@ -354,8 +383,9 @@ def write_summary(path: Path, keys, rows: list[CaseRow]) -> None:
 
 
 def format_table(keys, rows: list[CaseRow]) -> str:
-    """The summary as an aligned text table (the error column last, unpadded)."""
-    header, body = summary_table(keys, rows)
+    """The summary as an aligned text table (the error column last, unpadded);
+    the per-fracture columns are in summary.csv only."""
+    header, body = summary_table(keys, rows, per_fracture=False)
     header = header[1:-1]  # the case id is long; the parameters say it all
     body = [[*cells[1:-1], cells[-1]] for cells in body]
     widths = [max(len(r[i]) for r in [header, *body]) for i in range(len(header))]

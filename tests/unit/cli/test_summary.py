@@ -156,6 +156,13 @@ def test_summary_steps_prints_a_table_per_load_step(ran):
         rows = _table("\n".join(block.splitlines()[1:]))
         for row, ff in zip(rows, step.fractures, strict=True):
             assert float(row[2]) == pytest.approx(np.abs(ff.slip).max() * 1e3, 1e-3)
+    # each step ends with what its own slip added (fracture 0 slips in both)
+    grow = np.abs(read.steps[1].fractures[0].slip - read.steps[0].fractures[0].slip)
+    last = blocks[1].splitlines()[-1]
+    assert last.startswith("this step alone: fracture 0 +")
+    assert float(last.split("+", 1)[1].split(" mm")[0]) == pytest.approx(
+        grow.max() * 1e3, rel=1e-2
+    )
 
 
 def test_quiet_run_leaves_the_table_out(tmp_path):
@@ -176,13 +183,15 @@ def test_events_extent_is_the_w_of_every_magnitude(tmp_path):
 
 
 def test_summary_of_a_result_whose_case_files_are_elsewhere(ran, tmp_path):
-    """A [network] CSV next to the original case is not next to the result:
-    the fracture ends come from the contact points, and the summary says so."""
+    """A result without stored event sizes (written before they were kept)
+    whose [network] CSV is not next to it: the fracture ends come from the
+    contact points, and the summary says so."""
     _, out = ran
     (tmp_path / "seg.csv").write_text("x0,y0,x1,y1\n0.4,1.5,1.6,1.5\n")
     copy = tmp_path / "copy"
     shutil.copytree(out, copy)
     with h5py.File(copy / "result.h5", "r+") as h5:
+        del h5["events"]
         text = h5.attrs["case_toml"]
         text = text.decode() if isinstance(text, bytes) else text
         # the third fracture as a network.file member instead
@@ -217,3 +226,67 @@ def test_summary_of_a_missing_file_or_not_a_result_exits_2(tmp_path):
     assert result.exit_code == 2
     assert len(result.output.strip().splitlines()) == 1
     assert "not a result.h5 of xfemslip" in result.output
+
+
+def test_result_h5_keeps_the_event_sizes_of_every_step(ran):
+    """/events holds, per step and fracture, the numbers computed here from
+    the arrays (the final step against _expected; the step numbers)."""
+    _, out = ran
+    result = xfemslip.read_result(out)
+    with h5py.File(out / "result.h5", "r") as h5:
+        group = h5["events"]
+        assert list(group["step"][()]) == [1, 2]
+        assert group["moment"].attrs["units"] == "N m"
+        assert group["max_slip"].shape == (2, len(FRACTURES))
+        moment = group["moment"][()]
+    events = result.events
+    assert not events.extent_given
+    for i, exp in enumerate(_expected(result)):
+        slipped, max_mm, lslip, m0, _, w = exp
+        assert bool(events.slipped[-1, i]) == slipped
+        assert events.max_slip[-1, i] * 1e3 == pytest.approx(max_mm, rel=1e-12)
+        assert events.slipping_length[-1, i] == pytest.approx(lslip, rel=1e-12)
+        assert events.moment_per_length[-1, i] == pytest.approx(m0, rel=1e-12)
+        assert moment[-1, i] == pytest.approx(m0 * w, rel=1e-12)
+        # the stress drop is undefined (NaN in memory, 0 in the file) without slip
+        assert math.isnan(events.stress_drop[-1, i]) == (lslip == 0.0)
+    # the increments of step 2: mu int |s2 - s1| ds, and step 1's are its own
+    for i, (points, _) in enumerate(FRACTURES):
+        s1, s2 = (step.fractures[i] for step in result.steps)
+        mid = 0.5 * (s2.s[1:] + s2.s[:-1])
+        stretch = np.diff(np.concatenate([[0.0], mid, [math.dist(*points)]]))
+        inc = MU * float(np.sum(stretch * np.abs(s2.slip - s1.slip)))
+        assert events.moment_per_length_increment[1, i] == pytest.approx(inc, 1e-12)
+        assert events.max_slip_increment[1, i] == pytest.approx(
+            np.abs(s2.slip - s1.slip).max(), rel=1e-12
+        )
+        assert events.moment_per_length_increment[0, i] == pytest.approx(
+            events.moment_per_length[0, i], rel=1e-12
+        )
+
+
+def test_summary_reads_the_stored_event_sizes(ran, tmp_path):
+    """The table comes from /events when the file has it: a number changed
+    there shows; the same file without /events gives the recomputed table."""
+    _, out = ran
+    edited, stripped = tmp_path / "edited", tmp_path / "stripped"
+    shutil.copytree(out, edited)
+    shutil.copytree(out, stripped)
+    with h5py.File(edited / "result.h5", "r+") as h5:
+        h5["events/max_slip"][-1, 1] = 0.123456  # m
+    with h5py.File(stripped / "result.h5", "r+") as h5:
+        del h5["events"]
+    runner = CliRunner()
+    original = runner.invoke(cli, ["summary", str(out)])
+    assert "123.5" in runner.invoke(cli, ["summary", str(edited)]).output
+    again = runner.invoke(cli, ["summary", str(stripped)])
+    assert again.exit_code == 0, again.output
+    assert _table(again.output) == _table(original.output)
+    # a group lacking one of its datasets is not trusted: recomputed as well
+    partial = tmp_path / "partial"
+    shutil.copytree(out, partial)
+    with h5py.File(partial / "result.h5", "r+") as h5:
+        del h5["events/moment_per_length_increment"]
+    assert xfemslip.read_result(partial).events is None
+    third = runner.invoke(cli, ["summary", str(partial)])
+    assert _table(third.output) == _table(original.output)

@@ -277,3 +277,37 @@ def test_slip_figure_colours_tell_many_fractures_apart():
     for n in (3, 10, 15, 20, 40):
         colours = {matplotlib.colors.to_rgba(c) for c in _distinct_colours(n)[:n]}
         assert len(colours) == n
+
+
+def test_permeability_figure_draws_the_apertures_and_the_ratio(tmp_path, runner):
+    """--figure permeability: the aperture [mm] and transmissivity curves are
+    those of result.h5, the ratio panel starts at 1 in situ and ends at the
+    stored tensor's ratio; a result without [permeability] is refused (2)."""
+    case = tmp_path / "k.toml"
+    case.write_text(BASE + "[permeability]\naperture = 1.0e-4\ndilation_angle = 5.0\n")
+    out = tmp_path / "out"
+    assert runner.invoke(cli, ["run", str(case), "-o", str(out)]).exit_code == 0
+    result = runner.invoke(
+        cli, ["plot", str(out), "--figure", "permeability", "--format", "png"]
+    )
+    assert result.exit_code == 0, result.output
+    assert (out / "figures" / "permeability.png").read_bytes()[:8] == PNG
+    from xfemslip import read_result
+    from xfemslip.plot.permeability import figure_permeability
+
+    read = read_result(out)
+    fig = figure_permeability(out)
+    ax_a, ax_t, ax_k = fig.axes
+    ff = read.fractures[0]
+    np.testing.assert_allclose(ax_a.lines[0].get_ydata(), ff.aperture * 1e3)
+    np.testing.assert_allclose(ax_a.lines[1].get_ydata(), [0.1, 0.1])  # a0 [mm]
+    np.testing.assert_allclose(ax_t.lines[0].get_ydata(), ff.transmissivity)
+    kxx = ax_k.lines[0].get_ydata()
+    assert kxx[0] == 1.0 and kxx[-1] == pytest.approx(read.permeability.ratio()[0])
+    assert "tiny" in fig._suptitle.get_text()
+    plain = tmp_path / "plain"
+    case.write_text(BASE)
+    assert runner.invoke(cli, ["run", str(case), "-o", str(plain)]).exit_code == 0
+    refused = runner.invoke(cli, ["plot", str(plain), "--figure", "permeability"])
+    assert refused.exit_code == 2
+    assert "no permeability in this result" in refused.output

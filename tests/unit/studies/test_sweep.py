@@ -13,13 +13,14 @@ import h5py
 import numpy as np
 import pytest
 
+import xfemslip
 from tests.support.casegen import SWEEP_BASE as BASE
 from tests.support.casegen import SWEEP_CASE as CASE
 from xfemslip.case import build
 from xfemslip.case.tables import Table
 from xfemslip.cli import cli
 from xfemslip.errors import CaseError
-from xfemslip.post.metrics import arc_extent, slipping_length
+from xfemslip.post.metrics import METRICS, arc_extent, slipping_length
 from xfemslip.studies.run import run_sweep
 from xfemslip.studies.sweep import (
     case_id,
@@ -388,6 +389,49 @@ def test_run_sweep_summary_skip_and_failure(tmp_path, base):
     assert [r.status for r in again] == ["failed", "skipped"]
     assert (out / rows[1].case_id / "result.h5").stat().st_mtime_ns == mtime
     assert again[1].metrics == ok
+
+
+def test_summary_adds_event_and_permeability_columns_after_the_metrics(tmp_path, base):
+    """summary.csv keeps every earlier column, in order, and adds the event
+    size of each fracture (from the member's /events, checked here against
+    its arrays: Mw = 2/3 (log10(mu int |s| ds W) - 9.1), the slipping length
+    and W = events.extent) and, with [permeability], the ratios."""
+    text = base.read_text() + (
+        "[events]\nextent = 100.0\n[permeability]\naperture = 1.0e-4\n"
+        "dilation_angle = 5.0\n"
+    )
+    base.write_text(text)
+    path = _sweep(tmp_path, 'base = "base.toml"\n[vary]\n"material.E" = [5e9]\n')
+    out = tmp_path / "out"
+    (row,) = run_sweep(load_sweep(path), out)
+    with open(out / "summary.csv", newline="") as fh:
+        header = next(csv.reader(fh))
+    assert header[: 2 + len(METRICS)] == ["case", "material.E", *METRICS]
+    assert header[-2:] == ["status", "error"]
+    (line,) = _read_summary(out / "summary.csv")
+    result = xfemslip.read_result(out / row.case_id)
+    ff = result.fractures[0]
+    mu = 5e9 / (2 * (1 + CASE["material"]["nu"]))
+    mid = 0.5 * (ff.s[1:] + ff.s[:-1])
+    length = CASE["fractures"][0]["length"]  # inside the domain
+    stretch = np.diff(np.concatenate([[0.0], mid, [length]]))
+    m0 = mu * float(np.sum(stretch * np.abs(ff.slip)))
+    mw = 2.0 / 3.0 * (math.log10(m0 * 100.0) - 9.1)
+    assert float(line["fracture0_moment_per_length_Nm_per_m"]) == pytest.approx(
+        m0, rel=1e-5
+    )
+    assert float(line["fracture0_Mw"]) == pytest.approx(mw, abs=1e-5)
+    assert float(line["max_Mw"]) == pytest.approx(mw, abs=1e-5)
+    assert line["Mw_extent"] == "100 m" and line["fracture0_slipped"] == "true"
+    assert float(line["fracture0_max_slip_m"]) == pytest.approx(
+        float(line["max_abs_slip_m"]), rel=1e-12
+    )
+    # one fracture along the block's diagonal direction: both ratios the
+    # same, that of the mean a^3 along it over a0^3
+    rx, ry = float(line["k_xx_ratio"]), float(line["k_yy_ratio"])
+    mean = float(np.sum(stretch * ff.aperture**3) / np.sum(stretch)) / 1.0e-12
+    assert rx > 1.0 and rx == pytest.approx(mean, rel=1e-5)
+    assert ry == pytest.approx(rx, rel=1e-5)
 
 
 def test_rerun_after_editing_the_base_runs_again(tmp_path, base):
