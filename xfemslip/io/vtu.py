@@ -18,7 +18,6 @@ from __future__ import annotations
 
 import logging
 import re
-import shutil
 from collections.abc import Mapping, Sequence
 from pathlib import Path
 from xml.sax.saxutils import quoteattr
@@ -110,6 +109,7 @@ def write_fractures(
     path: Path | str,
     fractures: Sequence[tuple[int, FractureFields]],
     *,
+    faces: Sequence[tuple[np.ndarray, np.ndarray]] | None = None,
     run_id: int | None = None,
 ) -> bool:
     """Write the fractures as polylines with their contact fields (``fractures.vtu``).
@@ -122,13 +122,21 @@ def write_fractures(
         ``index`` is the fracture's position in the case file.  Each fracture's
         K points, sorted by ``s``, are joined by "line" cells; a fracture with a
         single point becomes a "vertex" cell, one with none is left out.
+    faces : list of (u_minus, u_plus), optional
+        Per fracture (same order), the displacement of its - and + faces at
+        its K points, each (K, 2) [m] sorted by ``s``
+        (:func:`xfemslip.post.fields.fracture_faces`).  Given, the point data
+        gets ``displacement`` = (u_minus + u_plus) / 2, so that "Warp By
+        Vector" moves the fracture with the body, and ``displacement_jump`` =
+        u_plus - u_minus ([[u]]), both 3 components with z = 0.
     run_id : int, optional
         The output set's id (field data ``run_id``, as in :func:`write_bulk`).
 
     Point data: ``slip``, ``opening`` [m], ``normal_traction``,
     ``shear_traction``, ``contact_pressure`` = max(0, -normal_traction) [Pa],
     ``state`` (int32: 0 open, 1 stick, 2 slip), ``s`` [m] and ``fracture``
-    (the index).  Points are 3D with z = 0.
+    (the index), and with ``faces`` the two displacements above.  Points are
+    3D with z = 0.
 
     Returns
     -------
@@ -142,7 +150,14 @@ def write_fractures(
     OutputError
         The file cannot be written.
     """
-    parts = [_fracture_part(index, fields) for index, fields in fractures]
+    if faces is not None and len(faces) != len(fractures):
+        raise ValueError(
+            f"write_fractures: {len(faces)} face pairs for {len(fractures)} fractures"
+        )
+    parts = [
+        _fracture_part(index, fields, None if faces is None else faces[k])
+        for k, (index, fields) in enumerate(fractures)
+    ]
     parts = [part for part in parts if part["points"].shape[0] > 0]
     if not parts:
         logger.debug("%s: no fracture points, file not written", path)
@@ -228,8 +243,11 @@ def _field_data(run_id: int | None) -> dict[str, np.ndarray]:
     return {"run_id": np.array([run_id], dtype=np.int64)}
 
 
-def _fracture_part(index: int, fields: FractureFields) -> dict[str, np.ndarray]:
-    """Point arrays of one fracture, sorted by arc length s."""
+def _fracture_part(
+    index: int, fields: FractureFields, faces=None
+) -> dict[str, np.ndarray]:
+    """Point arrays of one fracture, sorted by arc length s (``faces``: its
+    (u_minus, u_plus) at the same points, or None)."""
     s = np.asarray(fields.s, dtype=np.float64).reshape(-1)
     order = np.argsort(s, kind="stable")
     n_points = s.shape[0]
@@ -243,6 +261,12 @@ def _fracture_part(index: int, fields: FractureFields) -> dict[str, np.ndarray]:
     part["state"] = np.asarray(fields.state, dtype=np.int32).reshape(n_points)
     part["s"] = s
     part["fracture"] = np.full(n_points, index, dtype=np.int32)
+    if faces is not None:
+        u_minus, u_plus = (
+            np.asarray(face, dtype=np.float64).reshape(n_points, 2) for face in faces
+        )
+        part["displacement"] = _pad_3d(0.5 * (u_minus + u_plus), "displacement")
+        part["displacement_jump"] = _pad_3d(u_plus - u_minus, "displacement_jump")
     return {name: value[order] for name, value in part.items()}
 
 
@@ -255,7 +279,8 @@ def _pad_3d(xy, name: str) -> np.ndarray:
 
 
 def _write_vtu(path: Path | str, mesh: meshio.Mesh) -> None:
-    """Write ``mesh`` as VTU (binary, zlib) through a temporary file."""
+    """Write ``mesh`` as VTU (binary, zlib) through a temporary file, with the
+    field data ``run_id`` and the component names of COMPONENT_NAMES."""
     refuse_non_finite(mesh.points, f"{path}: points")
     for name, value in mesh.point_data.items():
         refuse_non_finite(value, f"{path}: {name}")
@@ -264,34 +289,55 @@ def _write_vtu(path: Path | str, mesh: meshio.Mesh) -> None:
             refuse_non_finite(value, f"{path}: {name}")
     run_id = mesh.field_data.get("run_id")
     with atomic_path(Path(path)) as tmp:
-        if run_id is None:
-            meshio.write(tmp, mesh, file_format="vtu")
-            return
         raw = tmp.with_name(f"{tmp.name}.raw")
         try:
             meshio.write(raw, mesh, file_format="vtu")
-            _add_field_data(raw, tmp, int(run_id[0]))
+            _annotate(raw, tmp, None if run_id is None else int(run_id[0]))
         finally:
             raw.unlink(missing_ok=True)
 
 
-# meshio (5.3) does not write field data; VTK reads it as a child of the grid.
+# Names of the components of the multi-component arrays (VTK reads the
+# ComponentName<k> attributes of a DataArray; ParaView shows them in its
+# colouring and calculator menus instead of 0, 1, 2 or X, Y, Z).
+# stress_tensor follows VTK's symmetric tensor order.
+COMPONENT_NAMES = {
+    "stress_tensor": ("XX", "YY", "ZZ", "XY", "YZ", "XZ"),
+    "stress": ("XX", "YY", "XY"),
+    "effective_stress": ("XX", "YY", "XY"),
+    "principal_stress": ("max", "min"),
+}
+
+# meshio (5.3) writes neither field data nor component names; VTK reads the
+# field data as a child of the grid.
 _FIELD_DATA = (
     '\n<FieldData>\n<DataArray type="Int64" Name="run_id" NumberOfTuples="1" '
     'format="ascii">\n{}\n</DataArray>\n</FieldData>'
 )
 _GRID_TAG = b"<UnstructuredGrid>"
+_ARRAY_NAME = re.compile(rb'^<DataArray [^>]*Name="([^"]+)"')
 
 
-def _add_field_data(src: Path, dst: Path, run_id: int) -> None:
-    """Copy the VTU ``src`` to ``dst`` with the ``run_id`` field data array
-    inserted after the grid's opening tag (which meshio writes in its first
-    lines)."""
+def _annotate(src: Path, dst: Path, run_id: int | None) -> None:
+    """Copy the VTU ``src`` that meshio wrote to ``dst``, with the ``run_id``
+    field data array after the grid's opening tag and the component names of
+    COMPONENT_NAMES in the opening tags of their arrays.  meshio writes each
+    tag on a line of its own (and the binary data base64-encoded), so the
+    copy goes line by line."""
     with open(src, "rb") as fin, open(dst, "wb") as fout:
-        head = fin.read(4096)
-        at = head.index(_GRID_TAG) + len(_GRID_TAG)
-        fout.write(head[:at] + _FIELD_DATA.format(run_id).encode() + head[at:])
-        shutil.copyfileobj(fin, fout, 1 << 20)
+        for line in fin:
+            if run_id is not None and line.startswith(_GRID_TAG):
+                at = len(_GRID_TAG)
+                line = line[:at] + _FIELD_DATA.format(run_id).encode() + line[at:]
+                run_id = None
+            match = _ARRAY_NAME.match(line)
+            names = match and COMPONENT_NAMES.get(match[1].decode())
+            if names:
+                extra = "".join(
+                    f' ComponentName{k}="{name}"' for k, name in enumerate(names)
+                )
+                line = line.replace(b" format=", extra.encode() + b" format=", 1)
+            fout.write(line)
 
 
 _VTU_RUN_ID = re.compile(rb'Name="run_id" NumberOfTuples="1" format="ascii">\s*(\d+)')
