@@ -6,7 +6,9 @@ coloured by slip (not run in CI).
     xvfb-run -a pvpython docs/figures/paraview/screenshot.py out/plate \
         docs/figures/paraview/plate_von_mises.png 1
 
-Nothing but "Warp By Vector" between the files and the picture.
+(Where xvfb-run finds no display, start one: `Xvfb :77 &` and run pvpython
+with DISPLAY=:77.)  Nothing but "Warp By Vector" between the files and the
+picture.
 """
 
 import sys
