@@ -31,12 +31,13 @@ import numpy as np
 from matplotlib.collections import LineCollection, PolyCollection
 from matplotlib.colors import Normalize
 from matplotlib.figure import Figure
+from matplotlib.ticker import MaxNLocator
 from matplotlib.tri import Triangulation
 
 from xfemslip.conventions import SLIP
 from xfemslip.errors import UsageError
-from xfemslip.plot.data import ResultData, figure_data
-from xfemslip.plot.mohr import add_legend, draw_mohr, mohr_figsize
+from xfemslip.plot.data import ResultData, distinct_labels, figure_data
+from xfemslip.plot.mohr import NUMBERED_FROM, add_legend, draw_mohr, mohr_figsize
 
 logger = logging.getLogger(__name__)
 
@@ -71,6 +72,19 @@ def _frame(ax, data: ResultData, title: str, fractures: bool = True) -> None:
     ax.set_xlabel("x [m]")
     ax.set_ylabel("y [m]")
     ax.set_title(title, fontsize=9)
+
+
+def _case_title(fig, results: Sequence[ResultData]) -> None:
+    """The case name(s) above the panels, when the panels are labelled by
+    something else (a sweep's parameters, or --label)."""
+    names = list(dict.fromkeys(data.name for data in results if data.name))
+    if names and any(data.label != data.name for data in results):
+        fig.suptitle(", ".join(names), fontsize=10)
+
+
+def _row_colorbar(fig, mappable, axes_row, label: str) -> None:
+    """One colour bar for a row of panels that share a colour scale."""
+    fig.colorbar(mappable, ax=list(axes_row), label=label, shrink=0.85, aspect=25)
 
 
 def _triangulation(data: ResultData):
@@ -109,12 +123,23 @@ def figure_displacement(results: Sequence[ResultData]) -> Figure:
         values = [1e3 * u[:, comp] for _, u in fields]
         lo = min(float(v.min()) for v in values)
         hi = max(float(v.max()) for v in values)
-        levels = np.linspace(lo, hi, 21) if hi > lo else 20
+        levels = MaxNLocator(nbins=20).tick_values(lo, hi) if hi > lo else 20
         for j, data in enumerate(results):
             ax = axes[i, j]
             cs = ax.tricontourf(fields[j][0], values[j], levels=levels, cmap="viridis")
-            fig.colorbar(cs, ax=ax, label=f"$u_{'xy'[comp]}$ [mm]", shrink=0.8)
-            _frame(ax, data, f"{data.label}\n{word} displacement $u_{'xy'[comp]}$ [mm]")
+            # Filled contours are polygons side by side; anti-aliased, their
+            # shared edges let the white background through as specks, most
+            # along the fracture, where the split cells' triangles are
+            # small.  An outline in the polygon's own colour closes them.
+            cs.set_edgecolor("face")
+            cs.set_linewidth(0.35)
+            _frame(ax, data, f"{data.label}\n{word} displacement $u_{'xy'[comp]}$")
+        label = f"{word} displacement $u_{'xy'[comp]}$ [mm]"
+        if len(results) > 1:
+            _row_colorbar(fig, cs, axes[i, :], label)
+        else:
+            fig.colorbar(cs, ax=axes[i, 0], label=label, shrink=0.8)
+    _case_title(fig, results)
     return fig
 
 
@@ -142,8 +167,13 @@ def figure_principal(results: Sequence[ResultData]) -> Figure:
             ax.add_collection(coll)
             ax.margins(0.0)
             ax.autoscale_view()
-            fig.colorbar(coll, ax=ax, label="[MPa], tension positive", shrink=0.8)
             _frame(ax, data, f"{data.label}\n{title}")
+        label = f"{title.split(' [')[0]} [MPa], tension positive"
+        if len(results) > 1:
+            _row_colorbar(fig, coll, axes[i, :], label)
+        else:
+            fig.colorbar(coll, ax=axes[i, 0], label=label, shrink=0.8)
+    _case_title(fig, results)
     return fig
 
 
@@ -336,7 +366,12 @@ def _point_labels(results: Sequence[ResultData]) -> dict:
     for k, data in enumerate(results):
         for f in data.fractures:
             if len(results) == 1:
-                labels[k, f.index] = f"fracture {f.index}, $\\theta$ = {f.theta:g} deg"
+                # a network is numbered on the diagram, with a key
+                labels[k, f.index] = (
+                    str(f.index)
+                    if len(data.fractures) >= NUMBERED_FROM
+                    else f"fracture {f.index}, $\\theta$ = {f.theta:.1f} deg"
+                )
                 continue
             key = (data.stress_state, round(f.theta % 180.0, 9))
             if key in first:
@@ -383,10 +418,10 @@ def figure_mohr(results: Sequence[ResultData]) -> Figure:
         circles.add(data.stress_state)
         criteria |= keys
     source = results[0].stress_source
+    names = ", ".join(dict.fromkeys(data.name for data in results if data.name))
     ax.set_title(
-        f"Mohr-Coulomb diagram (far field: {source}; pore pressure "
-        f"{results[0].pore_pressure:g} Pa; "
-        "tension positive)",
+        f"{names}\nMohr-Coulomb diagram (far field: {source}; pore pressure "
+        f"{results[0].pore_pressure / 1e6:g} MPa; tension positive)",
         fontsize=9,
     )
     add_legend(fig)
@@ -459,7 +494,7 @@ def _screen_figure(stress, pore_pressure, friction, cohesion, fractures) -> Figu
     else:
         draw_mohr(ax, stress, pore_pressure, fractures=fractures)
     ax.set_title(
-        f"Mohr-Coulomb screening (pore pressure {pore_pressure:g} Pa; "
+        f"Mohr-Coulomb screening (pore pressure {pore_pressure / 1e6:g} MPa; "
         "tension positive)",
         fontsize=9,
     )
@@ -480,13 +515,17 @@ def plot_results(
     """Read the results and write the figures; returns the files written.
 
     ``kinds`` from KINDS, ``formats`` "png" / "pdf", ``labels`` one per result
-    (default: the folder name), ``scale`` the deformed mesh's magnification
-    (default :func:`auto_scale`), ``dpi`` of the PNG files."""
+    (default: the case's name, or a sweep case's parameters; runs of one case
+    in several folders are told apart by their folders), ``scale`` the
+    deformed mesh's magnification (default :func:`auto_scale`), ``dpi`` of
+    the PNG files."""
     if labels and len(labels) != len(paths):
         raise UsageError(f"got {len(labels)} labels for {len(paths)} results")
     results = [
         figure_data(p, labels[i] if labels else None) for i, p in enumerate(paths)
     ]
+    if not labels:
+        distinct_labels(results)
     makers = {
         "displacement": lambda: figure_displacement(results),
         "principal_stress": lambda: figure_principal(results),
