@@ -6,14 +6,13 @@ swapped in whole, :mod:`xfemslip.io.folder`); ``write_results`` writes a
 :class:`~xfemslip.post.result.Result` into its staging folder:
 
 - ``result.h5`` (:mod:`xfemslip.io.hdf5`), always;
-- ``result.xdmf`` (and ``result_steps.xdmf`` with more than one load step)
-  describing ``result.h5`` for ParaView (:mod:`xfemslip.io.xdmf`), once a step
-  converged;
-- with ``"vtu"`` in the case's ``output.formats`` and at least one converged
-  step: ``result.vtu`` and ``fractures.vtu`` of the final step and, with more
-  than one load step, ``steps/result_<kkkk>.vtu`` (and fractures) per step and
-  the series ``result.pvd`` (bulk) and ``fractures.pvd``
-  (:mod:`xfemslip.io.vtu`).
+- with ``"vtu"`` in the case's ``output.formats`` (the ParaView files) and
+  at least one converged step: ``result.xdmf`` (and ``result_steps.xdmf``
+  with more than one load step) describing ``result.h5``
+  (:mod:`xfemslip.io.xdmf`), ``result.vtu`` and ``fractures.vtu`` of the
+  final step and, with more than one load step, ``steps/result_<kkkk>.vtu``
+  (and fractures) per step and the series ``result.pvd`` (bulk) and
+  ``fractures.pvd`` (:mod:`xfemslip.io.vtu`).
 
 The time of the series is the load factor, or what ``step_time`` makes of it
 (``deplete``: the pore-pressure change reached).
@@ -80,8 +79,10 @@ def write_results(
         attrs=result.attrs,
         load_steps=result.load_steps,
     )
-    write_xdmf(folder, "result.h5", step_time=step_time)
     if "vtu" in formats and result.steps:
+        # the ParaView files: those of the split mesh, and the description
+        # of result.h5 that lets ParaView read it
+        write_xdmf(folder, "result.h5", step_time=step_time)
         _write_vtu(folder, result, vis_mesh, fracture_ids, step_time)
 
 

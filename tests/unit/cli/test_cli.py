@@ -342,8 +342,7 @@ def test_overwrite_leaves_no_file_of_the_earlier_run(tmp_path):
         cli, ["run", "-q", "--overwrite", str(case), "-o", str(out)]
     )
     assert second.exit_code == 0, second.output
-    # result.xdmf describes result.h5; result_steps.xdmf of the 5 steps is gone
-    assert sorted(p.name for p in out.iterdir()) == ["result.h5", "result.xdmf"]
+    assert sorted(p.name for p in out.iterdir()) == ["result.h5"]
 
 
 # ------------------------------------------------------------------- environment
