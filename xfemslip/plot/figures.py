@@ -148,8 +148,8 @@ def figure_principal(results: Sequence[ResultData]) -> Figure:
     shares one colour scale across the results."""
     fig, axes = _grid(2, len(results))
     rows = (
-        (1, r"$\sigma_{min}$ (most compressive) [MPa]"),
-        (0, r"$\sigma_{max}$ (least compressive) [MPa]"),
+        (1, r"$\sigma_{min}$ (most compressive)"),
+        (0, r"$\sigma_{max}$ (least compressive)"),
     )
     for i, (col, title) in enumerate(rows):
         values = [1e-6 * data.principal[:, col] for data in results]
@@ -168,7 +168,7 @@ def figure_principal(results: Sequence[ResultData]) -> Figure:
             ax.margins(0.0)
             ax.autoscale_view()
             _frame(ax, data, f"{data.label}\n{title}")
-        label = f"{title.split(' [')[0]} [MPa], tension positive"
+        label = f"{title} [MPa], tension positive"
         if len(results) > 1:
             _row_colorbar(fig, coll, axes[i, :], label)
         else:
