@@ -246,32 +246,36 @@ def fracture_faces(model, u) -> list[tuple[np.ndarray, np.ndarray]]:
         eps = JUMP_PROBE * mesh.h_min
         tol = GEOMETRY_TOL * mesh.h_min
         probes = (ip.xy + eps * ip.normal, ip.xy - eps * ip.normal)
-        rows_all = np.arange(n_points)
-        for s in range(n_slots):
-            k = ec.slot_cand[pos, s]
-            a = ec.slot_node[pos, s]
-            d = model.bulk.enr_dofs[pos, 8 + 2 * s]
-            live = (k >= 0) & (a >= 0) & (d >= 0)
-            if not live.any():
-                continue
-            rows = rows_all[live]
-            kk, dd = k[live], d[live]
-            weight = N[rows, a[live]]
-            amp = np.column_stack([u[dd], u[dd + 1]])
-            column = np.where(cand.func[kk] == HEAVISIDE, 0, cand.func[kk] - 1)
-            group = cand.fracture[kk] * 100003 + cand.tip[kk] + 50000
-            for g in np.unique(group):
-                fi, tip = divmod(int(g), 100003)
-                tip -= 50000
-                sel = group == g
-                r, fr = rows[sel], fractures[fi]
-                for side, probe in zip(sides, probes, strict=True):
-                    values = group_values(
-                        fractures, fi, tip, ip.xy[r], fr.side(probe[r]), tol, probe[r]
-                    )[0]
-                    F = values[np.arange(r.size), column[sel]]
-                    shift = F - ec.slot_fnode[pos[r], s]
-                    side[r] += (weight[sel] * shift)[:, None] * amp[sel]
+        K = ec.slot_cand[pos]  # (n, S) candidate of each slot of the point's cell
+        node = ec.slot_node[pos]
+        dof = model.bulk.enr_dofs[pos, 8::2][:, :n_slots]
+        live = (K >= 0) & (node >= 0) & (dof >= 0)
+        Kc = np.maximum(K, 0)
+        group = np.where(live, cand.fracture[Kc] * 100003 + cand.tip[Kc] + 50000, -1)
+        # one evaluation of a (fracture, tip) group's functions per side, for
+        # every slot of every point it enriches
+        for g in np.unique(group[live]):
+            fi, tip = divmod(int(g), 100003)
+            tip -= 50000
+            rows, cols = np.nonzero(group == g)
+            k, d = Kc[rows, cols], dof[rows, cols]
+            weight = N[rows, node[rows, cols]]
+            amp = np.column_stack([u[d], u[d + 1]])
+            column = np.where(cand.func[k] == HEAVISIDE, 0, cand.func[k] - 1)
+            shift_node = ec.slot_fnode[pos[rows], cols]
+            fr = fractures[fi]
+            for side, probe in zip(sides, probes, strict=True):
+                values = group_values(
+                    fractures,
+                    fi,
+                    tip,
+                    ip.xy[rows],
+                    fr.side(probe[rows]),
+                    tol,
+                    probe[rows],
+                )[0]
+                F = values[np.arange(rows.size), column]
+                np.add.at(side, rows, ((F - shift_node) * weight)[:, None] * amp)
     out = []
     for fi in range(len(fractures)):
         m = np.nonzero(ip.fracture == fi)[0]
