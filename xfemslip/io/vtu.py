@@ -1,12 +1,20 @@
-"""ParaView output via meshio: ``result.vtu``, ``fractures.vtu``, ``result.pvd``.
+"""ParaView output via meshio: ``result.vtu``, ``fractures.vtu`` and the PVD
+series ``result.pvd`` / ``fractures.pvd``.
 
 - ``write_bulk``: the bulk mesh with cut elements split along the fractures
   (:class:`~xfemslip.post.fields.VisMesh`), so that "Warp By Vector" on the point
   field ``displacement`` shows the jump.  Points and displacement are padded to
   3D with z = 0, as ParaView expects.
 - ``write_fractures``: every fracture as a polyline through its contact
-  integration points, with the contact fields as point data.
+  integration points, with the contact fields as point data and, given the
+  faces' displacements, their mean ``displacement`` (so the fracture warps
+  with the bulk) and their ``displacement_jump``.
 - ``write_pvd``: a ParaView collection (time series over load steps).
+
+The arrays of a file are one dict (point data per fracture point in
+``_fracture_part``, cell data per bulk cell in ``write_bulk``'s
+``cell_data``): an array is added there.  Multi-component arrays get the
+component names of COMPONENT_NAMES.
 
 Every file is written atomically (:mod:`xfemslip.io.atomic`).  meshio is
 given ``file_format="vtu"`` explicitly because the temporary name has another
