@@ -40,7 +40,7 @@ from xfemslip.geometry.junctions import build_fractures
 from xfemslip.io.results import run_folder, write_results
 from xfemslip.memory import check_memory, enriched_footprint, model_footprint
 from xfemslip.post.events import event_inputs, event_table
-from xfemslip.post.fields import first_non_finite, step_fields, vis_mesh
+from xfemslip.post.fields import first_non_finite, step_fields, vis_mesh_with_faces
 from xfemslip.post.hydraulics import add_permeability
 from xfemslip.post.result import Result, run_id
 from xfemslip.solve.newton import NewtonSolver, Problem
@@ -306,7 +306,9 @@ class Written:
     result: Result  # the fields of the results (those written)
 
 
-def solve_and_write(spec, out_dir, overwrite, drive, finish=None) -> Written:
+def solve_and_write(
+    spec, out_dir, overwrite, drive, finish=None, step_time=None
+) -> Written:
     """The frame of every command that solves a case: take the output folder
     (:func:`xfemslip.io.results.run_folder`: locked, refused when it holds
     results and not ``overwrite``; ``out_dir`` None: no folder, nothing
@@ -314,7 +316,8 @@ def solve_and_write(spec, out_dir, overwrite, drive, finish=None) -> Written:
     model)``, and write the converged steps (also after a ConvergenceError,
     which is returned, not raised, with converged = False in result.h5).
     ``finish(written, folder)`` may add files of its own to the set in
-    ``folder``; the set replaces the folder's content whole."""
+    ``folder``; the set replaces the folder's content whole.  ``step_time``
+    maps a load factor to the time of the ParaView series (default: itself)."""
     start = time.perf_counter()
     folder = (
         run_folder(out_dir, overwrite)
@@ -345,10 +348,9 @@ def solve_and_write(spec, out_dir, overwrite, drive, finish=None) -> Written:
                 stage.path,
                 result,
                 formats=spec.output.formats,
-                vis_mesh=lambda i: vis_mesh(
-                    model.mesh, model.ec, model.bulk, results[i].u
-                ),
+                vis_mesh=lambda i: vis_mesh_with_faces(model, results[i].u),
                 fracture_ids=[fr.index for fr in model.fractures],
+                step_time=step_time,
             )
             result.out_dir = Path(out_dir)
             done = Written(result.out_dir, model, results, value, failure, result)

@@ -445,6 +445,10 @@ def test_sweep_reruns_a_member_whose_set_is_not_whole(tmp_path):
     assert [r.status for r in rows] == ["ok", "skipped"]
     assert (member / "result.vtu").is_file()
     assert (member / "case.toml").is_file()  # carried into the new set
+    # a step file that only the fractures' series names counts as well
+    assert is_done(member, sweep.cases[0].text, sweep.cases[0].spec)
+    (member / "steps" / "fractures_0002.vtu").unlink()
+    assert not is_done(member, sweep.cases[0].text, sweep.cases[0].spec)
     assert harness.leftovers(member) == []
     assert sorted(p.name for p in tmp_path.glob(".*")) == []
 

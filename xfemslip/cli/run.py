@@ -100,8 +100,9 @@ def info() -> None:
         (name, _dist_version(name))
         for name in (
             *("numpy", "scipy", "numba", "h5py", "meshio", "click", "tomli-w"),
-            # optional: AMG, figures, Dask sweeps, MKL PARDISO (the mkl extra)
-            *("pyamg", "matplotlib", "dask", "distributed", "pypardiso"),
+            # optional: AMG, figures, Dask sweeps, MKL PARDISO (the mkl extra),
+            # VTK (the tests read the ParaView files with it)
+            *("pyamg", "matplotlib", "dask", "distributed", "pypardiso", "vtk"),
         )
     ]
     rows += numba_settings()

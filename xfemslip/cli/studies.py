@@ -174,7 +174,16 @@ def _default_figure_dir(results: list[Path]) -> Path:
 
 
 @click.command()
-@click.argument("results", nargs=-1, required=True, type=PathParam(path_type=Path))
+@click.argument("results", nargs=-1, required=False, type=PathParam(path_type=Path))
+@click.option(
+    "--case",
+    "case",
+    type=PathParam(path_type=Path, dir_okay=False),
+    default=None,
+    help="Draw this case file before it runs: geometry, mesh, fractures, "
+    "boundary conditions and loads, as <case file name>.png/.pdf [default "
+    "folder: the case file's].",
+)
 @click.option(
     "-o",
     "--output",
@@ -220,10 +229,24 @@ def _default_figure_dir(results: list[Path]) -> Path:
     help="Resolution of the PNG files.",
 )
 @debug_option
-def plot(results, output, kinds, formats, labels, scale, dpi, debug) -> None:
+def plot(results, case, output, kinds, formats, labels, scale, dpi, debug) -> None:
     """Draw the paper's figures of one or several RESULTS (result.h5 files or
-    their folders); several results are drawn side by side or overlaid."""
+    their folders); several results are drawn side by side or overlaid.
+    With --case, draw a case file before it runs (the paper's Fig. 5)."""
     with reported_errors(debug):
+        if case is not None:
+            spec = load_case_file(case)
+            from xfemslip.plot.case import plot_case
+
+            out_dir = output or Path(case).parent
+            for path in plot_case(spec, out_dir, formats or ("png", "pdf"), dpi):
+                click.echo(str(path))
+            if not results:
+                return
+        elif not results:
+            raise UsageError(
+                "plot needs RESULTS (result.h5 files or folders) or --case"
+            )
         from xfemslip.plot.figures import plot_results
 
         out_dir = output or _default_figure_dir(list(results))

@@ -1,9 +1,11 @@
 """Files in and out: the output set of a run, its folder, and the one reader.
 
 - ``results``: the output set of a run (``result.h5``, ``result.vtu``,
-  ``fractures.vtu``, ``result.pvd``) written into its folder;
+  ``fractures.vtu``, ``result.pvd``, ``fractures.pvd``, ``result.xdmf``)
+  written into its folder;
 - ``read``: ``read_result`` / ``read_attrs``, the one reader of ``result.h5``;
-- ``hdf5``, ``vtu``: the two formats (``output-format.md``);
+- ``hdf5``, ``vtu``, ``xdmf``: the formats (``output-format.md``; the XDMF
+  files describe ``result.h5`` for ParaView);
 - ``folder``, ``lock``, ``fileset``: output folders and sets of files that
   appear whole or not at all (locked, staged, swapped);
 - ``atomic``: single files written under a temporary name and renamed;

@@ -6,10 +6,16 @@ swapped in whole, :mod:`xfemslip.io.folder`); ``write_results`` writes a
 :class:`~xfemslip.post.result.Result` into its staging folder:
 
 - ``result.h5`` (:mod:`xfemslip.io.hdf5`), always;
-- with ``"vtu"`` in the case's ``output.formats`` and at least one converged
-  step: ``result.vtu`` and ``fractures.vtu`` of the final step and, with more
-  than one load step, ``steps/result_<kkkk>.vtu`` (and fractures) per step and
-  the series ``result.pvd`` (:mod:`xfemslip.io.vtu`).
+- with ``"vtu"`` in the case's ``output.formats`` (the ParaView files) and
+  at least one converged step: ``result.xdmf`` (and ``result_steps.xdmf``
+  with more than one load step) describing ``result.h5``
+  (:mod:`xfemslip.io.xdmf`), ``result.vtu`` and ``fractures.vtu`` of the
+  final step and, with more than one load step, ``steps/result_<kkkk>.vtu``
+  (and fractures) per step and the series ``result.pvd`` (bulk) and
+  ``fractures.pvd`` (:mod:`xfemslip.io.vtu`).
+
+The time of the series is the load factor, or what ``step_time`` makes of it
+(``deplete``: the pore-pressure change reached).
 
 Every file carries the set's ``run_id``.
 """
@@ -29,7 +35,15 @@ __all__ = ["OUTPUT_FILES", "run_folder", "write_results"]
 
 # The files a run writes into its folder (an earlier set of them is refused
 # without --overwrite).
-OUTPUT_FILES = ("result.h5", "result.vtu", "fractures.vtu", "result.pvd")
+OUTPUT_FILES = (
+    "result.h5",
+    "result.vtu",
+    "fractures.vtu",
+    "result.pvd",
+    "fractures.pvd",
+    "result.xdmf",
+    "result_steps.xdmf",
+)
 
 
 def run_folder(out_dir: Path | str, overwrite: bool):
@@ -44,14 +58,19 @@ def write_results(
     formats: Sequence[str],
     vis_mesh: Callable[[int], VisMesh],
     fracture_ids: Sequence[int],
+    step_time: Callable[[float], float] | None = None,
 ) -> None:
     """Write the output set of ``result`` into ``folder``.
 
     formats : the case's ``output.formats`` ("h5" always, "vtu" optional);
     vis_mesh : the split visualisation mesh of step ``i`` (0-based index into
         ``result.steps``), built only when a VTU file is written;
-    fracture_ids : the case-file index of each fracture of the steps.
+    fracture_ids : the case-file index of each fracture of the steps;
+    step_time : the time of a step in the PVD and XDMF series, from its load
+        factor (default: the load factor itself).
     """
+    from xfemslip.io.xdmf import write_xdmf
+
     hdf5.write_result(
         folder / "result.h5",
         points=result.points,
@@ -63,10 +82,13 @@ def write_results(
         permeability=result.permeability,
     )
     if "vtu" in formats and result.steps:
-        _write_vtu(folder, result, vis_mesh, fracture_ids)
+        # the ParaView files: those of the split mesh, and the description
+        # of result.h5 that lets ParaView read it
+        write_xdmf(folder, "result.h5", step_time=step_time)
+        _write_vtu(folder, result, vis_mesh, fracture_ids, step_time)
 
 
-def _write_vtu(folder, result, vis_mesh, fracture_ids) -> None:
+def _write_vtu(folder, result, vis_mesh, fracture_ids, step_time) -> None:
     """The VTU (and PVD) files of the converged steps, stamped with run_id."""
     # here, not at the top: meshio costs 0.3 s of imports that a run writing
     # result.h5 alone does not pay
@@ -74,7 +96,7 @@ def _write_vtu(folder, result, vis_mesh, fracture_ids) -> None:
 
     series = result.load_steps > 1
     set_id = result.run_id
-    entries = []
+    entries, fracture_entries = [], []
     last = len(result.steps) - 1
     for i, f in enumerate(result.steps):
         interrupt.checkpoint()  # between files: a deferred signal stops here
@@ -92,13 +114,19 @@ def _write_vtu(folder, result, vis_mesh, fracture_ids) -> None:
         if series:
             (folder / "steps").mkdir(exist_ok=True)
             names.append(f"steps/%s_{f.step:04d}.vtu")
-            entries.append((f.load_factor, f"steps/result_{f.step:04d}.vtu"))
+            time = f.load_factor if step_time is None else step_time(f.load_factor)
+            entries.append((time, f"steps/result_{f.step:04d}.vtu"))
         if i == last:
             names.append("%s.vtu")
         vis = vis_mesh(i)
         for name in names:
             vtu.write_bulk(folder / (name % "result"), vis, cell_data, run_id=set_id)
-            if fr:
-                vtu.write_fractures(folder / (name % "fractures"), fr, run_id=set_id)
+            written = fr and vtu.write_fractures(
+                folder / (name % "fractures"), fr, faces=vis.faces, run_id=set_id
+            )
+            if written and name.startswith("steps/"):
+                fracture_entries.append((time, name % "fractures"))
     if series:
         vtu.write_pvd(folder / "result.pvd", entries, run_id=set_id)
+        if fracture_entries:
+            vtu.write_pvd(folder / "fractures.pvd", fracture_entries, run_id=set_id)

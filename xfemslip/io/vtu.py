@@ -1,12 +1,20 @@
-"""ParaView output: ``result.vtu``, ``fractures.vtu``, ``result.pvd``.
+"""ParaView output: ``result.vtu``, ``fractures.vtu`` and the PVD series
+``result.pvd`` / ``fractures.pvd``.
 
 - ``write_bulk``: the bulk mesh with cut elements split along the fractures
   (:class:`~xfemslip.post.fields.VisMesh`), so that "Warp By Vector" on the point
   field ``displacement`` shows the jump.  Points and displacement are padded to
   3D with z = 0, as ParaView expects.
 - ``write_fractures``: every fracture as a polyline through its contact
-  integration points, with the contact fields as point data.
+  integration points, with the contact fields as point data and, given the
+  faces' displacements, their mean ``displacement`` (so the fracture warps
+  with the bulk) and their ``displacement_jump``.
 - ``write_pvd``: a ParaView collection (time series over load steps).
+
+The arrays of a file are one dict (point data per fracture point in
+``_fracture_part``, cell data per bulk cell in ``write_bulk``'s
+``cell_data``): an array is added there.  Multi-component arrays get the
+component names of COMPONENT_NAMES.
 
 Every file is written atomically (:mod:`xfemslip.io.atomic`); the VTU files
 by :mod:`xfemslip.io.vtkxml` (meshio's ``Mesh`` only holds the data).  Given a
@@ -111,6 +119,7 @@ def write_fractures(
     path: Path | str,
     fractures: Sequence[tuple[int, FractureFields]],
     *,
+    faces: Sequence[tuple[np.ndarray, np.ndarray]] | None = None,
     run_id: int | None = None,
 ) -> bool:
     """Write the fractures as polylines with their contact fields (``fractures.vtu``).
@@ -123,14 +132,22 @@ def write_fractures(
         ``index`` is the fracture's position in the case file.  Each fracture's
         K points, sorted by ``s``, are joined by "line" cells; a fracture with a
         single point becomes a "vertex" cell, one with none is left out.
+    faces : list of (u_minus, u_plus), optional
+        Per fracture (same order), the displacement of its - and + faces at
+        its K points, each (K, 2) [m] sorted by ``s``
+        (:func:`xfemslip.post.fields.fracture_faces`).  Given, the point data
+        gets ``displacement`` = (u_minus + u_plus) / 2, so that "Warp By
+        Vector" moves the fracture with the body, and ``displacement_jump`` =
+        u_plus - u_minus ([[u]]), both 3 components with z = 0.
     run_id : int, optional
         The output set's id (field data ``run_id``, as in :func:`write_bulk`).
 
     Point data: ``slip``, ``opening`` [m], ``normal_traction``,
     ``shear_traction``, ``contact_pressure`` = max(0, -normal_traction) [Pa],
     ``state`` (int32: 0 open, 1 stick, 2 slip), ``s`` [m] and ``fracture``
-    (the index); with ``[permeability]`` also ``aperture`` [m] and
-    ``transmissivity`` [m^3].  Points are 3D with z = 0.
+    (the index), with ``faces`` the two displacements above, and with
+    ``[permeability]`` also ``aperture`` [m] and ``transmissivity`` [m^3].
+    Points are 3D with z = 0.
 
     Returns
     -------
@@ -144,7 +161,14 @@ def write_fractures(
     OutputError
         The file cannot be written.
     """
-    parts = [_fracture_part(index, fields) for index, fields in fractures]
+    if faces is not None and len(faces) != len(fractures):
+        raise ValueError(
+            f"write_fractures: {len(faces)} face pairs for {len(fractures)} fractures"
+        )
+    parts = [
+        _fracture_part(index, fields, None if faces is None else faces[k])
+        for k, (index, fields) in enumerate(fractures)
+    ]
     parts = [part for part in parts if part["points"].shape[0] > 0]
     if not parts:
         logger.debug("%s: no fracture points, file not written", path)
@@ -230,8 +254,11 @@ def _field_data(run_id: int | None) -> dict[str, np.ndarray]:
     return {"run_id": np.array([run_id], dtype=np.int64)}
 
 
-def _fracture_part(index: int, fields: FractureFields) -> dict[str, np.ndarray]:
-    """Point arrays of one fracture, sorted by arc length s."""
+def _fracture_part(
+    index: int, fields: FractureFields, faces=None
+) -> dict[str, np.ndarray]:
+    """Point arrays of one fracture, sorted by arc length s (``faces``: its
+    (u_minus, u_plus) at the same points, or None)."""
     s = np.asarray(fields.s, dtype=np.float64).reshape(-1)
     order = np.argsort(s, kind="stable")
     n_points = s.shape[0]
@@ -249,6 +276,12 @@ def _fracture_part(index: int, fields: FractureFields) -> dict[str, np.ndarray]:
         value = getattr(fields, name, None)
         if value is not None:
             part[name] = np.asarray(value, dtype=np.float64).reshape(n_points)
+    if faces is not None:
+        u_minus, u_plus = (
+            np.asarray(face, dtype=np.float64).reshape(n_points, 2) for face in faces
+        )
+        part["displacement"] = _pad_3d(0.5 * (u_minus + u_plus), "displacement")
+        part["displacement_jump"] = _pad_3d(u_plus - u_minus, "displacement_jump")
     return {name: value[order] for name, value in part.items()}
 
 
@@ -261,7 +294,8 @@ def _pad_3d(xy, name: str) -> np.ndarray:
 
 
 def _write_vtu(path: Path | str, mesh: meshio.Mesh) -> None:
-    """Write ``mesh`` as VTU (binary, zlib) through a temporary file."""
+    """Write ``mesh`` as VTU (binary, zlib) through a temporary file, with the
+    field data ``run_id`` and the component names of COMPONENT_NAMES."""
     refuse_non_finite(mesh.points, f"{path}: points")
     for name, value in mesh.point_data.items():
         refuse_non_finite(value, f"{path}: {name}")
@@ -277,7 +311,20 @@ def _write_vtu(path: Path | str, mesh: meshio.Mesh) -> None:
             mesh.point_data,
             mesh.cell_data,
             None if run_id is None else {"run_id": int(run_id[0])},
+            COMPONENT_NAMES,
         )
+
+
+# Names of the components of the multi-component arrays (VTK reads the
+# ComponentName<k> attributes of a DataArray; ParaView shows them in its
+# colouring and calculator menus instead of 0, 1, 2 or X, Y, Z).
+# stress_tensor follows VTK's symmetric tensor order.
+COMPONENT_NAMES = {
+    "stress_tensor": ("XX", "YY", "ZZ", "XY", "YZ", "XZ"),
+    "stress": ("XX", "YY", "XY"),
+    "effective_stress": ("XX", "YY", "XY"),
+    "principal_stress": ("max", "min"),
+}
 
 
 _VTU_RUN_ID = re.compile(rb'Name="run_id" NumberOfTuples="1" format="ascii">\s*(\d+)')

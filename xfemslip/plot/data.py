@@ -47,7 +47,7 @@ class ResultData:
     """A run's result, enough for every figure."""
 
     path: Path
-    label: str
+    label: str  # the panel title: the case name, or a sweep case's parameters
     converged: bool
     points: np.ndarray  # (N, 2) [m]
     cells: np.ndarray  # (M, 4)
@@ -64,14 +64,72 @@ class ResultData:
     vis_displacement: np.ndarray | None = None  # (P, 2)
     vis_triangles: np.ndarray | None = None  # (T, 3): quads split in two + cut
     vis_edges: np.ndarray | None = None  # (E, 2) point pairs: the element outlines
+    name: str = ""  # the case's name (a sweep case: its base case's name)
 
 
-def default_label(path: Path, case: dict) -> str:
-    """The result's folder name without a sweep index (``002_angle=45`` ->
-    ``angle=45``), or the case name for a folder called like a file."""
+# Display of the keys a sweep varies, by the last name of the key path (the
+# name in a sweep case's id, ``002_angle=45``): (name shown, factor, unit).
+PARAMETER_UNITS = {
+    "E": ("E", 1e-9, "GPa"),
+    "nu": ("\u03bd", 1.0, ""),
+    "angle": ("angle", 1.0, "deg"),
+    "friction": ("f", 1.0, ""),
+    "cohesion": ("c", 1e-6, "MPa"),
+    "kn": ("$k_N$", 1.0, "Pa/m"),
+    "kt": ("$k_T$", 1.0, "Pa/m"),
+    "length": ("length", 1.0, "m"),
+    "change": ("$\\Delta p$", 1e-6, "MPa"),
+    "initial": ("$p_0$", 1e-6, "MPa"),
+    "xx": ("$\\sigma_{xx}$", 1e-6, "MPa"),
+    "yy": ("$\\sigma_{yy}$", 1e-6, "MPa"),
+    "xy": ("$\\sigma_{xy}$", 1e-6, "MPa"),
+    "elements": ("elements", 1.0, ""),
+}
+_SWEEP_ID = re.compile(r"^\d+_(.+)$")
+_PARAMETER = re.compile(r"([A-Za-z][A-Za-z0-9]*)=([^_]+)")
+
+
+def parameter_label(text: str) -> str:
+    """``E=5e9_friction=0.3`` (a sweep case id without its index) as
+    ``E = 5 GPa, f = 0.3``: known keys in their engineering unit, others as
+    written."""
+    parts = []
+    for key, value in _PARAMETER.findall(text):
+        shown, factor, unit = PARAMETER_UNITS.get(key, (key, 1.0, ""))
+        try:
+            number = f"{float(value) * factor:.4g}"
+        except ValueError:
+            number = value
+        parts.append(f"{shown} = {number} {unit}".rstrip())
+    return ", ".join(parts) or text
+
+
+def default_label(path: Path, case: dict) -> tuple[str, str]:
+    """(label, name) of a result: a sweep case (its folder ``002_angle=45``,
+    its name ``<base name>-002_angle=45``) is labelled by its parameters with
+    units (``angle = 45 deg``) and named by its base case; any other result
+    by the case's ``name`` (else its folder's)."""
     folder = path.resolve().parent.name
-    label = re.sub(r"^\d+_", "", folder)
-    return label or str(case.get("name", path.stem))
+    name = str(case.get("name") or folder or path.stem)
+    match = _SWEEP_ID.match(folder)
+    if match and name.endswith(f"-{folder}"):
+        return parameter_label(match[1]), name[: -len(folder) - 1]
+    return name, name
+
+
+def distinct_labels(results: list[ResultData]) -> None:
+    """Make the labels of results that share one (runs of one case in
+    several folders) tell them apart by their folder: ``tiny (angle = 45
+    deg)`` for a folder named like a sweep case, else ``tiny (run-b)``."""
+    count: dict[str, int] = {}
+    for data in results:
+        count[data.label] = count.get(data.label, 0) + 1
+    for data in results:
+        if count[data.label] > 1:
+            folder = data.path.resolve().parent.name
+            match = _SWEEP_ID.match(folder)
+            where = parameter_label(match[1]) if match else folder
+            data.label = f"{data.label} ({where})"
 
 
 def _chord_angle(table: dict) -> float:
@@ -266,9 +324,11 @@ def figure_data(path: str | Path, label: str | None = None) -> ResultData:
     d2 = points[cells[:, 3]] - points[cells[:, 1]]
     area = 0.5 * np.abs(d1[:, 0] * d2[:, 1] - d1[:, 1] * d2[:, 0])
     state, source = _stress_state(case, result.stress, area)
+    default, name = default_label(path, case)
     data = ResultData(
         path=path,
-        label=label or default_label(path, case),
+        label=label or default,
+        name=name,
         converged=result.converged,
         points=points,
         cells=cells,

@@ -34,12 +34,13 @@ import numpy as np
 from matplotlib.collections import LineCollection, PolyCollection
 from matplotlib.colors import Normalize
 from matplotlib.figure import Figure
+from matplotlib.ticker import MaxNLocator
 from matplotlib.tri import Triangulation
 
 from xfemslip.conventions import SLIP
 from xfemslip.errors import UsageError
-from xfemslip.plot.data import ResultData, figure_data
-from xfemslip.plot.mohr import add_legend, draw_mohr, mohr_figsize
+from xfemslip.plot.data import ResultData, distinct_labels, figure_data
+from xfemslip.plot.mohr import NUMBERED_FROM, add_legend, draw_mohr, mohr_figsize
 from xfemslip.plot.permeability import figure_permeability
 
 logger = logging.getLogger(__name__)
@@ -75,6 +76,19 @@ def _frame(ax, data: ResultData, title: str, fractures: bool = True) -> None:
     ax.set_xlabel("x [m]")
     ax.set_ylabel("y [m]")
     ax.set_title(title, fontsize=9)
+
+
+def _case_title(fig, results: Sequence[ResultData]) -> None:
+    """The case name(s) above the panels, when the panels are labelled by
+    something else (a sweep's parameters, or --label)."""
+    names = list(dict.fromkeys(data.name for data in results if data.name))
+    if names and any(data.label != data.name for data in results):
+        fig.suptitle(", ".join(names), fontsize=10)
+
+
+def _row_colorbar(fig, mappable, axes_row, label: str) -> None:
+    """One colour bar for a row of panels that share a colour scale."""
+    fig.colorbar(mappable, ax=list(axes_row), label=label, shrink=0.85, aspect=25)
 
 
 def _triangulation(data: ResultData):
@@ -113,12 +127,23 @@ def figure_displacement(results: Sequence[ResultData]) -> Figure:
         values = [1e3 * u[:, comp] for _, u in fields]
         lo = min(float(v.min()) for v in values)
         hi = max(float(v.max()) for v in values)
-        levels = np.linspace(lo, hi, 21) if hi > lo else 20
+        levels = MaxNLocator(nbins=20).tick_values(lo, hi) if hi > lo else 20
         for j, data in enumerate(results):
             ax = axes[i, j]
             cs = ax.tricontourf(fields[j][0], values[j], levels=levels, cmap="viridis")
-            fig.colorbar(cs, ax=ax, label=f"$u_{'xy'[comp]}$ [mm]", shrink=0.8)
-            _frame(ax, data, f"{data.label}\n{word} displacement $u_{'xy'[comp]}$ [mm]")
+            # Filled contours are polygons side by side; anti-aliased, their
+            # shared edges let the white background through as specks, most
+            # along the fracture, where the split cells' triangles are
+            # small.  An outline in the polygon's own colour closes them.
+            cs.set_edgecolor("face")
+            cs.set_linewidth(0.35)
+            _frame(ax, data, f"{data.label}\n{word} displacement $u_{'xy'[comp]}$")
+        label = f"{word} displacement $u_{'xy'[comp]}$ [mm]"
+        if len(results) > 1:
+            _row_colorbar(fig, cs, axes[i, :], label)
+        else:
+            fig.colorbar(cs, ax=axes[i, 0], label=label, shrink=0.8)
+    _case_title(fig, results)
     return fig
 
 
@@ -127,8 +152,8 @@ def figure_principal(results: Sequence[ResultData]) -> Figure:
     shares one colour scale across the results."""
     fig, axes = _grid(2, len(results))
     rows = (
-        (1, r"$\sigma_{min}$ (most compressive) [MPa]"),
-        (0, r"$\sigma_{max}$ (least compressive) [MPa]"),
+        (1, r"$\sigma_{min}$ (most compressive)"),
+        (0, r"$\sigma_{max}$ (least compressive)"),
     )
     for i, (col, title) in enumerate(rows):
         values = [1e-6 * data.principal[:, col] for data in results]
@@ -146,8 +171,13 @@ def figure_principal(results: Sequence[ResultData]) -> Figure:
             ax.add_collection(coll)
             ax.margins(0.0)
             ax.autoscale_view()
-            fig.colorbar(coll, ax=ax, label="[MPa], tension positive", shrink=0.8)
             _frame(ax, data, f"{data.label}\n{title}")
+        label = f"{title} [MPa], tension positive"
+        if len(results) > 1:
+            _row_colorbar(fig, coll, axes[i, :], label)
+        else:
+            fig.colorbar(coll, ax=axes[i, 0], label=label, shrink=0.8)
+    _case_title(fig, results)
     return fig
 
 
@@ -229,11 +259,13 @@ def figure_slip(results: Sequence[ResultData]) -> Figure:
     colours = _distinct_colours(many)
     for k, data in enumerate(results):
         for fr in data.fractures:
-            label = (
-                data.label
-                if len(data.fractures) == 1
-                else (f"{data.label}, fracture {fr.index}")
-            )
+            # the title names the case: one result's fractures by number
+            if len(data.fractures) == 1:
+                label = data.label
+            elif len(results) == 1:
+                label = f"fracture {fr.index}"
+            else:
+                label = f"{data.label}, fracture {fr.index}"
             s = fr.s - fr.s.min() if fr.s.size else fr.s
             # one result with several fractures (a network): one colour each
             colour = colours[(k if len(results) > 1 else fr.index) % len(colours)]
@@ -243,9 +275,16 @@ def figure_slip(results: Sequence[ResultData]) -> Figure:
             ax.plot(s[in_slip], mm[in_slip], ".", ms=3, color=line.get_color())
     ax.set_xlabel("distance from the first tip along the fracture x_0 [m]")
     ax.set_ylabel("slip |[[u]] . t| [mm]")
-    ax.set_title("Slip along the fracture (dots: points in slip)", fontsize=10)
+    names = ", ".join(dict.fromkeys(data.name for data in results if data.name))
+    ax.set_title(
+        f"{names}\nslip along the fracture (dots: points in slip)", fontsize=10
+    )
     ax.grid(alpha=0.3)
-    ax.legend(fontsize=8)
+    entries = sum(len(data.fractures) for data in results)
+    if entries > 6:  # beside the axes, not over the curves
+        ax.legend(fontsize=7, loc="upper left", bbox_to_anchor=(1.01, 1.0))
+    else:
+        ax.legend(fontsize=8)
     return fig
 
 
@@ -262,60 +301,68 @@ def _distinct_colours(n: int) -> list:
 STATE_COLOURS = {0: "0.6", 1: "tab:blue", 2: "tab:red"}  # open, stick, slip
 
 
-def _fracture_segments(fr) -> np.ndarray:
-    """(K-1, 2, 2) segments between consecutive contact points of a fracture,
-    broken where the fracture's polyline is (a gap of more than 3 spacings)."""
-    p = fr.points
+def fracture_pieces(fr) -> tuple[np.ndarray, np.ndarray]:
+    """Segments (S, 2, 2) covering a fracture's line point by point, and the
+    contact point (S,) each one belongs to: point k owns the line from the
+    midpoint towards its previous point to the midpoint towards its next, so
+    consecutive pieces meet end to end (no gap shows the background) and a
+    point's colour covers its share of the line.  The line is broken where
+    two points lie more than 4 times the usual spacing apart (the 90th
+    percentile: a small spacing near a junction or a tip does not count)."""
+    p = np.asarray(fr.points, dtype=float).reshape(-1, 2)
     if len(p) < 2:
-        return np.zeros((0, 2, 2))
-    seg = np.stack([p[:-1], p[1:]], axis=1)
+        return np.zeros((0, 2, 2)), np.zeros(0, np.int64)
     gap = np.linalg.norm(p[1:] - p[:-1], axis=1)
-    return seg[gap <= 3.0 * np.median(gap)]
+    joined = gap <= 4.0 * np.percentile(gap, 90)
+    mid = 0.5 * (p[1:] + p[:-1])
+    left = np.vstack([p[:1], np.where(joined[:, None], mid, p[1:])])
+    right = np.vstack([np.where(joined[:, None], mid, p[:-1]), p[-1:]])
+    pieces = np.concatenate([np.stack([left, p], axis=1), np.stack([p, right], axis=1)])
+    owner = np.concatenate([np.arange(len(p)), np.arange(len(p))])
+    keep = np.linalg.norm(pieces[:, 1] - pieces[:, 0], axis=1) > 0.0
+    return pieces[keep], owner[keep]
 
 
 def figure_network(data: ResultData, scale: float | None = None) -> Figure:
-    """A fracture network: |slip| along every fracture over the deformed,
-    split mesh (left) and the contact state of every point (right), each
-    fracture numbered as in the case file."""
+    """A fracture network: |slip| [mm] along every fracture over the
+    deformed, split mesh (left) and the contact state of every point (right),
+    each fracture numbered as in the case file."""
     fig, axes = _grid(1, 2)
     ax_slip, ax_state = axes[0]
     factor = scale if scale is not None else auto_scale(data)
     _draw_mesh(ax_slip, data, factor)
     slips = [np.abs(f.slip) for f in data.fractures if f.slip.size]
     top = max((float(v.max()) for v in slips), default=0.0) or 1.0
-    norm = Normalize(0.0, top)
+    norm = Normalize(0.0, 1e3 * top)
+    mappable = None
     for fr in data.fractures:
-        seg = _fracture_segments(fr)
-        if not seg.size:
+        pieces, owner = fracture_pieces(fr)
+        if not pieces.size:
             continue
         # drawn where the deformed mesh has moved it (nearest node)
+        ends = pieces.reshape(-1, 2)
         near = np.argmin(
-            np.linalg.norm(seg.reshape(-1, 1, 2) - data.points[None], axis=2), axis=1
+            np.linalg.norm(ends[:, None, :] - data.points[None], axis=2), axis=1
         )
-        moved = seg + factor * data.displacement[near].reshape(seg.shape)
-        mid = 0.5 * (np.abs(fr.slip[:-1]) + np.abs(fr.slip[1:]))
-        gap = np.linalg.norm(fr.points[1:] - fr.points[:-1], axis=1)
-        mid = mid[gap <= 3.0 * np.median(gap)]
-        lc = LineCollection(moved, array=mid, cmap="plasma", norm=norm, linewidths=2.2)
-        ax_slip.add_collection(lc)
-        state_seg = seg
-        colours = [STATE_COLOURS.get(int(c), "k") for c in fr.state[:-1]]
-        colours = [
-            c for c, g in zip(colours, gap, strict=True) if g <= 3 * np.median(gap)
-        ]
+        moved = pieces + factor * data.displacement[near].reshape(pieces.shape)
+        mappable = LineCollection(
+            moved,
+            array=1e3 * np.abs(fr.slip[owner]),
+            cmap="plasma",
+            norm=norm,
+            linewidths=2.2,
+            capstyle="round",
+        )
+        ax_slip.add_collection(mappable)
+        colours = [STATE_COLOURS.get(int(c), "k") for c in fr.state[owner]]
         ax_state.add_collection(
-            LineCollection(state_seg, colors=colours, linewidths=2.2)
+            LineCollection(pieces, colors=colours, linewidths=2.2, capstyle="butt")
         )
         m = fr.points[len(fr.points) // 3]  # not the middle: Xs cross there
         ax_state.annotate(
             str(fr.index), m, fontsize=7, xytext=(3, 3), textcoords="offset points"
         )
-    fig.colorbar(
-        ax_slip.collections[-1] if ax_slip.collections else None,
-        ax=ax_slip,
-        label="|slip| [m]",
-        shrink=0.8,
-    )
+    fig.colorbar(mappable, ax=ax_slip, label="|slip| [mm]", shrink=0.8)
     ax_slip.autoscale_view()
     _frame(
         ax_slip,
@@ -340,7 +387,12 @@ def _point_labels(results: Sequence[ResultData]) -> dict:
     for k, data in enumerate(results):
         for f in data.fractures:
             if len(results) == 1:
-                labels[k, f.index] = f"fracture {f.index}, $\\theta$ = {f.theta:g} deg"
+                # a network is numbered on the diagram, with a key
+                labels[k, f.index] = (
+                    str(f.index)
+                    if len(data.fractures) >= NUMBERED_FROM
+                    else f"fracture {f.index}, $\\theta$ = {f.theta:.1f} deg"
+                )
                 continue
             key = (data.stress_state, round(f.theta % 180.0, 9))
             if key in first:
@@ -387,10 +439,10 @@ def figure_mohr(results: Sequence[ResultData]) -> Figure:
         circles.add(data.stress_state)
         criteria |= keys
     source = results[0].stress_source
+    names = ", ".join(dict.fromkeys(data.name for data in results if data.name))
     ax.set_title(
-        f"Mohr-Coulomb diagram (far field: {source}; pore pressure "
-        f"{results[0].pore_pressure:g} Pa; "
-        "tension positive)",
+        f"{names}\nMohr-Coulomb diagram (far field: {source}; pore pressure "
+        f"{results[0].pore_pressure / 1e6:g} MPa; tension positive)",
         fontsize=9,
     )
     add_legend(fig)
@@ -463,7 +515,7 @@ def _screen_figure(stress, pore_pressure, friction, cohesion, fractures) -> Figu
     else:
         draw_mohr(ax, stress, pore_pressure, fractures=fractures)
     ax.set_title(
-        f"Mohr-Coulomb screening (pore pressure {pore_pressure:g} Pa; "
+        f"Mohr-Coulomb screening (pore pressure {pore_pressure / 1e6:g} MPa; "
         "tension positive)",
         fontsize=9,
     )
@@ -484,13 +536,17 @@ def plot_results(
     """Read the results and write the figures; returns the files written.
 
     ``kinds`` from KINDS, ``formats`` "png" / "pdf", ``labels`` one per result
-    (default: the folder name), ``scale`` the deformed mesh's magnification
-    (default :func:`auto_scale`), ``dpi`` of the PNG files."""
+    (default: the case's name, or a sweep case's parameters; runs of one case
+    in several folders are told apart by their folders), ``scale`` the
+    deformed mesh's magnification (default :func:`auto_scale`), ``dpi`` of
+    the PNG files."""
     if labels and len(labels) != len(paths):
         raise UsageError(f"got {len(labels)} labels for {len(paths)} results")
     results = [
         figure_data(p, labels[i] if labels else None) for i, p in enumerate(paths)
     ]
+    if not labels:
+        distinct_labels(results)
     makers = {
         "displacement": lambda: figure_displacement(results),
         "principal_stress": lambda: figure_principal(results),

@@ -15,9 +15,21 @@ from __future__ import annotations
 import math
 
 import numpy as np
+from matplotlib.ticker import FuncFormatter
 
 from xfemslip.reference.closed_form import angle_to_sigma1
 from xfemslip.reference.screen import effective_stress, slip_band
+
+# From this many labelled points on, numbered labels on leader lines.
+NUMBERED_FROM = 5
+# Least angle (in 2 beta, degrees) between two numbered labels on their ring.
+LABEL_GAP_DEG = 8.0
+# Line styles of the failure lines of successive (f, c).
+CRITERION_STYLES = ("--", "-.", ":", (0, (6, 2, 1, 2, 1, 2)))
+
+
+def _mpa(value: float) -> str:
+    return f"{value / 1e6:.3g} MPa"
 
 
 def _circle_point(centre: float, radius: float, beta_deg):
@@ -61,8 +73,8 @@ def draw_mohr(
             ys,
             color=color,
             lw=1.2,
-            label=f"Mohr circle: $\\sigma_1'$ = {s1:.3g} Pa, "
-            f"$\\sigma_3'$ = {s3:.3g} Pa (compressive)",
+            label=f"Mohr circle: $\\sigma_1'$ = {_mpa(s1)}, "
+            f"$\\sigma_3'$ = {_mpa(s3)} (compressive)",
         )
         ax.plot([-s1, -s3], [0, 0], "o", color=color, ms=3)
     seen = set()
@@ -75,11 +87,11 @@ def draw_mohr(
         ax.plot(
             xs,
             c - f * xs,
-            "--",
+            linestyle=CRITERION_STYLES[(len(seen) - 1) % len(CRITERION_STYLES)],
             color=color,
             lw=1.0,
             label=f"failure line $|\\tau| = c - f\\,\\sigma_n'$ "
-            f"(f = {f:g}, c = {c:g} Pa)",
+            f"(f = {f:g}, c = {c / 1e6:g} MPa)",
         )
         band = slip_band(eff, f, c)
         if band.beta is not None:
@@ -97,20 +109,25 @@ def draw_mohr(
             )
         else:
             ax.plot([], [], " ", label=f"f = {f:g}: no orientation slips")
+    labelled = []
     for label, theta, _, _ in fractures:
         beta = angle_to_sigma1(theta, dir1)
         px, py = _circle_point(centre, radius, beta)
         ax.plot([centre, px], [0.0, py], color=color, lw=0.6)
         ax.plot(px, py, "o", color=color, mec="k", ms=7, zorder=5)
-        if not label:  # annotated with an earlier result at the same point
-            continue
-        ax.annotate(
-            f"{label} ($\\beta$ = {beta:.1f} deg)",
-            (px, py),
-            textcoords="offset points",
-            xytext=(5, 4),
-            fontsize=7,
-        )
+        if label:  # else annotated with an earlier result at the same point
+            labelled.append((label, theta, beta))
+    if len(labelled) >= NUMBERED_FROM:
+        _numbered_labels(ax, centre, radius, labelled, color)
+    else:
+        for label, _, beta in labelled:
+            ax.annotate(
+                f"{label} ($\\beta$ = {beta:.1f} deg)",
+                _circle_point(centre, radius, beta),
+                textcoords="offset points",
+                xytext=(5, 4),
+                fontsize=7,
+            )
     for k, (pn, pt) in enumerate(contact):
         ax.plot(
             pn,
@@ -123,14 +140,16 @@ def draw_mohr(
             else None,
         )
     if first:
-        ax.set_xlabel("effective normal stress $\\sigma_n'$ [Pa] (tension positive)")
-        ax.set_ylabel("shear stress $|\\tau|$ [Pa]")
+        ax.set_xlabel("effective normal stress $\\sigma_n'$ [MPa] (tension positive)")
+        ax.set_ylabel("shear stress $|\\tau|$ [MPa]")
         ax.axhline(0.0, color="k", lw=0.5)
         ax.axvline(0.0, color="k", lw=0.5)
         ax.set_aspect("equal")
         ax.set_xlim(*mohr_limits(stress, pore_pressure)[:2])
         ax.set_ylim(*mohr_limits(stress, pore_pressure)[2:])
-        ax.ticklabel_format(style="sci", scilimits=(-3, 3))
+        in_mpa = FuncFormatter(lambda value, _: f"{value / 1e6:g}")
+        ax.xaxis.set_major_formatter(in_mpa)
+        ax.yaxis.set_major_formatter(in_mpa)
         f0, c0 = (fractures[0][2], fractures[0][3]) if fractures else (0.0, 0.0)
         if inset_lines is None:
             inset_lines = [(theta, color) for _, theta, _, _ in fractures]
@@ -141,7 +160,10 @@ def mohr_limits(stress, pore_pressure: float = 0.0) -> tuple[float, ...]:
     """(x0, x1, y0, y1) of the diagram [Pa]: the circle, zero and room above."""
     band = slip_band(effective_stress(stress, pore_pressure), 0.0)
     s1, radius = max(band.sigma1, 1.0), (band.sigma1 - band.sigma3) / 2.0
-    return -1.08 * s1, 0.25 * s1, 0.0, max(1.5 * radius, 0.3 * s1)
+    centre = -(band.sigma1 + band.sigma3) / 2.0
+    # room for the ring of numbered labels (1.25 R) left of the circle
+    x0 = min(-1.08 * s1, centre - 1.35 * radius)
+    return x0, 0.25 * s1, 0.0, max(1.5 * radius, 0.3 * s1)
 
 
 def mohr_figsize(stress, pore_pressure: float = 0.0, width: float = 8.0):
@@ -153,6 +175,81 @@ def mohr_figsize(stress, pore_pressure: float = 0.0, width: float = 8.0):
 def add_legend(fig) -> None:
     """One legend below the diagram for everything drawn on it."""
     fig.legend(loc="outside lower center", ncol=2, fontsize=7)
+
+
+def spread(angles, gap: float, lo: float, hi: float) -> np.ndarray:
+    """Angles moved apart to at least ``gap`` from each other, within [lo,
+    hi], each as near its own as that allows (in the given order, which
+    must be increasing).  When they cannot all fit, they are evenly spaced
+    over [lo, hi]."""
+    a = np.asarray(angles, dtype=float)
+    n = a.size
+    if n == 0:
+        return a
+    if (n - 1) * gap > hi - lo:
+        return np.linspace(lo, hi, n)
+    # positions relative to the minimum spacing: out[i] = b[i] + i * gap with
+    # b non-decreasing, the nearest such b to a - i * gap (pool adjacent
+    # violators), then clipped into the range
+    target = a - gap * np.arange(n)
+    blocks: list[list[float]] = []
+    for value in target:
+        blocks.append([value, 1.0])
+        while len(blocks) > 1 and blocks[-2][0] > blocks[-1][0]:
+            v2, w2 = blocks.pop()
+            v1, w1 = blocks.pop()
+            blocks.append([(v1 * w1 + v2 * w2) / (w1 + w2), w1 + w2])
+    b = np.concatenate([[v] * int(w) for v, w in blocks])
+    b = np.clip(b, lo, hi - gap * (n - 1))
+    return b + gap * np.arange(n)
+
+
+def _numbered_labels(ax, centre, radius, labelled, color) -> None:
+    """Number the points on a ring outside the circle (leader lines to the
+    points, numbers spread apart) and list the numbers in a key beside the
+    diagram.  Points at one place share their number label ("3, 7")."""
+    groups: dict[float, list] = {}
+    for label, theta, beta in labelled:
+        groups.setdefault(round(beta, 6), []).append((label, theta))
+    betas = sorted(groups)  # right to left along the circle
+    at = [2.0 * b for b in betas]  # polar angle of each point [deg]
+    ring = spread(at, LABEL_GAP_DEG, 4.0, 176.0)
+    for beta, angle, ring_angle in zip(betas, at, ring, strict=True):
+        tag = ", ".join(label for label, _ in groups[beta])
+        point = (
+            centre + radius * math.cos(math.radians(angle)),
+            radius * math.sin(math.radians(angle)),
+        )
+        place = (
+            centre + 1.22 * radius * math.cos(math.radians(ring_angle)),
+            1.22 * radius * math.sin(math.radians(ring_angle)),
+        )
+        ax.annotate(
+            tag,
+            point,
+            xytext=place,
+            fontsize=7.5,
+            ha="center",
+            va="center",
+            bbox={"boxstyle": "round,pad=0.15", "fc": "white", "ec": color, "lw": 0.6},
+            arrowprops={"arrowstyle": "-", "color": "0.3", "lw": 0.6},
+            zorder=6,
+        )
+    key = [
+        f"{label}: $\\theta$ = {theta:.1f}, $\\beta$ = {beta:.1f} deg"
+        for beta in betas
+        for label, theta in groups[beta]
+    ]
+    ax.figure.legend(
+        [ax.plot([], [], " ")[0]] * len(key),
+        key,
+        loc="outside right upper",
+        fontsize=6.5,
+        title="fracture: angle, to $\\sigma_1'$",
+        title_fontsize=7,
+        handlelength=0,
+        handletextpad=0,
+    )
 
 
 def _inset(ax, band, lines) -> None:

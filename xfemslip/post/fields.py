@@ -20,7 +20,10 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from xfemslip.contact.interface import JUMP_PROBE
+from xfemslip.fem.enrichment import HEAVISIDE, find_candidates, group_values
 from xfemslip.fem.poro import fluid_pressure
+from xfemslip.geometry.fracture import GEOMETRY_TOL
 
 
 @dataclass
@@ -76,6 +79,9 @@ class VisMesh:
     quad_cell: np.ndarray  # (Q,) int64
     triangles: np.ndarray  # (T, 3) int64
     triangle_cell: np.ndarray  # (T,) int64
+    # per fracture (position order): the displacement of its - and + faces at
+    # its contact points, each (K, 2) [m], sorted by s (fracture_faces)
+    faces: list[tuple[np.ndarray, np.ndarray]] | None = None
 
 
 def cell_strain(mesh, bulk, u) -> np.ndarray:
@@ -217,6 +223,76 @@ def vis_mesh(mesh, ec, bulk, u) -> VisMesh:
         triangles=triangles,
         triangle_cell=cell.astype(np.int64),
     )
+
+
+def fracture_faces(model, u) -> list[tuple[np.ndarray, np.ndarray]]:
+    """Displacement of the two faces of every fracture at its contact points.
+
+    Per fracture (position order), ``(u_minus, u_plus)`` (K, 2) [m] sorted by
+    s as in :func:`fracture_fields`: the XFEM field of the point's cell
+    evaluated on each side, u(x +/- eps n) = sum_a N_a u_a + sum_s N_a(s)
+    (F_s(x +/- eps n) - F_s(x_a(s))) a_s, the functions' sides taken at the
+    probes x +/- eps n as for the jump operators of the contact
+    (xfemslip.contact.interface), so u_plus - u_minus is the jump [[u]] whose
+    t and n components are ``slip`` and ``opening``.
+    """
+    mesh, ec, ip, fractures = model.mesh, model.ec, model.ip, model.fractures
+    n_points = ip.n
+    U = u[: 2 * mesh.n_nodes].reshape(-1, 2)
+    N = mesh.shape_at(ip.cell, ip.xy) if n_points else np.zeros((0, 4))
+    std = np.einsum("na,nac->nc", N, U[mesh.cells[ip.cell]])
+    sides = [std.copy(), std.copy()]  # +, -
+    n_slots = ec.slot_cand.shape[1]
+    if n_points and n_slots:
+        cand = find_candidates(mesh, fractures)
+        pos = np.searchsorted(ec.cells, ip.cell)
+        eps = JUMP_PROBE * mesh.h_min
+        tol = GEOMETRY_TOL * mesh.h_min
+        probes = (ip.xy + eps * ip.normal, ip.xy - eps * ip.normal)
+        K = ec.slot_cand[pos]  # (n, S) candidate of each slot of the point's cell
+        node = ec.slot_node[pos]
+        dof = model.bulk.enr_dofs[pos, 8::2][:, :n_slots]
+        live = (K >= 0) & (node >= 0) & (dof >= 0)
+        Kc = np.maximum(K, 0)
+        group = np.where(live, cand.fracture[Kc] * 100003 + cand.tip[Kc] + 50000, -1)
+        # one evaluation of a (fracture, tip) group's functions per side, for
+        # every slot of every point it enriches
+        for g in np.unique(group[live]):
+            fi, tip = divmod(int(g), 100003)
+            tip -= 50000
+            rows, cols = np.nonzero(group == g)
+            k, d = Kc[rows, cols], dof[rows, cols]
+            weight = N[rows, node[rows, cols]]
+            amp = np.column_stack([u[d], u[d + 1]])
+            column = np.where(cand.func[k] == HEAVISIDE, 0, cand.func[k] - 1)
+            shift_node = ec.slot_fnode[pos[rows], cols]
+            fr = fractures[fi]
+            for side, probe in zip(sides, probes, strict=True):
+                values = group_values(
+                    fractures,
+                    fi,
+                    tip,
+                    ip.xy[rows],
+                    fr.side(probe[rows]),
+                    tol,
+                    probe[rows],
+                )[0]
+                F = values[np.arange(rows.size), column]
+                np.add.at(side, rows, ((F - shift_node) * weight)[:, None] * amp)
+    out = []
+    for fi in range(len(fractures)):
+        m = np.nonzero(ip.fracture == fi)[0]
+        m = m[np.argsort(ip.s[m], kind="stable")]
+        out.append((sides[1][m], sides[0][m]))
+    return out
+
+
+def vis_mesh_with_faces(model, u) -> VisMesh:
+    """:func:`vis_mesh` of ``model`` at the solution ``u`` with the fractures'
+    face displacements (:func:`fracture_faces`), for the ParaView files."""
+    vis = vis_mesh(model.mesh, model.ec, model.bulk, u)
+    vis.faces = fracture_faces(model, u)
+    return vis
 
 
 def step_fields(model, r) -> StepFields:

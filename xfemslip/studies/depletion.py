@@ -394,6 +394,9 @@ def deplete(spec, out_dir=None, *, tolerance=None, plot=False, overwrite=False):
             solver, model, spec.loading.steps, tolerance, report.onsets
         ),
         finish,
+        # the series' time is the size of the pore-pressure change reached
+        # [Pa]: increasing over the steps, whichever its sign
+        step_time=lambda load_factor: abs(load_factor * change),
     )
     report.wall_time_s = time.perf_counter() - start
     if done.failure is not None:

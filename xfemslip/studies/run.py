@@ -116,9 +116,13 @@ def _vtu_set_whole(out_dir: Path, spec, run_id: int) -> bool:
     if (out_dir / "fractures.vtu").exists():
         names.append("fractures.vtu")
     if spec.loading.steps > 1:
-        if read_run_id(out_dir / "result.pvd") != run_id:
-            return False
-        names += pvd_files(out_dir / "result.pvd")
+        series = ["result.pvd"]
+        if (out_dir / "fractures.pvd").exists():
+            series.append("fractures.pvd")
+        for name in series:
+            if read_run_id(out_dir / name) != run_id:
+                return False
+            names += pvd_files(out_dir / name)
     return all(read_run_id(out_dir / name) == run_id for name in names)
 
 

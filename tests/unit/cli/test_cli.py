@@ -73,6 +73,7 @@ def test_info_prints_versions(runner):
         "dask",
         "distributed",
         "pypardiso",
+        "vtk",
         "threading layer",
         "NUMBA_NUM_THREADS",
         "cache dir",

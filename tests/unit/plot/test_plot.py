@@ -20,7 +20,12 @@ from tests.support.casegen import SWEEP_CASE as CASE
 from xfemslip.case import build
 from xfemslip.cli import cli
 from xfemslip.errors import UsageError
-from xfemslip.plot.data import FractureData, _piece_outlines, figure_data
+from xfemslip.plot.data import (
+    FractureData,
+    _piece_outlines,
+    distinct_labels,
+    figure_data,
+)
 from xfemslip.plot.figures import KINDS, auto_scale, figure_slip, plot_results
 from xfemslip.plot.mohr import _circle_point
 from xfemslip.reference.closed_form import angle_to_sigma1, principal
@@ -59,7 +64,14 @@ def test_run_plot_writes_every_figure_as_png_and_pdf(two_runs):
 
 def test_slip_figure_draws_the_result_data(two_runs):
     results = [figure_data(out / "result.h5") for out in two_runs]
-    assert [r.label for r in results] == ["angle=45", "angle=63"]
+    # labelled by the case's name; two runs of one case by their folders,
+    # here named like sweep cases: the parameter with its unit
+    assert [r.label for r in results] == ["tiny", "tiny"]
+    distinct_labels(results)
+    assert [r.label for r in results] == [
+        "tiny (angle = 45 deg)",
+        "tiny (angle = 63 deg)",
+    ]
     fig = figure_slip(results)
     lines = [ln for ln in fig.axes[0].lines if ln.get_linestyle() == "-"]
     assert len(lines) == 2
@@ -68,7 +80,7 @@ def test_slip_figure_draws_the_result_data(two_runs):
             s, slip = f["fractures/0/s"][()], f["fractures/0/slip"][()]
         np.testing.assert_array_equal(line.get_xdata(), s - s.min())
         np.testing.assert_array_equal(line.get_ydata(), 1e3 * np.abs(slip))  # mm
-        assert line.get_label() == out.name.split("_", 1)[1]
+        assert line.get_label() == f"tiny (angle = {out.name[-2:]} deg)"
 
 
 def test_plot_command_several_results(two_runs, tmp_path, runner):

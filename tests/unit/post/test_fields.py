@@ -64,3 +64,55 @@ def test_result_vtu_carries_the_tensor_and_invariants(tmp_path):
     expected = np.sqrt(0.5 * ((s1 - s2) ** 2 + (s2 - s3) ** 2 + (s3 - s1) ** 2))
     vm = np.concatenate(vtu.cell_data["von_mises"])
     np.testing.assert_allclose(vm, expected, rtol=1e-9)
+
+
+@pytest.mark.parametrize(
+    "polylines",
+    [
+        [[[0.2, 0.2], [0.8, 0.8]], [[0.2, 0.75], [0.75, 0.2]]],  # X junction
+        [[[0.15, 0.3], [0.85, 0.62]], [[0.5, 0.46], [0.42, 0.85]]],  # T junction
+    ],
+    ids=["X", "T"],
+)
+def test_face_displacements_jump_by_slip_and_opening(polylines):
+    """The two faces of every fracture (fractures.vtu's displacement and
+    jump) evaluated on each side of the junction functions too: u+ - u-
+    projected on t and n is the slip and the opening that the contact's own
+    jump operators give."""
+    from xfemslip.case import build, loads_case
+    from xfemslip.post.fields import fracture_faces, fracture_fields
+    from xfemslip.simulation import build_model, newton_solver
+
+    text = build.case_text(
+        {
+            "domain": {"size": [1.0, 1.0]},
+            "mesh": {"elements": [20, 20]},
+            "material": {"E": 5.0e9, "nu": 0.3},
+            "fractures": [
+                {"points": p, "friction": 0.2, "kn": 5e12, "kt": 5e12, "tip": "ramp"}
+                for p in polylines
+            ],
+            "loading": {"stress": {"xx": -20.0e6, "yy": -40.0e6, "xy": 5.0e6}},
+            "boundary": {
+                "bottom": {"uy": 0.0},
+                "top": "traction",
+                "left": "traction",
+                "right": "traction",
+            },
+        }
+    )
+    model = build_model(loads_case(text, "faces.toml"))
+    solver = newton_solver(model)
+    solver.run(1)
+    result = solver.completed[-1]
+    faces = fracture_faces(model, result.u)
+    fields = fracture_fields(model.ip, result.contact, len(model.fractures))
+    assert max(np.abs(f.slip).max() for f in fields) > 1e-6  # they slip
+    for fi, ((u_minus, u_plus), f) in enumerate(zip(faces, fields, strict=True)):
+        t = np.subtract(*polylines[fi][::-1])
+        t /= np.linalg.norm(t)
+        n = np.array([-t[1], t[0]])
+        jump = u_plus - u_minus
+        scale = np.abs(f.slip).max()
+        np.testing.assert_allclose(jump @ t, f.slip, atol=1e-9 * scale)
+        np.testing.assert_allclose(jump @ n, f.opening, atol=1e-9 * scale)
