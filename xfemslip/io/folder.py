@@ -70,17 +70,22 @@ logger = logging.getLogger(__name__)
 PAUSE_ENV = "XFEMSLIP_TEST_PAUSE"
 PAUSE_LIMIT_S = 600.0  # a paused process that nobody signals goes on after this
 
+# The files a run writes into its folder (an earlier set of them is refused
+# without --overwrite).
+RUN_FILES = (
+    "result.h5",
+    "result.vtu",
+    "fractures.vtu",
+    "result.pvd",
+    "fractures.pvd",
+    "result.xdmf",
+    "result_steps.xdmf",
+)
 # Every name an xfemslip command writes into a result folder: an earlier one is
 # never carried into a new set, whichever command wrote it.
 OWNED = frozenset(
     {
-        "result.h5",
-        "result.vtu",
-        "fractures.vtu",
-        "result.pvd",
-        "fractures.pvd",
-        "result.xdmf",
-        "result_steps.xdmf",
+        *RUN_FILES,
         "steps",
         "figures",
         "critical_depletion.csv",

@@ -27,23 +27,13 @@ from pathlib import Path
 
 from xfemslip import interrupt
 from xfemslip.io import hdf5
-from xfemslip.io.folder import output_folder
+from xfemslip.io.folder import RUN_FILES, output_folder
 from xfemslip.post.fields import VisMesh, stress_for_paraview
 from xfemslip.post.result import Result
 
 __all__ = ["OUTPUT_FILES", "run_folder", "write_results"]
 
-# The files a run writes into its folder (an earlier set of them is refused
-# without --overwrite).
-OUTPUT_FILES = (
-    "result.h5",
-    "result.vtu",
-    "fractures.vtu",
-    "result.pvd",
-    "fractures.pvd",
-    "result.xdmf",
-    "result_steps.xdmf",
-)
+OUTPUT_FILES = RUN_FILES
 
 
 def run_folder(out_dir: Path | str, overwrite: bool):
