@@ -90,9 +90,17 @@ def sweep(sweep_file, output, jobs, scheduler, force, verbose, debug) -> None:
             raise UsageError(f"{sweep_file}: no such file")
         from xfemslip.studies.run import format_table, require_dask, run_sweep
         from xfemslip.studies.sweep import load_sweep
+        from xfemslip.studies.uncertainty import is_uncertainty_file
 
         if scheduler:
             require_dask()
+        if is_uncertainty_file(sweep_file):  # docs/sweep-format.md, Uncertainty
+            from xfemslip.cli.uncertainty import run_uncertainty
+
+            run_uncertainty(
+                sweep_file, output, jobs or os.cpu_count() or 1, scheduler, force
+            )
+            return
         spec = load_sweep(sweep_file)
         folder = output or spec.directory
         n_jobs = jobs or os.cpu_count() or 1
