@@ -359,3 +359,31 @@ def test_xfem_matches_the_screen_on_an_isolated_fracture(tmp_path, runner):
     again = runner.invoke(main, ["sweep", str(path), "-o", str(out), "-j", "1"])
     assert again.exit_code == 0
     assert "4 evaluated (4 read back)" in again.output
+
+
+def test_shipped_study_of_the_depleting_reservoir():
+    """cases/sweeps/slip_probability.toml: the reservoir is a full-width layer,
+    so the screen follows uniaxial strain inside it; fracture 2 lies in the
+    host rock, whose stress does not change: its P stays at its in-situ value
+    while fractures 0 and 1 (inside / across the top of the layer, mirror
+    images at the same depth of the layer) rise together."""
+    from pathlib import Path
+
+    from xfemslip.studies.uncertainty import load_uncertainty
+
+    root = Path(__file__).resolve().parents[3]
+    spec = load_uncertainty(root / "cases" / "sweeps" / "slip_probability.toml")
+    result = evaluate_screen(spec)
+    assert "200 m < y < 300 m" in result.path_text
+    assert result.evaluated == spec.samples == 20000
+    p = result.probability
+    assert np.all(p[2] == p[2, 0])
+    assert np.all(np.diff(p[0]) >= 0.0) and p[0, -1] > p[0, 0] + 0.1
+    # the two mirror-image fractures differ only by their sampled friction
+    assert np.all(np.abs(p[0] - p[1]) <= result.ci_high[0] - result.ci_low[0])
+    # the correlation asked for between the pore pressure and sigma_h
+    rho = np.corrcoef(
+        np.argsort(np.argsort(spec.values[:, 4])),
+        np.argsort(np.argsort(spec.values[:, 3])),
+    )[0, 1]
+    assert rho == pytest.approx(0.5, abs=0.03)
