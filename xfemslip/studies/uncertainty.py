@@ -31,6 +31,7 @@ the same samples.  Evaluating them is :mod:`xfemslip.studies.reactivation`.
 
 from __future__ import annotations
 
+import copy
 import math
 from dataclasses import dataclass
 from pathlib import Path
@@ -383,8 +384,6 @@ def _check_keys(table: Table, keys: list[str], base: dict) -> None:
                 )
             )
             continue
-        import copy
-
         trial = copy.deepcopy(base) if base is not None else {}
         message = set_key_path(trial, parse_key_path(key), 0.0)
         if message:
@@ -467,6 +466,13 @@ def _check_screen(table: Table, keys: list[str], base: dict, base_spec) -> None:
     """The closed form follows the base case's stress path and reads the keys."""
     from xfemslip.studies.slip_screen import screen_key_problem, stress_path
 
+    segments = sum(len(f.points) - 1 for f in base_spec.fractures)
+    if table.data.get("samples", 0) * segments > MAX_SCREEN_CELLS:
+        table.error(
+            "samples",
+            f"{table.data['samples']} samples x {segments} fracture segments is "
+            f"more than the screen's {MAX_SCREEN_CELLS} (memory); draw fewer",
+        )
     _, why = stress_path(base_spec)
     if why:
         table.error(
@@ -509,8 +515,6 @@ def load_uncertainty(path: str | Path) -> UncertaintySpec:
 
 def sample_document(spec: UncertaintySpec, index: int) -> dict:
     """The case document of sample ``index``: the base with its input values."""
-    import copy
-
     document = copy.deepcopy(spec.base)
     for key, value in zip(spec.keys, spec.values[index], strict=True):
         set_key_path(document, parse_key_path(key), _toml_value(value))

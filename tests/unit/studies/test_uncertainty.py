@@ -387,3 +387,29 @@ def test_shipped_study_of_the_depleting_reservoir():
         np.argsort(np.argsort(spec.values[:, 3])),
     )[0, 1]
     assert rho == pytest.approx(0.5, abs=0.03)
+
+
+def test_refused_samples_are_reported_not_fatal(tmp_path, runner):
+    """A normal friction reaching below 0 gives samples the case format
+    refuses: they are listed with the reason, left out of the counts, and
+    the exit code is 1; the other samples are evaluated."""
+    inputs = (
+        '"fractures[0].friction" = { distribution = "normal", mean = 0.02, std = 0.1 }'
+    )
+    path = study(tmp_path, inputs, samples=3, evaluate="xfem")
+    out = tmp_path / "out"
+    res = runner.invoke(main, ["sweep", str(path), "-o", str(out), "-j", "1"])
+    assert res.exit_code == 1, res.output
+    rows = (out / "uncertainty.csv").read_text().splitlines()[1:]
+    status = [r.split(",")[2] for r in rows]
+    negative = [float(r.split(",")[1]) < 0.0 for r in rows]
+    assert [s == "refused" for s in status] == negative
+    assert 0 < sum(negative) < 3
+    assert "friction: must be >= 0" in (out / "uncertainty.csv").read_text()
+    with h5py.File(out / "uncertainty.h5") as h5:
+        assert h5.attrs["evaluated"] == 3 - sum(negative)
+    # the screen refuses the same values without a case per sample
+    path = study(tmp_path, inputs, samples=200)
+    result = evaluate_screen(load(path))
+    assert np.array_equal(result.status == "refused", load(path).values[:, 0] < 0)
+    assert result.evaluated == int(np.sum(load(path).values[:, 0] >= 0))
