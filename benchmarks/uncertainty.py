@@ -19,8 +19,9 @@ Usage, from the project root::
   ``--dask`` single-threaded workers (started before timing).
 - ``compare``: the screen and the XFEM P curves of the same samples, on an
   isolated fracture in a large box (the closed form is exact: they must
-  agree within their intervals) and on the depleting reservoir, whose
-  fracture 1 crosses the reservoir top and whose fractures interact.
+  agree within their intervals), on two fractures side by side that
+  interact once one slips, and on the depleting reservoir (fracture 1
+  crosses the reservoir top).
 """
 
 from __future__ import annotations
@@ -96,6 +97,22 @@ ISOLATED = (
         "center = [0.5, 0.5]\nlength = 0.6", "center = [50.0, 50.0]\nlength = 10.0"
     )
     .replace("kn = 5.0e12\nkt = 5.0e12\n", "")
+)
+
+# Two parallel 4 m fractures 1.4 m apart (side by side at 45 degrees) in a
+# 20 m box of 0.5 m cells, same stresses: once one slips, it loads and
+# unloads the other, which the closed form does not see.
+INTERACTING = (
+    RESERVOIR.replace('name = "reservoir-pore"', 'name = "interacting"')
+    .replace("size = [1.0, 1.0]", "size = [20.0, 20.0]")
+    .replace("elements = [50, 50]", "elements = [40, 40]")
+    .replace("center = [0.5, 0.5]\nlength = 0.6", "center = [10.0, 10.0]\nlength = 4.0")
+    .replace("kn = 5.0e12\nkt = 5.0e12\n", "")
+    .replace(
+        "[pore_pressure]",
+        "[[fractures]]\ncenter = [11.0, 9.0]\nlength = 4.0\nangle = 45.0\n"
+        "friction = 0.27\n[pore_pressure]",
+    )
 )
 
 
@@ -221,6 +238,10 @@ def compare(samples: int, jobs: int) -> None:
         spec = load_uncertainty(path)
         result = evaluate_xfem(spec, folder / "iso", jobs=jobs, force=True)
         _agreement("isolated fracture, 100 m box", spec, result)
+        path = _study(folder, INTERACTING, samples, "xfem")
+        spec = load_uncertainty(path)
+        result = evaluate_xfem(spec, folder / "two", jobs=jobs, force=True)
+        _agreement("two fractures 1.4 m apart", spec, result)
         shipped = (ROOT / "cases" / "sweeps" / "slip_probability.toml").read_text()
         base = (ROOT / "cases" / "depleting_reservoir.toml").as_posix()
         text = (

@@ -80,6 +80,10 @@ def sweep(sweep_file, output, jobs, scheduler, force, verbose, debug) -> None:
     of the same case text are skipped, cases that cannot be built are
     reported and not run.  A table of the results is printed and written to
     <folder>/summary.csv.  Exit 1 if a case failed or was refused.
+
+    A sweep file with an [uncertainty] table instead of [vary] draws samples
+    of uncertain inputs and writes the probability that each fracture slips
+    against the pore-pressure change (docs/uncertainty.md).
     """
     with reported_errors(debug):
         configure_logging(verbose, not verbose)
