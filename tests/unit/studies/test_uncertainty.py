@@ -413,3 +413,30 @@ def test_refused_samples_are_reported_not_fatal(tmp_path, runner):
     result = evaluate_screen(load(path))
     assert np.array_equal(result.status == "refused", load(path).values[:, 0] < 0)
     assert result.evaluated == int(np.sum(load(path).values[:, 0] >= 0))
+
+
+@pytest.mark.slow  # a scheduler and two worker processes: ~15 s
+def test_xfem_samples_on_a_local_dask_cluster(tmp_path, runner, monkeypatch):
+    """The same samples through --scheduler give the critical changes of the
+    closed form (exact here) and a second run reads them back."""
+    from pathlib import Path
+
+    from distributed import LocalCluster
+
+    monkeypatch.setenv("PYTHONPATH", str(Path(__file__).resolve().parents[3]))
+    path = study(tmp_path, samples=4, evaluate="xfem")
+    out = tmp_path / "out"
+    with LocalCluster(
+        n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None
+    ) as cluster:
+        args = ["sweep", str(path), "-o", str(out)]
+        res = runner.invoke(main, [*args, "--scheduler", cluster.scheduler_address])
+        assert res.exit_code == 0, res.output
+        again = runner.invoke(main, [*args, "--scheduler", cluster.scheduler_address])
+        assert "4 evaluated (4 read back)" in again.output
+    with h5py.File(out / "uncertainty.h5") as h5:
+        xfem = h5["dp_critical"][:, 0]
+    screen = evaluate_screen(load(path)).dp_critical[:, 0]
+    reached = np.abs(np.nan_to_num(screen, nan=np.inf)) <= 20e6
+    assert np.array_equal(~np.isnan(xfem), reached) and reached.sum() >= 2
+    np.testing.assert_allclose(xfem[reached], screen[reached], atol=2e5)
