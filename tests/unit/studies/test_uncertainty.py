@@ -150,6 +150,14 @@ def test_bad_uncertainty_tables_name_the_key(
     assert str(path) in text and key in text and words in text
 
 
+def test_overlapping_inputs_are_refused(tmp_path):
+    inputs = (
+        FRICTION + '\n"fractures[0]" = { distribution = "choice", values = [1.0, 2.0] }'
+    )
+    with pytest.raises(CaseError, match=r'"fractures\[0\].friction": overlaps'):
+        load(study(tmp_path, inputs, evaluate="xfem"))
+
+
 def test_levels_must_lie_within_the_case_change(tmp_path):
     path = study(tmp_path)
     path.write_text(path.read_text().replace("stop = -20.0e6", "stop = -30.0e6"))
