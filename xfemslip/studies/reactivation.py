@@ -14,7 +14,7 @@ evaluated, then counted per fracture and depletion level.
 A fracture has slipped by level L (a pore-pressure change, < 0 depletion)
 when its critical change dp_c is finite and |dp_c| <= |L| (same sign).  Over
 the n evaluated samples the count k gives P = k / n, its Wilson interval and
-the samples a target half-width needs
+the samples the Wilson interval needs for a target half-width
 (:mod:`xfemslip.studies.sampling`).  The sensitivity is Spearman's rank
 correlation of each input with dp_c, a fracture that never slips counting as
 slipping beyond every level (ranked last).
@@ -35,8 +35,8 @@ from scipy import stats
 from xfemslip.errors import XfemslipError
 from xfemslip.studies.sampling import (
     rank_correlation,
-    samples_for_half_width,
     wilson_interval,
+    wilson_samples_needed,
 )
 
 logger = logging.getLogger(__name__)
@@ -310,9 +310,9 @@ def aggregate(result: UncertaintyResult) -> UncertaintyResult:
         return result
     result.probability = result.slipped / n
     result.ci_low, result.ci_high = wilson_interval(result.slipped, n, spec.confidence)
-    result.samples_needed = np.vectorize(
-        lambda p: samples_for_half_width(p, spec.half_width, spec.confidence)
-    )(result.probability).astype(int)
+    result.samples_needed = wilson_samples_needed(
+        result.probability, spec.half_width, spec.confidence
+    )
     sign = np.sign(spec.base_spec.pore_pressure.change)
     result.sensitivity = sensitivity(spec.values[use], dp, sign)
     return result
