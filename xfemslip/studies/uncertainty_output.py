@@ -62,7 +62,13 @@ def write_samples(path: Path, result) -> None:
         header += [f"max_slip_{i}_m" for i in frac]
         header += [f"slip_length_{i}_m" for i in frac]
     header.append("error")
-    rows = []
+    write_rows(path, header, _sample_rows(result))
+
+
+def _sample_rows(result):
+    """The rows of uncertainty.csv, one at a time (a million samples would
+    otherwise hold ~1 GB of cell strings)."""
+    spec = result.spec
     for s in range(spec.samples):
         row = [result.ids[s], *(f"{v:.9g}" for v in spec.values[s]), result.status[s]]
         row += [_g(v) for v in result.dp_critical[s]]
@@ -70,8 +76,7 @@ def write_samples(path: Path, result) -> None:
             row += [_g(v) for v in result.max_slip[s]]
             row += [_g(v) for v in result.slip_length[s]]
         row.append(result.errors[s])
-        rows.append(row)
-    write_rows(path, header, rows)
+        yield row
 
 
 def write_probability(path: Path, result) -> None:
