@@ -80,6 +80,10 @@ def sweep(sweep_file, output, jobs, scheduler, force, verbose, debug) -> None:
     of the same case text are skipped, cases that cannot be built are
     reported and not run.  A table of the results is printed and written to
     <folder>/summary.csv.  Exit 1 if a case failed or was refused.
+
+    A sweep file with an [uncertainty] table instead of [vary] draws samples
+    of uncertain inputs and writes the probability that each fracture slips
+    against the pore-pressure change (docs/uncertainty.md).
     """
     with reported_errors(debug):
         configure_logging(verbose, not verbose)
@@ -90,9 +94,17 @@ def sweep(sweep_file, output, jobs, scheduler, force, verbose, debug) -> None:
             raise UsageError(f"{sweep_file}: no such file")
         from xfemslip.studies.run import format_table, require_dask, run_sweep
         from xfemslip.studies.sweep import load_sweep
+        from xfemslip.studies.uncertainty import is_uncertainty_file
 
         if scheduler:
             require_dask()
+        if is_uncertainty_file(sweep_file):  # docs/sweep-format.md, Uncertainty
+            from xfemslip.cli.uncertainty import run_uncertainty
+
+            run_uncertainty(
+                sweep_file, output, jobs or os.cpu_count() or 1, scheduler, force
+            )
+            return
         spec = load_sweep(sweep_file)
         folder = output or spec.directory
         n_jobs = jobs or os.cpu_count() or 1

@@ -6,6 +6,12 @@ Modules:
 - ``sweep``: sweep files: a base case plus the parameters to vary;
 - ``vary``: the ``[vary]`` table: key paths, value lists and ranges;
 - ``sampling``: random samples of uncertain inputs;
+- ``uncertainty``: the ``[uncertainty]`` table of a sweep file (``inputs``:
+  its distributions and correlations);
+- ``slip_screen``: the closed-form critical change of many samples along a
+  case's stress path;
+- ``reactivation``: the samples evaluated (screen or deplete) and counted
+  into probabilities of slip (``uncertainty_output``: its files);
 - ``run``: running a sweep (processes or Dask), reruns, the summary;
 - ``dfn_summary``: the aggregate of a sweep over network realizations;
 - ``depletion``: the pore-pressure drop at which each fracture first slips.
@@ -13,4 +19,16 @@ Modules:
 The subpackage imports nothing itself: import the module you need (``from
 xfemslip.studies.sweep import ...``)."""
 
-__all__ = ["depletion", "dfn_summary", "run", "sampling", "sweep", "vary"]
+__all__ = [
+    "depletion",
+    "dfn_summary",
+    "inputs",
+    "reactivation",
+    "run",
+    "sampling",
+    "slip_screen",
+    "sweep",
+    "uncertainty",
+    "uncertainty_output",
+    "vary",
+]

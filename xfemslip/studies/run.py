@@ -213,16 +213,18 @@ def _outcome(task: CaseTask, future) -> tuple:
         return task.case_id, "failed", {}, f"worker error: {type(exc).__name__}: {exc}"
 
 
-def _run_local(tasks: list[CaseTask], jobs: int) -> Iterable[tuple]:
-    """Results in completion order: in this process, or a spawn process pool."""
+def run_local(tasks: list, jobs: int, fn=run_task) -> Iterable[tuple]:
+    """``fn(task)`` of every task, in completion order: in this process, or a
+    spawn process pool (``fn`` must be importable by the workers and never
+    raise, as :func:`run_task`)."""
     jobs = min(jobs, len(tasks))  # no idle workers to start
     if jobs <= 1:
         for task in tasks:
-            yield run_task(task)
+            yield fn(task)
         return
     context = get_context("spawn")  # no forked Numba/BLAS state in the workers
     with ProcessPoolExecutor(max_workers=jobs, mp_context=context) as pool:
-        futures = {pool.submit(run_task, task): task for task in tasks}
+        futures = {pool.submit(fn, task): task for task in tasks}
         try:
             for future in as_completed(futures):
                 yield _outcome(futures[future], future)
@@ -241,7 +243,7 @@ def require_dask() -> None:
         ) from None
 
 
-def _client(scheduler: str):
+def connect(scheduler: str):
     """A dask.distributed Client of the scheduler at ``scheduler``."""
     require_dask()
     from distributed import Client
@@ -255,12 +257,13 @@ def _client(scheduler: str):
         ) from None
 
 
-def _run_dask(tasks: list[CaseTask], client) -> Iterable[tuple]:
-    """Results in completion order from a dask.distributed ``client``."""
+def run_dask(tasks: list, client, fn=run_task) -> Iterable[tuple]:
+    """``fn(task)`` of every task, in completion order, from a
+    dask.distributed ``client``."""
     from distributed import as_completed as dask_completed
 
     # pure=False: a rerun of the same task must run, not hit a cached result
-    futures = client.map(run_task, tasks, pure=False)
+    futures = client.map(fn, tasks, pure=False)
     owner = {future.key: task for future, task in zip(futures, tasks, strict=True)}
     try:
         for future in dask_completed(futures):
@@ -287,9 +290,9 @@ def run_sweep(
         raise UsageError(f"--jobs must be >= 1, got {jobs}")
     directory = Path(directory) if directory is not None else sweep.directory
     # connect first: a wrong address must not leave case folders behind
-    client = _client(scheduler) if scheduler else None
+    client = connect(scheduler) if scheduler else None
     try:
-        with _sweep_lock(directory):
+        with sweep_lock(directory):
             rows = _run_all(sweep, directory, jobs, client, force, progress)
     finally:
         if client is not None:
@@ -309,7 +312,7 @@ def run_sweep(
     return rows
 
 
-def _sweep_lock(directory: Path):
+def sweep_lock(directory: Path):
     """The lock of the sweep folder (``.NAME.lock`` beside it): one sweep at a
     time writes its members and summary."""
     try:
@@ -325,7 +328,7 @@ def _run_all(sweep, directory, jobs, client, force, progress) -> list[CaseRow]:
     for row in rows if progress is not None else ():
         progress(row)
     params = {case.case_id: case.params for case in sweep.cases}
-    results = _run_dask(tasks, client) if client else _run_local(tasks, jobs)
+    results = run_dask(tasks, client) if client else run_local(tasks, jobs)
     for case_id, status, metrics, error in results if tasks else ():
         row = CaseRow(case_id, params[case_id], status, metrics, error)
         if status == "failed":

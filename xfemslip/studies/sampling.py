@@ -210,3 +210,30 @@ def rank_correlation(x: np.ndarray, y: np.ndarray) -> float:
     if np.ptp(x) == 0.0 or np.ptp(y) == 0.0:
         return math.nan
     return float(stats.spearmanr(x, y).statistic)
+
+
+def wilson_samples_needed(p, half_width: float, confidence: float = 0.95) -> np.ndarray:
+    """Smallest n whose Wilson interval (:func:`wilson_interval`) at proportion
+    p is at most ``half_width`` wide on each side (the half of its width).
+
+    Unlike :func:`samples_for_half_width` it stays meaningful at p = 0 and 1,
+    where the interval still has a width of about z^2 / n (Wilson 1927); the
+    half-width decreases with n at fixed p, so n is found by bisection.
+    """
+    p = np.clip(np.asarray(p, float), 0.0, 1.0)
+    z2 = float(special.ndtri(0.5 + confidence / 2.0)) ** 2
+
+    def half(n):
+        denom = 1.0 + z2 / n
+        return np.sqrt(z2) * np.sqrt(p * (1 - p) / n + z2 / (4 * n * n)) / denom
+
+    lo = np.zeros(p.shape)  # half(lo) > half_width (n = 0: no samples)
+    hi = np.full(p.shape, 1.0)
+    while np.any(half(hi) > half_width):
+        hi = np.where(half(hi) > half_width, 2.0 * hi, hi)
+    while np.any(hi - lo > 1.0):
+        mid = np.floor(0.5 * (lo + hi))
+        mid = np.where(mid <= lo, lo + 1.0, mid)
+        ok = half(mid) <= half_width
+        hi, lo = np.where(ok, mid, hi), np.where(ok, lo, mid)
+    return hi.astype(np.int64)

@@ -155,7 +155,7 @@ def _combinations(vary: list, combine: str) -> list[tuple[tuple[str, object], ..
     return [tuple(zip(keys, row, strict=True)) for row in rows]
 
 
-def _build_case(base: dict, base_name: str, index: int, n: int, params, path: Path):
+def build_case(base: dict, base_name: str, index: int, n: int, params, path: Path):
     """(case_id, TOML text, why it cannot be written, problems of the sweep
     file: vary keys the base case cannot take)."""
     cid = case_id(index, n, params)
@@ -178,7 +178,7 @@ def _build_case(base: dict, base_name: str, index: int, n: int, params, path: Pa
         return cid, "", f"cannot be written as TOML: {exc}", []
 
 
-def _validate_case(text: str, path: Path):
+def validate_case(text: str, path: Path):
     """(spec, "") or (None, one-line reason): the case loader, then the
     geometry check."""
     from xfemslip.simulation import check_geometry
@@ -202,7 +202,7 @@ def _validate_case(text: str, path: Path):
 # --------------------------------------------------------------------------- #
 
 
-def _read_base(root: Table, path: Path) -> tuple[dict | None, Path, str | None]:
+def read_base(root: Table, path: Path) -> tuple[dict | None, Path, str | None]:
     """``base``: a case file path (relative to the sweep file) or an inline table.
 
     Returns (document, path to load the cases as, base name)."""
@@ -241,7 +241,7 @@ def loads_sweep(text: str, path: str | Path = "<string>") -> SweepSpec:
     elif isinstance(name, str) and path_problem(name):
         root.error("name", f"{path_problem(name)} (it names the sweep folder)")
     combine = root.choice("combine", COMBINE, "product")
-    base, case_path, base_name = _read_base(root, path)
+    base, case_path, base_name = read_base(root, path)
     vary = read_vary(root, combine)
     output = root.table("output", ("directory",))
     directory = output.string("directory", None) if output is not None else None
@@ -295,7 +295,7 @@ def _generate(base, base_name, case_path, combos, problems) -> list[SweepCase]:
     a case that cannot be built is kept with its reason (``refused``)."""
     cases = []
     for index, params in enumerate(combos):
-        cid, text, reason, found = _build_case(
+        cid, text, reason, found = build_case(
             base, base_name, index, len(combos), params, case_path
         )
         problems += found
@@ -303,7 +303,7 @@ def _generate(base, base_name, case_path, combos, problems) -> list[SweepCase]:
             continue
         spec = None
         if not reason and not problems:  # else the sweep is refused anyway
-            spec, reason = _validate_case(text, case_path)
+            spec, reason = validate_case(text, case_path)
         cases.append(SweepCase(index, cid, params, text, case_path, spec, reason))
     return cases
 

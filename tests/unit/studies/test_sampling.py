@@ -114,3 +114,16 @@ def test_samples_for_half_width():
     # p = 0.5, +-0.05 at 95 %: 0.25 * (1.96 / 0.05)^2 = 384.1 -> 385
     assert samples_for_half_width(0.5, 0.05) == 385
     assert samples_for_half_width(0.1, 0.05) < samples_for_half_width(0.5, 0.05)
+
+
+def test_wilson_samples_needed_is_the_fewest_that_reach_the_half_width():
+    from xfemslip.studies.sampling import wilson_samples_needed
+
+    p = np.array([0.0, 0.01, 0.1, 0.5, 0.9, 1.0])
+    for hw, conf in ((0.05, 0.95), (0.01, 0.99)):
+        n = wilson_samples_needed(p, hw, conf)
+        for pi, ni in zip(p, n, strict=True):
+            lo, hi = wilson_interval(pi * ni, ni, conf)
+            lo1, hi1 = wilson_interval(pi * (ni - 1), ni - 1, conf)
+            assert (hi - lo) / 2 <= hw < (hi1 - lo1) / 2
+        assert n[0] == n[-1] > 1  # P = 0 still needs samples to be sure of it
