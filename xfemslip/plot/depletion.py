@@ -22,8 +22,11 @@ def _pyplot():
     return plt
 
 
-def plot_slip_vs_depletion(report, out_dir: Path, dpi: float = 110.0) -> Path:
-    """Max |slip| and slipping length of each fracture against the pressure drop."""
+def plot_slip_vs_depletion(
+    report, out_dir: Path, dpi: float = 110.0, name: str | None = None
+) -> Path:
+    """Max |slip| and slipping length of each fracture against the pressure
+    drop; ``name`` (the case's) titles the figure."""
     plt = _pyplot()
     rows = report.rows
     drop = np.array([-r[2] for r in rows]) / 1e6  # pressure drop [MPa]
@@ -42,6 +45,8 @@ def plot_slip_vs_depletion(report, out_dir: Path, dpi: float = 110.0) -> Path:
     a2.set_ylabel("slipping length [m]")
     a1.legend(fontsize=8)
     a1.set_title("dotted: critical depletion (bisection)", fontsize=9)
+    if name:
+        fig.suptitle(f"{name}: slip against depletion", fontsize=10)
     path = out_dir / "slip_vs_depletion.png"
     fig.savefig(path, dpi=dpi)
     plt.close(fig)

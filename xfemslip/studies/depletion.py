@@ -381,7 +381,7 @@ def deplete(spec, out_dir=None, *, tolerance=None, plot=False, overwrite=False):
         if plot:
             from xfemslip.plot.depletion import plot_field, plot_slip_vs_depletion
 
-            names.append(plot_slip_vs_depletion(report, folder))
+            names.append(plot_slip_vs_depletion(report, folder, name=spec.name))
             if done.results:
                 names.append(plot_field(done.model, done.results[-1], folder))
         report.written = [done.out_dir / Path(name).name for name in names]

@@ -147,3 +147,34 @@ def test_sweep_parameters_read_with_units():
     assert parameter_label("angle=27_friction=0.3") == "angle = 27 deg, f = 0.3"
     assert parameter_label("cohesion=2e6") == "c = 2 MPa"
     assert parameter_label("mystery=abc") == "mystery = abc"
+
+
+def test_slip_vs_depletion_is_titled_by_the_case_and_draws_the_table(
+    tmp_path, monkeypatch
+):
+    """deplete's slip figure: the case's name in its title, and its lines the
+    report's rows (mm against the pressure drop in MPa)."""
+    import matplotlib.pyplot as plt
+
+    from xfemslip.plot.depletion import plot_slip_vs_depletion
+    from xfemslip.studies.depletion import DepletionReport, FractureOnset
+
+    report = DepletionReport(
+        onsets=[FractureOnset(0, -12e6, -13e6)],
+        rows=[
+            (0, 0.0, 0.0, [(0.0, 0.0)]),
+            (1, 0.5, -10e6, [(0.0, 0.0)]),
+            (2, 1.0, -20e6, [(2.5e-3, 40.0)]),
+        ],
+    )
+    kept = []
+    monkeypatch.setattr(plt, "close", kept.append)
+    path = plot_slip_vs_depletion(report, tmp_path, name="depleting-reservoir")
+    assert path.is_file()
+    (fig,) = kept
+    assert fig._suptitle.get_text() == "depleting-reservoir: slip against depletion"
+    slip_axes = fig.axes[0]
+    x, y = slip_axes.lines[0].get_data()
+    assert list(x) == [0.0, 10.0, 20.0] and list(y) == [0.0, 0.0, 2.5]
+    # the bracket's midpoint, 12.5 MPa of drop, as the dotted line
+    assert slip_axes.lines[1].get_xdata()[0] == 12.5
