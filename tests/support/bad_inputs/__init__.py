@@ -11,7 +11,7 @@ keys of the shipped cases mutated one at a time through ``check``, those of a
 small case through ``check`` and ``run``, misspelt keys), ``files.py``
 (TOML nesting depth, special and oversized files in every place a file is
 read, bytes that are not clean UTF-8 TOML, boundary and network CSV files),
-``studies.py`` (sweeps, random networks, depletion) and
+``studies.py`` (sweeps, uncertainty studies, random networks, depletion) and
 ``commands.py`` (command-line options, environment variables,
 sizes, geometry of many vertices); ``base.py`` holds what they
 share.  This module assembles the two suites.
@@ -45,6 +45,7 @@ from tests.support.bad_inputs.studies import (
     depletion_inputs,
     generate_inputs,
     sweep_inputs,
+    uncertainty_inputs,
 )
 
 SEED = 20240613
@@ -64,6 +65,7 @@ def default_inputs() -> list[Input]:
         *boundary_csv_inputs(),
         *network_csv_inputs(),
         *sweep_inputs(),
+        *uncertainty_inputs(),
         *generate_inputs(),
         *depletion_inputs(),
         *cli_inputs(),

@@ -373,3 +373,164 @@ def depletion_inputs() -> list[Input]:
             )
         )
     return out
+
+
+# --------------------------------------------------------------------------- #
+# Uncertainty studies
+# --------------------------------------------------------------------------- #
+
+
+def _uncertainty_text(head: str, inputs: str, extra: str = "") -> str:
+    return (
+        f'name = "un"\nbase = "base.toml"\n\n[uncertainty]\n{head}\n'
+        f"\n[uncertainty.inputs]\n{inputs}\n{extra}"
+    )
+
+
+FRICTION = (
+    '"fractures[0].friction" = { distribution = "uniform", low = 0.3, high = 0.7 }'
+)
+SCREEN = 'samples = 50\nseed = 1\nevaluate = "screen"\nlevels = [0.0, -5.0e5, -1.0e6]'
+
+
+def uncertainty_inputs() -> list[Input]:
+    """[uncertainty] sweep files on the small depletion case: every key with
+    values out of range, of the wrong type, sizes that must be bounded before
+    anything is drawn, and a valid one that runs."""
+    base = toml(DEPLETION)
+    dist = {
+        "unknown": '{ distribution = "weibull", low = 0.1, high = 0.5 }',
+        "uniform-reversed": '{ distribution = "uniform", low = 0.7, high = 0.3 }',
+        "uniform-nan": '{ distribution = "uniform", low = nan, high = 0.3 }',
+        "normal-std-negative": '{ distribution = "normal", mean = 0.5, std = -0.1 }',
+        "normal-trunc-empty": (
+            '{ distribution = "normal", mean = 0.5, std = 0.1, low = 0.9, high = 0.8 }'
+        ),
+        "lognormal-median-0": (
+            '{ distribution = "lognormal", median = 0.0, sigma = 0.2 }'
+        ),
+        "lognormal-sigma-inf": (
+            '{ distribution = "lognormal", median = 0.5, sigma = inf }'
+        ),
+        "triangular-mode-outside": (
+            '{ distribution = "triangular", low = 0.2, mode = 0.9, high = 0.6 }'
+        ),
+        "choice-empty": '{ distribution = "choice", values = [] }',
+        "choice-weights-negative": (
+            '{ distribution = "choice", values = [0.3, 0.5], weights = [1.0, -1.0] }'
+        ),
+        "choice-weights-count": (
+            '{ distribution = "choice", values = [0.3, 0.5], weights = [1.0] }'
+        ),
+        "missing-parameter": '{ distribution = "normal", mean = 0.5 }',
+        "not-a-table": "0.5",
+        "string": '"uniform"',
+    }
+    cases = {
+        f"dist-{name}": (
+            SCREEN,
+            f'"fractures[0].friction" = {value}',
+            "",
+            ("fractures[0].friction",),
+        )
+        for name, value in dist.items()
+    }
+    heads = {
+        "samples-0": ("samples = 0", "samples"),
+        "samples-negative": ("samples = -5", "samples"),
+        "samples-1e12": ("samples = 1000000000000", "samples"),
+        "samples-float": ("samples = 10.5", "samples"),
+        "samples-big-int": (f"samples = {BIG_INT_TEXT}", "samples"),
+        "method-bad": ('method = "sobol"', "method"),
+        "evaluate-bad": ('evaluate = "exact"', "evaluate"),
+        "confidence-1": ("confidence = 1.0", "confidence"),
+        "confidence-nan": ("confidence = nan", "confidence"),
+        "seed-negative": ("seed = -1", "seed"),
+        "levels-wrong-sign": ("levels = [1.0e6]", "levels"),
+        "levels-beyond-change": ("levels = [-5.0e6]", "levels"),
+        "levels-empty": ("levels = []", "levels"),
+        "levels-num-1e9": (
+            "levels = { start = 0.0, stop = -1.0e6, num = 1000000000 }",
+            "levels",
+        ),
+        "levels-step-0": (
+            "levels = { start = 0.0, stop = -1.0e6, step = 0.0 }",
+            "levels",
+        ),
+        "unknown-key": ("sampels = 10", "sampels"),
+    }
+    for name, (line, key) in heads.items():
+        key_name = key.split(".")[-1]
+        head = "\n".join(
+            ln for ln in SCREEN.splitlines() if not ln.startswith(key_name + " ")
+        )
+        cases[f"head-{name}"] = (head + "\n" + line, FRICTION, "", (key,))
+    corr = {
+        "rho-2": 'keys = ["fractures[0].friction", "material.E"]\nrho = 2.0',
+        "same-key": (
+            'keys = ["fractures[0].friction", "fractures[0].friction"]\nrho = 0.5'
+        ),
+        "not-an-input": 'keys = ["fractures[0].friction", "material.nu"]\nrho = 0.5',
+        "one-key": 'keys = ["fractures[0].friction"]\nrho = 0.5',
+    }
+    two = FRICTION + (
+        '\n"material.E" = { distribution = "uniform", low = 0.9e9, high = 1.1e9 }'
+    )
+    for name, body in corr.items():
+        cases[f"corr-{name}"] = (
+            SCREEN.replace('evaluate = "screen"', 'evaluate = "xfem"'),
+            two,
+            f"\n[[uncertainty.correlation]]\n{body}\n",
+            ("correlation",),
+        )
+    cases["input-unknown-key"] = (
+        SCREEN,
+        '"material.Young" = { distribution = "uniform", low = 1.0, high = 2.0 }',
+        "",
+        ("material.Young",),
+    )
+    cases["input-axis-key"] = (
+        SCREEN,
+        '"pore_pressure.change" = '
+        '{ distribution = "uniform", low = -2e6, high = -1e6 }',
+        "",
+        ("pore_pressure.change",),
+    )
+    cases["no-inputs"] = (SCREEN, "", "", ("inputs",))
+    out = []
+    for name, (head, inputs, extra, names) in cases.items():
+        out.append(
+            Input(
+                id=f"uncertainty/{name}",
+                family="uncertainty",
+                files={
+                    "sweep.toml": _uncertainty_text(head, inputs, extra),
+                    "base.toml": base,
+                },
+                argv=("sweep", "-j", "1", "-o", OUT, "sweep.toml"),
+                names=("sweep.toml", *names),
+            )
+        )
+    both = _uncertainty_text(SCREEN, FRICTION) + '\n[vary]\n"material.E" = [1e9]\n'
+    out.append(
+        Input(
+            id="uncertainty/vary-and-uncertainty",
+            family="uncertainty",
+            files={"sweep.toml": both, "base.toml": base},
+            argv=("sweep", "-j", "1", "-o", OUT, "sweep.toml"),
+            names=("sweep.toml",),
+        )
+    )
+    out.append(
+        Input(
+            id="uncertainty/valid-screen",
+            family="uncertainty",
+            files={
+                "sweep.toml": _uncertainty_text(SCREEN, FRICTION),
+                "base.toml": base,
+            },
+            argv=("sweep", "-j", "1", "-o", OUT, "sweep.toml"),
+            expect=frozenset({0}),
+        )
+    )
+    return out
