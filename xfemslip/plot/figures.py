@@ -87,8 +87,12 @@ def _case_title(fig, results: Sequence[ResultData]) -> None:
 
 
 def _row_colorbar(fig, mappable, axes_row, label: str) -> None:
-    """One colour bar for a row of panels that share a colour scale."""
-    fig.colorbar(mappable, ax=list(axes_row), label=label, shrink=0.85, aspect=25)
+    """One colour bar for a row of panels that share a colour scale (beside
+    the single panel of a row of one)."""
+    if len(axes_row) > 1:
+        fig.colorbar(mappable, ax=list(axes_row), label=label, shrink=0.85, aspect=25)
+    else:
+        fig.colorbar(mappable, ax=axes_row[0], label=label, shrink=0.8)
 
 
 def _triangulation(data: ResultData):
@@ -139,10 +143,7 @@ def figure_displacement(results: Sequence[ResultData]) -> Figure:
             cs.set_linewidth(0.35)
             _frame(ax, data, f"{data.label}\n{word} displacement $u_{'xy'[comp]}$")
         label = f"{word} displacement $u_{'xy'[comp]}$ [mm]"
-        if len(results) > 1:
-            _row_colorbar(fig, cs, axes[i, :], label)
-        else:
-            fig.colorbar(cs, ax=axes[i, 0], label=label, shrink=0.8)
+        _row_colorbar(fig, cs, axes[i, :], label)
     _case_title(fig, results)
     return fig
 
@@ -173,10 +174,7 @@ def figure_principal(results: Sequence[ResultData]) -> Figure:
             ax.autoscale_view()
             _frame(ax, data, f"{data.label}\n{title}")
         label = f"{title} [MPa], tension positive"
-        if len(results) > 1:
-            _row_colorbar(fig, coll, axes[i, :], label)
-        else:
-            fig.colorbar(coll, ax=axes[i, 0], label=label, shrink=0.8)
+        _row_colorbar(fig, coll, axes[i, :], label)
     _case_title(fig, results)
     return fig
 
