@@ -44,7 +44,7 @@ _TYPES = {  # (kind, item size) -> VTK type
 PARALLEL_BYTES = 1 << 20
 
 
-def _compress(blocks: list[bytes]) -> list[bytes]:
+def _compress(blocks: list[memoryview]) -> list[bytes]:
     workers = min(len(blocks), os.cpu_count() or 1)
     if workers < 2 or sum(map(len, blocks)) < PARALLEL_BYTES:
         return [zlib.compress(b, LEVEL) for b in blocks]
@@ -54,7 +54,8 @@ def _compress(blocks: list[bytes]) -> list[bytes]:
 
 def _encode(data: np.ndarray) -> bytes:
     """The base64 text of one compressed binary DataArray."""
-    raw = np.ascontiguousarray(data).tobytes()
+    # zero-copy views of the array's bytes (zlib reads any buffer)
+    raw = memoryview(np.ascontiguousarray(data)).cast("B")
     blocks = [raw[i : i + BLOCK_SIZE] for i in range(0, len(raw), BLOCK_SIZE)]
     packed = _compress(blocks)
     last = len(blocks[-1]) if blocks else 0

@@ -17,7 +17,7 @@ The arrays of a file are one dict (point data per fracture point in
 component names of COMPONENT_NAMES.
 
 Every file is written atomically (:mod:`xfemslip.io.atomic`); the VTU files
-by :mod:`xfemslip.io.vtkxml` (meshio's ``Mesh`` only holds the data).  Given a
+by :mod:`xfemslip.io.vtkxml`.  Given a
 ``run_id``, each file carries it: the VTU files as the field data array
 ``run_id`` (1,) int64, the PVD as a comment.
 """
@@ -30,7 +30,6 @@ from collections.abc import Mapping, Sequence
 from pathlib import Path
 from xml.sax.saxutils import quoteattr
 
-import meshio
 import numpy as np
 
 from xfemslip.io.atomic import atomic_path, refuse_non_finite
@@ -105,14 +104,14 @@ def write_bulk(
     for name, values in cell_data.items():
         values = np.asarray(values)
         gathered[name] = [values[owner] for _, _, owner in blocks]
-    mesh = meshio.Mesh(
+    _write_vtu(
+        path,
         points,
         [(cell_type, conn) for cell_type, conn, _ in blocks],
-        point_data={"displacement": displacement},
-        cell_data=gathered,
-        field_data=_field_data(run_id),
+        {"displacement": displacement},
+        gathered,
+        run_id,
     )
-    _write_vtu(path, mesh)
 
 
 def write_fractures(
@@ -193,10 +192,7 @@ def write_fractures(
         if name != "points"
     }
     points = _pad_3d(np.concatenate([part["points"] for part in parts]), "points")
-    mesh = meshio.Mesh(
-        points, cells, point_data=point_data, field_data=_field_data(run_id)
-    )
-    _write_vtu(path, mesh)
+    _write_vtu(path, points, cells, point_data, {}, run_id)
     return True
 
 
@@ -247,13 +243,6 @@ def write_pvd(
         tmp.write_text("\n".join(lines), encoding="utf-8")
 
 
-def _field_data(run_id: int | None) -> dict[str, np.ndarray]:
-    """VTU field data: the set's ``run_id`` when given."""
-    if run_id is None:
-        return {}
-    return {"run_id": np.array([run_id], dtype=np.int64)}
-
-
 def _fracture_part(
     index: int, fields: FractureFields, faces=None
 ) -> dict[str, np.ndarray]:
@@ -293,24 +282,24 @@ def _pad_3d(xy, name: str) -> np.ndarray:
     return np.column_stack([xy, np.zeros(xy.shape[0])])
 
 
-def _write_vtu(path: Path | str, mesh: meshio.Mesh) -> None:
-    """Write ``mesh`` as VTU (binary, zlib) through a temporary file, with the
-    field data ``run_id`` and the component names of COMPONENT_NAMES."""
-    refuse_non_finite(mesh.points, f"{path}: points")
-    for name, value in mesh.point_data.items():
+def _write_vtu(path, points, cells, point_data, cell_data, run_id) -> None:
+    """Write a VTU (binary, zlib) through a temporary file, with the field
+    data ``run_id`` (when given) and the component names of COMPONENT_NAMES;
+    non-finite values are refused first."""
+    refuse_non_finite(points, f"{path}: points")
+    for name, value in point_data.items():
         refuse_non_finite(value, f"{path}: {name}")
-    for name, blocks in mesh.cell_data.items():
+    for name, blocks in cell_data.items():
         for value in blocks:
             refuse_non_finite(value, f"{path}: {name}")
-    run_id = mesh.field_data.get("run_id")
     with atomic_path(Path(path)) as tmp:
         write_vtu(
             tmp,
-            mesh.points,
-            [(block.type, block.data) for block in mesh.cells],
-            mesh.point_data,
-            mesh.cell_data,
-            None if run_id is None else {"run_id": int(run_id[0])},
+            points,
+            cells,
+            point_data,
+            cell_data,
+            None if run_id is None else {"run_id": int(run_id)},
             COMPONENT_NAMES,
         )
 
