@@ -11,13 +11,12 @@ The peak resident memory of a run is modelled from the sizes that set it
   per sub-triangle the vertex values: about QP_BYTES + QP_SLOT_BYTES * S
   per point, S the slots of the widest cell (the arrays are padded to it);
 - ``assembly``, while the stiffness is assembled: the padded element
-  matrices of the enriched cells, (8 + 2 S)^2 doubles each, the COO
-  triplets of every cell's entries with their conversion to CSR
-  (TRIPLET_BYTES per entry, ENRICHED_TRIPLET_BYTES more per entry of an
-  enriched cell, whose own triplets are still held while all are joined)
-  and, on the NumPy kernels, the shape-function gradients of all quadrature
-  points at once (NUMPY_QP_FUNCTION_BYTES per point and function, 4 + S
-  functions);
+  matrices of the enriched cells, (8 + 2 S)^2 doubles each, the intact
+  cells summed into the grid's CSR (GRID_BYTES per node), the COO triplets
+  of the enriched cells' entries with their conversion to CSR
+  (TRIPLET_BYTES per entry) and, on the NumPy kernels, the shape-function
+  gradients of all quadrature points at once (NUMPY_QP_FUNCTION_BYTES per
+  point and function, 4 + S functions);
 - ``solver``: the stiffness, its free-dof part, the Newton matrix and its
   CSC copy (MATRIX_BYTES per non-zero) and, with SuperLU, LU_FACTORS sparse
   LU factorizations (the kept one while the next is built), whose fill grows
@@ -89,9 +88,11 @@ BASE_NUMBA = 202e6  # measured 201 MB: the same case on the Numba kernels [B]
 QP_BYTES = 48.0  # per enriched-cell quadrature point: xy, w, triangle share [B]
 QP_SLOT_BYTES = 28.0  # per point and slot: F, grad F (24 B), vertex values [B]
 TRIPLET_BYTES = 48.0  # per COO entry: rows, cols, values and the CSR copy [B]
-# per COO entry of an enriched cell: its own rows, cols and values, held
-# while all cells' triplets are joined (assembly.assemble_bulk) [B]
-ENRICHED_TRIPLET_BYTES = 24.0
+# per grid node while the intact cells are summed into the grid's CSR
+# (assembly.grid_stiffness: 36 values per node in planes, their read-out with
+# int32 columns, the CSR and its sum with the enriched cells' part); measured
+# 750 B per node at 1000 x 1000 (peak 856 MB of the uncracked build) [B]
+GRID_BYTES = 800.0
 # per enriched-cell quadrature point and shape function, NumPy kernels only:
 # gradients, weighted gradients and their gathered cell data [B]
 NUMPY_QP_FUNCTION_BYTES = 56.0
@@ -106,7 +107,8 @@ LU_FACTORS = 2  # factorizations held at once
 PARDISO_BYTES = 6.0
 AMG_BYTES = 40.0  # per stiffness non-zero: hierarchy and its set-up [B]
 NEWTON_BLOCKS = 3  # contact tangent-block arrays held at once (+1 on NumPy)
-NNZ_PER_ENTRY = 0.56  # CSR non-zeros per COO entry (shared nodes summed)
+NNZ_PER_ENTRY = 0.53  # CSR non-zeros per COO entry (shared nodes summed, exact
+# cancellations left out: 0.52-0.55 on the shipped cases)
 # Enriched-cell quadrature points, estimated before the cells are cut: a
 # cell crossed by p fracture pieces has about QP_CELL + QP_PIECE p +
 # QP_PIECE2 p^2 points (its sub-triangles times 7), a cell near a branch
@@ -150,7 +152,7 @@ def estimate_terms(fp: Footprint) -> dict[str, float]:
     base = BASE_NUMBA if fp.numba else BASE_NUMPY
     enriched = fp.qp * (QP_BYTES + QP_SLOT_BYTES * fp.slots)
     gradients = 0.0 if fp.numba else NUMPY_QP_FUNCTION_BYTES * fp.qp * (4 + fp.slots)
-    triplets = TRIPLET_BYTES * fp.entries + ENRICHED_TRIPLET_BYTES * fp.enriched_entries
+    triplets = GRID_BYTES * fp.n_nodes + TRIPLET_BYTES * fp.enriched_entries
     assembly = fp.enriched_cells * (8 + 2 * fp.slots) ** 2 * 8.0
     assembly += max(gradients, triplets)  # one after the other
     if fp.linear == "amg":

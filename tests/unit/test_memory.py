@@ -20,6 +20,7 @@ from xfemslip.errors import MeshError, UsageError
 from xfemslip.fem.enrichment import find_candidates
 from xfemslip.memory import (
     ENV_LIMIT,
+    GRID_BYTES,
     LU_BYTES,
     LU_FACTORS,
     MATRIX_BYTES,
@@ -104,9 +105,11 @@ def test_terms_follow_their_sizes():
     assert estimate_terms(many)["solver"] == pytest.approx(
         4e5 * (MATRIX_BYTES + PARDISO_BYTES * math.log2(20_000))
     )
-    wide = replace(fp, enriched_cells=100, slots=10, entries=5e5, numba=True)
+    wide = replace(
+        fp, enriched_cells=100, slots=10, entries=6e5, enriched_entries=5e5, numba=True
+    )
     assert estimate_terms(wide)["assembly"] == pytest.approx(
-        100 * 28**2 * 8 + TRIPLET_BYTES * 5e5
+        100 * 28**2 * 8 + GRID_BYTES * 10_000 + TRIPLET_BYTES * 5e5
     )
     assert t["total"] == pytest.approx(
         t["base"]
