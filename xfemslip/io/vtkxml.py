@@ -1,8 +1,13 @@
-"""VTK XML unstructured grid (``.vtu``) writer: binary, zlib-compressed.
+"""VTK XML unstructured grid (``.vtu``) writer: zlib-compressed binary
+arrays in one raw appended section.
 
-The layout is the one VTK and meshio both read: inline ``format="binary"``
-arrays, each a base64 header of UInt64 block sizes followed by the base64 of
-its zlib-compressed blocks (VTK's ``vtkZLibDataCompressor``).
+The layout is the one VTK, ParaView and meshio read: each DataArray says
+``format="appended"`` and its ``offset`` into the ``<AppendedData
+encoding="raw">`` section at the end of the file, where its data are a
+header of UInt64 block sizes followed by its zlib-compressed blocks (VTK's
+``vtkZLibDataCompressor``).  Raw rather than base64: the file is a third
+smaller and no text encoding is made (base64 was a quarter of the writing
+time of a 986k-dof result).
 
 It is written here rather than by meshio because of time: meshio compresses
 at zlib's default level 6, one block after the other, which was 0.8 s of a
@@ -15,7 +20,6 @@ core.  It also writes field data (meshio 5 does not) and per-component names
 
 from __future__ import annotations
 
-import base64
 import os
 import zlib
 from collections.abc import Mapping, Sequence
@@ -32,6 +36,7 @@ CELL_TYPES = {"vertex": 1, "line": 3, "triangle": 5, "quad": 9}
 
 BLOCK_SIZE = 1 << 15  # bytes per compressed block (VTK's default)
 LEVEL = 1  # zlib level: 6 (the default) made files 0.3 % smaller in twice the time
+STORE_RATIO = 0.85  # arrays compressing worse than this are stored (_level)
 _TYPES = {  # (kind, item size) -> VTK type
     ("f", 8): "Float64",
     ("f", 4): "Float32",
@@ -44,16 +49,29 @@ _TYPES = {  # (kind, item size) -> VTK type
 PARALLEL_BYTES = 1 << 20
 
 
+def _level(blocks: list[memoryview]) -> int:
+    """LEVEL, or 0 (zlib's stored blocks: a copy and a checksum) for an
+    array whose first block does not shrink below STORE_RATIO: the stress
+    fields of a result compress to 0.89-0.94 of their size at level 1, which
+    was half the compression time of a 986k-dof result for 3 % of its bytes."""
+    if len(blocks) < 2:
+        return LEVEL
+    first = blocks[0]
+    return LEVEL if len(zlib.compress(first, LEVEL)) < STORE_RATIO * len(first) else 0
+
+
 def _compress(blocks: list[memoryview]) -> list[bytes]:
+    level = _level(blocks)
     workers = min(len(blocks), os.cpu_count() or 1)
     if workers < 2 or sum(map(len, blocks)) < PARALLEL_BYTES:
-        return [zlib.compress(b, LEVEL) for b in blocks]
+        return [zlib.compress(b, level) for b in blocks]
     with ThreadPoolExecutor(workers) as pool:
-        return list(pool.map(lambda b: zlib.compress(b, LEVEL), blocks))
+        return list(pool.map(lambda b: zlib.compress(b, level), blocks))
 
 
-def _encode(data: np.ndarray) -> bytes:
-    """The base64 text of one compressed binary DataArray."""
+def _encode(data: np.ndarray) -> list[bytes]:
+    """The appended bytes of one compressed DataArray: its header of block
+    sizes, then the compressed blocks."""
     # zero-copy views of the array's bytes (zlib reads any buffer)
     raw = memoryview(np.ascontiguousarray(data)).cast("B")
     blocks = [raw[i : i + BLOCK_SIZE] for i in range(0, len(raw), BLOCK_SIZE)]
@@ -62,25 +80,39 @@ def _encode(data: np.ndarray) -> bytes:
     header = np.array(
         [len(blocks), BLOCK_SIZE, last, *map(len, packed)], dtype="<u8"
     ).tobytes()
-    return base64.b64encode(header) + base64.b64encode(b"".join(packed))
+    return [header, *packed]
 
 
-def _data_array(fh, name: str, values, names: Sequence[str] | None = None) -> None:
-    data = np.asarray(values)
-    if (data.dtype.kind, data.dtype.itemsize) not in _TYPES:
-        data = data.astype(np.float64 if data.dtype.kind in "fc" else np.int64)
-    data = data.astype(data.dtype.newbyteorder("<"), copy=False)
-    vtk_type = _TYPES[data.dtype.kind, data.dtype.itemsize]
-    head = f'<DataArray type="{vtk_type}" Name={quoteattr(name)}'
-    if data.ndim == 2:
-        head += f' NumberOfComponents="{data.shape[1]}"'
-        for k, component in enumerate(names or ()):
-            head += f" ComponentName{k}={quoteattr(component)}"
-    elif data.ndim != 1:
-        raise ValueError(f"{name}: arrays must be (n,) or (n, k), not {data.shape}")
-    fh.write(f'{head} format="binary">\n'.encode())
-    fh.write(_encode(data))
-    fh.write(b"\n</DataArray>\n")
+class _Appended:
+    """The DataArray tags of one file and the raw bytes they point to."""
+
+    def __init__(self):
+        self.parts: list[bytes] = []
+        self.offset = 0
+
+    def data_array(self, fh, name: str, values, names: Sequence[str] | None = None):
+        data = np.asarray(values)
+        if (data.dtype.kind, data.dtype.itemsize) not in _TYPES:
+            data = data.astype(np.float64 if data.dtype.kind in "fc" else np.int64)
+        data = data.astype(data.dtype.newbyteorder("<"), copy=False)
+        vtk_type = _TYPES[data.dtype.kind, data.dtype.itemsize]
+        head = f'<DataArray type="{vtk_type}" Name={quoteattr(name)}'
+        if data.ndim == 2:
+            head += f' NumberOfComponents="{data.shape[1]}"'
+            for k, component in enumerate(names or ()):
+                head += f" ComponentName{k}={quoteattr(component)}"
+        elif data.ndim != 1:
+            raise ValueError(f"{name}: arrays must be (n,) or (n, k), not {data.shape}")
+        fh.write(f'{head} format="appended" offset="{self.offset}"/>\n'.encode())
+        parts = _encode(data)
+        self.parts.extend(parts)
+        self.offset += sum(map(len, parts))
+
+    def write(self, fh):
+        fh.write(b'<AppendedData encoding="raw">\n_')
+        for part in self.parts:
+            fh.write(part)
+        fh.write(b"\n</AppendedData>\n")
 
 
 def write_vtu(
@@ -115,6 +147,8 @@ def write_vtu(
         blocks.append((cell_type, conn.reshape(conn.shape[0], -1)))
     n_cells = sum(conn.shape[0] for _, conn in blocks)
     names = component_names or {}
+    arrays = _Appended()
+    _data_array = arrays.data_array
     with open(path, "wb") as fh:
         fh.write(
             b'<?xml version="1.0"?>\n<VTKFile type="UnstructuredGrid" '
@@ -172,4 +206,6 @@ def write_vtu(
                     )
                 _data_array(fh, name, values, names.get(name))
             fh.write(b"</CellData>\n")
-        fh.write(b"</Piece>\n</UnstructuredGrid>\n</VTKFile>\n")
+        fh.write(b"</Piece>\n</UnstructuredGrid>\n")
+        arrays.write(fh)
+        fh.write(b"</VTKFile>\n")
