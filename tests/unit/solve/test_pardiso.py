@@ -354,3 +354,15 @@ def test_the_library_is_found_without_walking_the_environment(monkeypatch):
         h.release()
     for x in answers:
         assert np.linalg.norm(x - x_ref) <= 1e-12 * np.linalg.norm(x_ref)
+
+
+def test_row_sums_match_scipy_with_empty_rows():
+    """The per-row sums the Schur set-up uses: scipy's row sums, empty rows
+    (5 of 50 here, and a leading and trailing one) included."""
+    from xfemslip.solve.pardiso import _row_sums
+
+    A = sp.random(50, 50, density=0.05, format="csr", random_state=1)
+    assert (np.diff(A.indptr) == 0).sum() > 0
+    assert np.allclose(_row_sums(A.data, A.indptr), np.asarray(A.sum(axis=1)).ravel())
+    counts = _row_sums(np.ones(3) > 0, np.array([0, 0, 2, 3, 3]))
+    assert counts.tolist() == [0, 2, 1, 0]
