@@ -107,8 +107,7 @@ LU_FACTORS = 2  # factorizations held at once
 PARDISO_BYTES = 6.0
 AMG_BYTES = 40.0  # per stiffness non-zero: hierarchy and its set-up [B]
 NEWTON_BLOCKS = 3  # contact tangent-block arrays held at once (+1 on NumPy)
-NNZ_PER_ENTRY = 0.53  # CSR non-zeros per COO entry (shared nodes summed, exact
-# cancellations left out: 0.52-0.55 on the shipped cases)
+NNZ_PER_ENTRY = 0.56  # CSR non-zeros per COO entry (shared nodes summed)
 # Enriched-cell quadrature points, estimated before the cells are cut: a
 # cell crossed by p fracture pieces has about QP_CELL + QP_PIECE p +
 # QP_PIECE2 p^2 points (its sub-triangles times 7), a cell near a branch
