@@ -156,7 +156,10 @@ def add_to_grid(mesh, K_grid, rows, cols, vals, n) -> sp.csr_matrix:
         inside = (in_y[:, :, None] & in_x[:, None, :]).reshape(-1, 9)
         before = np.cumsum(inside, axis=1) - inside
         pos = K_grid.indptr[r] + 2 * before[np.arange(r.size), k] + c % 2
-        np.add.at(data, pos, vals[std])
+        if pos.size > data.size // 16:  # many entries (networks): one pass
+            data += np.bincount(pos, weights=vals[std], minlength=data.size)
+        else:
+            np.add.at(data, pos, vals[std])
     tail = sp.coo_matrix((vals[~std], (rows[~std], cols[~std])), shape=(n, n)).tocsr()
     tail.sum_duplicates()
     indptr = np.zeros(n + 1, dtype=np.int64)
@@ -165,15 +168,21 @@ def add_to_grid(mesh, K_grid, rows, cols, vals, n) -> sp.csr_matrix:
     # the tail's entries of row r go after the grid's, at indptr[r + 1]: the
     # grid's arrays are copied run by run between those points (np.insert
     # took twice as long: it indexes every entry)
-    counts = np.diff(tail.indptr)
-    rows_with = np.nonzero(counts)[0]
-    points = indptr[rows_with + 1]
+    # one run per distinct point: the enriched rows all go after the last
+    # grid entry
+    ends = np.cumsum(np.diff(tail.indptr))
+    row_points = indptr[1:]
+    last = np.nonzero(np.r_[row_points[1:] != row_points[:-1], True])[0]
+    counts = np.diff(np.r_[0, ends[last]])
+    points = row_points[last]
+    keep = counts > 0
+    counts, points = counts[keep], points[keep]
     index_type = K_grid.indices.dtype
     out_indptr = (indptr + tail.indptr).astype(index_type)
     out_data = np.empty(out_indptr[-1])
     out_indices = np.empty(out_indptr[-1], dtype=index_type)
     src = dst = t = 0
-    for point, count in zip(points.tolist(), counts[rows_with].tolist(), strict=True):
+    for point, count in zip(points.tolist(), counts.tolist(), strict=True):
         run = point - src
         out_data[dst : dst + run] = data[src:point]
         out_indices[dst : dst + run] = K_grid.indices[src:point]

@@ -293,8 +293,14 @@ def build_enriched_cells(mesh, fractures, cand: Candidates) -> EnrichedCells:
     Fv = np.zeros((tris.shape[0], 3, S))
     e_used, s_used = np.nonzero(used)
     group = cand.fracture[k_used] * (1 << 32) + (cand.tip[k_used] + (1 << 31))
-    for g in np.unique(group):
-        mine = group == g
+    # the slots of each group as one slice of a stable sort (in the order a
+    # mask `group == g` gives) rather than a mask over all slots per group:
+    # 1,733 groups x 130k slots on a 100-fracture network
+    by_group = np.argsort(group, kind="stable")
+    _, starts = np.unique(group[by_group], return_index=True)
+    bounds = np.append(starts, group.size).tolist()
+    for lo, hi in zip(bounds[:-1], bounds[1:], strict=True):
+        mine = by_group[lo:hi]
         k0 = k_used[mine][0]
         fi, tip = int(cand.fracture[k0]), int(cand.tip[k0])
         cells = np.unique(e_used[mine])  # rows of the cells the group reaches
