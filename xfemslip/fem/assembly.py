@@ -5,8 +5,9 @@ Intact cells share one 2x2-Gauss rectangle stiffness per distinct (hx, hy);
 enriched cells go through the sub-cell kernel.  The intact cells are summed
 straight into the CSR data of the structured grid (grid_stiffness: node (i, j)
 couples to its 3 x 3 neighbourhood, so every row's columns are known without
-forming and sorting (row, column, value) triplets); the enriched cells' few
-entries are COO -> CSR and added.
+forming and sorting (row, column, value) triplets); the enriched cells'
+entries are added to it in place or appended to their rows (add_to_grid),
+which keeps the grid's pattern.
 """
 
 from __future__ import annotations
@@ -76,21 +77,20 @@ def grid_stiffness(mesh, cells, K_u, which) -> sp.csr_matrix:
     weight = listed.astype(np.float64)
     planes = np.zeros((9, 2, 2, ny + 1, nx + 1))
     work = np.empty((ny, nx))
-    for p, (px, py) in enumerate(_CELL_OFFSETS):
-        for q, (qx, qy) in enumerate(_CELL_OFFSETS):
-            k = (qy - py + 1) * 3 + (qx - px + 1)
-            for a in range(2):
-                for b in range(2):
-                    if which.size == 0:
-                        continue
-                    if uniform:
-                        np.multiply(
-                            weight, K_u[which[0], 2 * p + a, 2 * q + b], out=work
-                        )
-                    else:
-                        np.take(K_u[:, 2 * p + a, 2 * q + b], index, out=work)
-                        work *= weight
-                    planes[k, a, b, py : py + ny, px : px + nx] += work
+    # each local node pair (p, q) and component pair (a, b): the cells'
+    # entries land on node p's row, neighbour k of it (where q sits)
+    pairs = [
+        (p, q, a, b) for p in range(4) for q in range(4) for a in (0, 1) for b in (0, 1)
+    ]
+    for p, q, a, b in pairs if which.size else []:
+        (px, py), (qx, qy) = _CELL_OFFSETS[p], _CELL_OFFSETS[q]
+        k = (qy - py + 1) * 3 + (qx - px + 1)
+        if uniform:
+            np.multiply(weight, K_u[which[0], 2 * p + a, 2 * q + b], out=work)
+        else:
+            np.take(K_u[:, 2 * p + a, 2 * q + b], index, out=work)
+            work *= weight
+        planes[k, a, b, py : py + ny, px : px + nx] += work
     d = np.array([-1, 0, 1])
     in_y = ((np.arange(ny + 1)[:, None] + d) >= 0) & (
         (np.arange(ny + 1)[:, None] + d) <= ny
@@ -125,7 +125,7 @@ def grid_stiffness(mesh, cells, K_u, which) -> sp.csr_matrix:
 def add_to_grid(mesh, K_grid, rows, cols, vals, n) -> sp.csr_matrix:
     """K_grid (grid_stiffness) plus the entries (rows, cols, vals) as (n, n)
     CSR, n >= 2 n_nodes, keeping K_grid's pattern (its zeros too; scipy's
-    sum drops them).
+    sum drops them).  K_grid's data are added to in place.
 
     An entry between two standard dofs lies in the grid's pattern (both
     nodes belong to one cell) and is added where it is; the others (a row or
@@ -138,7 +138,9 @@ def add_to_grid(mesh, K_grid, rows, cols, vals, n) -> sp.csr_matrix:
     cols = np.asarray(cols, dtype=np.int64)
     vals = np.asarray(vals, dtype=np.float64)
     std = (rows < n_std) & (cols < n_std)
-    data = K_grid.data  # added to in place: K_grid is not used after
+    if vals.size == 0 and n == n_std:
+        return K_grid
+    data = K_grid.data
     if std.any():
         r, c = rows[std], cols[std]
         i, j = r // 2, c // 2
@@ -166,10 +168,9 @@ def add_to_grid(mesh, K_grid, rows, cols, vals, n) -> sp.csr_matrix:
     indptr[: n_std + 1] = K_grid.indptr
     indptr[n_std + 1 :] = K_grid.indptr[-1]
     # the tail's entries of row r go after the grid's, at indptr[r + 1]: the
-    # grid's arrays are copied run by run between those points (np.insert
-    # took twice as long: it indexes every entry)
-    # one run per distinct point: the enriched rows all go after the last
-    # grid entry
+    # grid's arrays are copied run by run between those points, one run per
+    # distinct point (the enriched rows all go after the last grid entry);
+    # np.insert took twice as long: it indexes every entry
     ends = np.cumsum(np.diff(tail.indptr))
     row_points = indptr[1:]
     last = np.nonzero(np.r_[row_points[1:] != row_points[:-1], True])[0]
