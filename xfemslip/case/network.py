@@ -22,16 +22,8 @@ from xfemslip.case.segments import PROPERTY_RULES, read_segments_file
 from xfemslip.case.specs import FractureSpec
 from xfemslip.case.tables import Table, frozen
 
-NETWORK_KEYS = (
-    "file",
-    "generate",
-    "friction",
-    "cohesion",
-    "kn",
-    "kt",
-    "tip",
-    "hydraulic",
-)
+# the network's own keys, then the properties its fractures take
+NETWORK_KEYS = ("file", "generate", *PROPERTY_RULES, "tip", "hydraulic")
 
 
 def network_table(root: Table) -> Table | None:

@@ -49,6 +49,17 @@ def std_cell_dofs(cells: np.ndarray) -> np.ndarray:
 _CELL_OFFSETS = ((0, 0), (1, 0), (1, 1), (0, 1))
 
 
+def _neighbours_inside(ix, iy, nx, ny) -> np.ndarray:
+    """(..., 9) bool: whether neighbour k = 3 (dy + 1) + (dx + 1) of the node
+    (ix, iy) (broadcast together) lies inside the (nx + 1) x (ny + 1) grid."""
+    d = np.array([-1, 0, 1])
+    x = np.asarray(ix)[..., None] + d
+    y = np.asarray(iy)[..., None] + d
+    in_x, in_y = (x >= 0) & (x <= nx), (y >= 0) & (y <= ny)
+    inside = in_y[..., :, None] & in_x[..., None, :]
+    return inside.reshape(*inside.shape[:-2], 9)
+
+
 def grid_stiffness(mesh, cells, K_u, which) -> sp.csr_matrix:
     """The sum of the element matrices K_u[which] (m, 8, 8) of the listed
     cells (m,) as (2 n_nodes, 2 n_nodes) CSR, with canonical (sorted,
@@ -91,21 +102,14 @@ def grid_stiffness(mesh, cells, K_u, which) -> sp.csr_matrix:
             np.take(K_u[:, 2 * p + a, 2 * q + b], index, out=work)
             work *= weight
         planes[k, a, b, py : py + ny, px : px + nx] += work
-    d = np.array([-1, 0, 1])
-    in_y = ((np.arange(ny + 1)[:, None] + d) >= 0) & (
-        (np.arange(ny + 1)[:, None] + d) <= ny
-    )
-    in_x = ((np.arange(nx + 1)[:, None] + d) >= 0) & (
-        (np.arange(nx + 1)[:, None] + d) <= nx
-    )
-    # (ny+1, nx+1, 9): whether neighbour k = 3 (dy + 1) + (dx + 1) is inside
-    inside = (in_y[:, None, :, None] & in_x[None, :, None, :]).reshape(
-        ny + 1, nx + 1, 9
+    inside = _neighbours_inside(
+        np.arange(nx + 1)[None, :], np.arange(ny + 1)[:, None], nx, ny
     )
     keep = np.broadcast_to(inside[:, :, None, :, None], (ny + 1, nx + 1, 2, 9, 2))
     values = planes.transpose(3, 4, 1, 0, 2)[keep]
     del planes
     index_type = np.int32 if 2 * N + 2 < 2**31 and values.size < 2**31 else np.int64
+    d = (-1, 0, 1)
     step = np.array([dy * (nx + 1) + dx for dy in d for dx in d], dtype=index_type)
     node = np.arange(N, dtype=index_type).reshape(ny + 1, nx + 1)
     col = 2 * (node[:, :, None, None, None] + step[None, None, None, :, None])
@@ -149,13 +153,9 @@ def add_to_grid(mesh, K_grid, rows, cols, vals, n) -> sp.csr_matrix:
         if np.abs(dx).max() > 1 or np.abs(dy).max() > 1:
             raise ValueError("an entry between standard dofs outside one cell")
         k = (dy + 1) * 3 + (dx + 1)
-        # the neighbours of node i inside the grid before neighbour k, from
-        # its row length and position in the grid
-        ix, iy = i % (nx + 1), i // (nx + 1)
-        ny = mesh.ny
-        in_x = np.stack([ix > 0, np.ones_like(ix, bool), ix < nx], axis=1)
-        in_y = np.stack([iy > 0, np.ones_like(iy, bool), iy < ny], axis=1)
-        inside = (in_y[:, :, None] & in_x[:, None, :]).reshape(-1, 9)
+        # the neighbours of node i inside the grid before neighbour k: the
+        # entry's place in the row grid_stiffness wrote
+        inside = _neighbours_inside(i % (nx + 1), i // (nx + 1), nx, mesh.ny)
         before = np.cumsum(inside, axis=1) - inside
         pos = K_grid.indptr[r] + 2 * before[np.arange(r.size), k] + c % 2
         if pos.size > data.size // 16:  # many entries (networks): one pass
