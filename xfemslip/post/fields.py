@@ -22,7 +22,8 @@ import numpy as np
 
 from xfemslip.contact.interface import JUMP_PROBE
 from xfemslip.fem.enrichment import HEAVISIDE, find_candidates, group_values
-from xfemslip.fem.poro import fluid_pressure
+from xfemslip.fem.poro import cell_centres
+from xfemslip.fem.zones import in_situ_stress
 from xfemslip.geometry.fracture import GEOMETRY_TOL
 
 
@@ -110,8 +111,9 @@ def bulk_fields(
     """stress (M, 3), stress_zz (M,), principal_stress (M, 2) [Pa] (total).
 
     With several materials (xfemslip.fem.poro): D (k, 3, 3), nu (k,) and
-    ``cell_material`` (M,).  With pore pressure, ``biot_p`` = (alpha p0,
-    alpha p (M,)) [Pa] at this step: sigma = sigma0 + D eps - alpha (p - p0) m
+    ``cell_material`` (M,).  ``initial_stress``: (3,), or (M, 3) varying with
+    depth.  With pore pressure, ``biot_p`` = (alpha p0, alpha p) [Pa] (each
+    (M,) or a number) at this step: sigma = sigma0 + D eps - alpha (p - p0) m
     and, in plane strain, sigma_zz = nu (sigma'_xx + sigma'_yy) - alpha p with
     sigma' = sigma0 + alpha p0 m + D eps (see xfemslip.fem.poro).
     """
@@ -122,8 +124,8 @@ def bulk_fields(
     else:
         stress = np.einsum("mij,mj->mi", np.asarray(D)[cell_material], eps)
         nu_c = np.asarray(nu, float)[cell_material]
-    if initial_stress is not None:
-        stress = stress + np.asarray(initial_stress, float)[None, :]
+    if initial_stress is not None:  # (3,) uniform or (M, 3) per cell
+        stress = stress + np.atleast_2d(np.asarray(initial_stress, float))
     a0, a = (0.0, np.zeros(mesh.n_cells)) if biot_p is None else biot_p
     # stress is sigma0 + D eps here, i.e. sigma' - alpha p0 m
     szz = (
@@ -295,22 +297,33 @@ def vis_mesh_with_faces(model, u) -> VisMesh:
     return vis
 
 
+def cell_in_situ(model):
+    """The in-situ stress of every cell: ``initial_stress`` (3,) when uniform
+    (or None), else (M, 3) [Pa] at the cell centres in their zones."""
+    spec = model.spec
+    if spec.loading.in_situ is None:
+        return spec.loading.initial_stress
+    mats = model.materials
+    p0 = None if model.pore is None else model.pore.cell_p0
+    return in_situ_stress(spec, mats.zones, cell_centres(model.mesh), mats.cell, p0)
+
+
 def step_fields(model, r) -> StepFields:
     """The fields of the converged step ``r`` (a ``StepResult``) of ``model``
     (a :class:`xfemslip.simulation.Model`)."""
     spec = model.spec
     mats, pore = model.materials, model.pore
-    hetero = spec.reservoir is not None
+    hetero = bool(spec.units)
     biot_p = None
     if pore is not None:
         p = pore.cell_pressure(r.load_factor)
-        biot_p = (pore.biot * pore.initial, pore.biot * p)
+        biot_p = (pore.cell_biot * pore.cell_p0, pore.cell_biot * p)
     stress, szz, principal = bulk_fields(
         model.mesh,
         model.bulk,
         mats.D if hetero else model.D,
         r.u,
-        spec.loading.initial_stress,
+        cell_in_situ(model),
         mats.nu if hetero else spec.material.nu,
         spec.material.model,
         cell_material=mats.cell if hetero else None,
@@ -323,7 +336,7 @@ def step_fields(model, r) -> StepFields:
             "effective_stress": stress + biot_p[1][:, None] * [1.0, 1.0, 0.0],
             "pore_pressure": p,
         }
-        fluid = fluid_pressure(model.ip, pore, r.load_factor)
+        fluid = pore.fluid(r.load_factor)
     n_std = 2 * model.mesh.n_nodes
     return StepFields(
         step=r.step,
