@@ -162,8 +162,14 @@ def _read_in_situ(loading: Table) -> InSituSpec | None:
         for key in ("xx", "gradient_xx"):
             if table.has(key):
                 table.error(key, "give either ratio_xx or xx and gradient_xx")
-        if table.data["ratio_xx"] == "uniaxial_strain":
+        value = table.data["ratio_xx"]
+        if value == "uniaxial_strain":
             ratio = "uniaxial_strain"
+        elif isinstance(value, str):
+            table.error(
+                "ratio_xx",
+                f'expected a number or "uniaxial_strain", got {show(value)}',
+            )
         else:
             ratio = table.number(
                 "ratio_xx",

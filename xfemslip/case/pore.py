@@ -27,13 +27,15 @@ def read_pore_pressure(root: Table, in_situ_datum=None) -> PorePressureSpec | No
     region = table.string("region", "all")
     gradient = table.number("gradient", 0.0)
     datum = table.number("datum", in_situ_datum)
-    if gradient not in (None, 0.0) and datum is None and not table.has("datum"):
+    loading = root.data.get("loading")
+    stress = loading.get("initial_stress") if isinstance(loading, dict) else None
+    stress_datum = isinstance(stress, dict) and "datum" in stress
+    if gradient not in (None, 0.0) and datum is None and not stress_datum:
         table.error(
             "datum",
             "required key missing: a gradient needs the datum, the y [m] of "
             "zero depth (or loading.initial_stress.datum)",
         )
-    loading = root.data.get("loading")
     has_initial = isinstance(loading, dict) and "initial_stress" in loading
     for key, value in (("initial", initial), ("gradient", gradient)):
         if value not in (None, 0.0) and not has_initial:

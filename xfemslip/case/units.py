@@ -10,7 +10,8 @@ overpressure.  What a unit leaves out is the host's (``[material]``,
 "reservoir" (its E and nu required, as always).
 
 Polygon and box edges that lie within ``SNAP_CELLS`` local cell sizes of a
-fracture, along it, are moved onto it (:func:`snap_to_fractures`): an edge
+fracture, along it, are moved onto it, each end sliding along its other
+edge (:func:`snap_to_fractures`): an edge
 typed a few millimetres off a fault would otherwise put a sliver of the
 wrong rock and pressure beside it, which moves the onset of slip (the
 loading jumps at the wrong place along the fault).
@@ -201,9 +202,9 @@ def _local_size(grid, point) -> float:
 
 
 def _nearest_line(fractures, p, q, tol):
-    """(fracture index, distance, projected p, projected q) of the first
-    fracture segment whose line passes within ``tol`` of both p and q with
-    p-q lying along it, or None."""
+    """(fracture index, distance, a point on its line, its unit tangent) of
+    the first fracture segment whose line passes within ``tol`` of both p and
+    q with p-q lying along it, or None."""
     for fr in fractures:
         P = np.asarray(fr.points, float)
         for a, b in zip(P[:-1], P[1:], strict=True):
@@ -216,15 +217,30 @@ def _nearest_line(fractures, p, q, tol):
             sp, sq = sorted((float((p - a) @ t), float((q - a) @ t)))
             if sq < -tol or sp > L + tol:  # beside the segment, not along it
                 continue
-            return fr.index, max(abs(dp), abs(dq)), p - dp * n, q - dq * n
+            return fr.index, max(abs(dp), abs(dq)), a, t
     return None
+
+
+def _onto_line(v, towards, a, t):
+    """v moved onto the line (a, t) along the edge from ``towards`` to v (so
+    the neighbouring edge keeps its direction: a corner on a horizon stays on
+    it), or straight across when that edge runs along the line."""
+    e = v - towards
+    den = e[0] * t[1] - e[1] * t[0]
+    n = np.array([-t[1], t[0]])
+    if abs(den) <= 1e-9 * float(np.hypot(*e)):
+        return v - float((v - a) @ n) * n
+    w = a - towards
+    k = (w[0] * t[1] - w[1] * t[0]) / den
+    return towards + k * e
 
 
 def snap_to_fractures(region: RegionSpec, fractures, grid):
     """(region, snapped): the region with every polygon/box edge that lies
     within SNAP_CELLS local cell sizes of a fracture, along it, moved onto it
-    (boxes become a polygon then), and (edge name, fracture, distance [m])
-    of each edge moved."""
+    (each end slides along its other edge, so corners stay on their
+    horizons; boxes become a polygon then), and (edge name, fracture,
+    distance [m]) of each edge moved."""
     if grid is None or not fractures or region.kind not in ("polygon", "boxes"):
         return region, ()
     if region.kind == "boxes" and len(region.boxes) > 1:
@@ -237,14 +253,16 @@ def snap_to_fractures(region: RegionSpec, fractures, grid):
     else:
         P = np.array(region.polygon, float)
         names = [f"polygon edge {i}" for i in range(len(P))]
+    k = len(P)
     moved = []
-    for i in range(len(P)):
-        j = (i + 1) % len(P)
-        mid = 0.5 * (P[i] + P[j])
-        tol = SNAP_CELLS * _local_size(grid, mid)
+    for i in range(k):
+        j = (i + 1) % k
+        tol = SNAP_CELLS * _local_size(grid, 0.5 * (P[i] + P[j]))
         hit = _nearest_line(fractures, P[i], P[j], tol)
         if hit is not None:
-            index, distance, P[i], P[j] = hit
+            index, distance, a, t = hit
+            P[i] = _onto_line(P[i], P[(i - 1) % k], a, t)
+            P[j] = _onto_line(P[j], P[(j + 1) % k], a, t)
             moved.append((names[i], index, distance))
     if not moved:
         return region, ()

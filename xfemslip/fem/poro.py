@@ -352,12 +352,13 @@ def _fluid(spec, zones, ip, eps, ratio, uniform, fractures):
     interface point, eq. (3): each fracture's rule on its two faces."""
     sides = []
     for sign in (1.0, -1.0):
-        xy = ip.xy + sign * eps * ip.normal
-        zone = zones.at(xy)
+        zone = zones.at(ip.xy + sign * eps * ip.normal)
+        # the depth term at the point itself (it is continuous), the face's
+        # unit for its overpressure
         p0 = (
             np.full(ip.n, spec.pore_pressure.initial)
             if uniform
-            else initial_pressure(spec, zones, xy, zone)
+            else initial_pressure(spec, zones, ip.xy, zone)
         )
         sides.append((p0, ratio[zone]))
     (p0_plus, r_plus), (p0_minus, r_minus) = sides
