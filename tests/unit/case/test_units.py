@@ -9,6 +9,7 @@ import numpy as np
 import pytest
 
 from xfemslip.case import build, loads_case
+from xfemslip.case.plausibility import plausibility_warnings
 from xfemslip.errors import CaseError
 
 
@@ -318,6 +319,8 @@ def test_a_polygon_edge_typed_off_the_fault_is_moved_onto_it():
     ((edge, fracture, distance),) = u.snapped
     assert (edge, fracture) == ("polygon edge 0", 0)
     assert distance == pytest.approx(0.1, rel=1e-9)
+    (warning,) = plausibility_warnings(_load(_case(units=units)))
+    assert warning.startswith("units[0]: polygon edge 0 lies 0.1 m off fractures[0]")
     # half a cell off: a feature the mesh resolves, kept as typed
     polygon[0] = list(p + 50.0 * n)
     polygon[1] = list(q + 50.0 * n)
