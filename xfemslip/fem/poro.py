@@ -204,6 +204,29 @@ def _warn_unaligned(mesh, reservoir, fractures=()) -> None:
         )
 
 
+def material_at(spec, xy) -> np.ndarray:
+    """(n,) int64 material at the points ``xy`` (n, 2) [m]: RESERVOIR where
+    a point lies in the ``[reservoir]`` region
+    (:func:`xfemslip.geometry.regions.in_region`), else HOST.  The one rule
+    for cell centres, quadrature points and the faces of fractures."""
+    xy = np.asarray(xy, float).reshape(-1, 2)
+    material = np.full(xy.shape[0], HOST, np.int64)
+    if spec.reservoir is not None:
+        material[in_region(xy, spec.reservoir)] = RESERVOIR
+    return material
+
+
+def face_materials(spec, ip, eps) -> tuple[np.ndarray, np.ndarray]:
+    """(n_ip,) material of the + and of the - face of every interface point:
+    :func:`material_at` the points x + eps n and x - eps n (eps [m], normally
+    FACE_OFFSET h_min).  A fracture inside one material has it on both faces;
+    a fault bounding the reservoir has the reservoir on one face only."""
+    return (
+        material_at(spec, ip.xy + eps * ip.normal),
+        material_at(spec, ip.xy - eps * ip.normal),
+    )
+
+
 def _area_majority(ec, qp_material, n_materials) -> np.ndarray:
     """(nc,) material covering most of each enriched cell's area."""
     cell_of_qp = np.repeat(np.arange(ec.cells.size), np.diff(ec.qp_offsets))
@@ -217,16 +240,15 @@ def build_materials(spec, mesh, ec=None, fractures=()) -> Materials:
     given the enriched cells ``ec``, per enriched-cell quadrature point."""
     m = spec.material
     E, nu = [m.E], [m.nu]
-    cell = np.zeros(mesh.n_cells, np.int64)
+    cell = material_at(spec, cell_centres(mesh))
     qp = None
     r = spec.reservoir
     if r is not None:
         E.append(r.E)
         nu.append(r.nu)
-        cell[in_region(cell_centres(mesh), r)] = RESERVOIR
         _warn_unaligned(mesh, r, fractures)
         if ec is not None and ec.cells.size:
-            qp = np.where(in_region(ec.qp_xy, r), RESERVOIR, HOST)
+            qp = material_at(spec, ec.qp_xy)
             cell[ec.cells] = _area_majority(ec, qp, 2)
     D = np.stack([elasticity_matrix(e, v, m.model) for e, v in zip(E, nu, strict=True)])
     return Materials(
@@ -277,8 +299,7 @@ def _face_mean(spec, ip, eps) -> np.ndarray:
     """(n_ip,) mean over the two faces of c (1 = the pressure changes), eq. (3)."""
     if spec.pore_pressure.region != "reservoir":
         return np.ones(ip.n)
-    plus = in_region(ip.xy + eps * ip.normal, spec.reservoir)
-    minus = in_region(ip.xy - eps * ip.normal, spec.reservoir)
+    plus, minus = (face == RESERVOIR for face in face_materials(spec, ip, eps))
     return 0.5 * (plus.astype(float) + minus)
 
 
