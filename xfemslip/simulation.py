@@ -43,7 +43,12 @@ from xfemslip.geometry.junctions import build_fractures
 from xfemslip.io.results import run_folder, write_results
 from xfemslip.memory import check_memory, enriched_footprint, model_footprint
 from xfemslip.post.events import event_inputs, event_table
-from xfemslip.post.fields import first_non_finite, step_fields, vis_mesh_with_faces
+from xfemslip.post.fields import (
+    first_non_finite,
+    fracture_properties,
+    step_fields,
+    vis_mesh_with_faces,
+)
 from xfemslip.post.hydraulics import add_permeability
 from xfemslip.post.result import Result, run_id
 from xfemslip.solve.newton import NewtonSolver, Problem
@@ -412,10 +417,12 @@ def collect_result(model: Model, results, *, converged, wall):
         "n_dofs": int(model.problem.n_dofs),
         "kernels": model.kernels,
         "status_codes": STATE_CODES,
+        "material_model": spec.material.model,
     }
     attrs["run_id"] = run_id(attrs, model.mesh.nodes, model.mesh.cells, fields)
     result = Result(attrs, model.mesh.nodes, model.mesh.cells, fields)
-    # derived from the fields and the case, so outside run_id
+    # of the case and derived from the fields, so outside run_id
+    result.fracture_properties = fracture_properties(model)
     result.events = event_table(result, event_inputs(result, spec))
     add_permeability(result, spec)
     if bad is None:

@@ -325,6 +325,9 @@ def test_run_leaves_complete_output_or_none(
         for name in _datasets(f):
             value = f[name][()]
             if value.dtype.kind == "f":
+                # the one NaN of the format: a stress drop that is undefined
+                if name == "events/stress_drop":
+                    value = np.where(np.isnan(value), 0.0, value)
                 assert np.all(np.isfinite(value)), name
 
 

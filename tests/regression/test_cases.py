@@ -64,6 +64,7 @@ FRACTURE_DATASETS = {  # name: (trailing shape, dtype kind)
     "normal_traction": ((), "f"),
     "shear_traction": ((), "f"),
     "state": ((), "i"),
+    "plastic_slip": ((), "f"),
 }
 ROOT_ATTRS = (
     "format_version",
@@ -270,8 +271,19 @@ def check_derived(f, doc, steps, n_fractures):
     assert list(events["step"][()]) == list(range(1, steps + 1))
     for name in ("slipped", "max_slip", "slipping_length", "moment_per_length"):
         assert events[name].shape == (steps, n_fractures), name
-    for name in ("stress_drop", "extent", "moment"):
+    for name in ("extent", "moment"):
         assert np.all(events[name][()] >= 0.0), name
+    # the stress drop: positive where there is a slipping length, else NaN
+    drop, length = events["stress_drop"][()], events["slipping_length"][()]
+    assert np.all(np.isnan(drop[length == 0.0])), "stress_drop"
+    assert np.all(drop[length > 0.0] > 0.0), "stress_drop"
+    for i in range(n_fractures):  # the elastic constants and ends, root only
+        g = f[f"fractures/{i}"]
+        K = g["s"].shape[0]
+        assert g["shear_modulus"].shape == g["poisson_ratio"].shape == (K,)
+        assert np.all(g["shear_modulus"][()] > 0.0)
+        lo, hi = g.attrs["ends"]
+        assert lo <= g["s"][0] < g["s"][-1] <= hi
     if "permeability" not in doc:
         assert "permeability" not in f
         assert "aperture" not in f["fractures/0"]

@@ -9,9 +9,13 @@ sqrt(a^2 - x^2), whose integral gives the seismic moment per unit length
     M0' = mu int |s| ds = pi a^2 (kappa + 1) dtau / 4,   kappa = 3 - 4 nu,
 
 and the crack-model stress drop recovers dtau from M0' and the slipping
-length 2a.  The error of the moment is that of the slip integral (the slip's
-relative L2 error of this setup is 1.17 %; measured: M0' 1.24 % low,
-the midpoint stretches missing part of the sqrt profile next to the tips).
+length 2a.  The slip counted is the one that slid, one value per contact
+patch (about 1.5 cells): the patch's mean jump less the elastic give of the
+penalty, dtau / k_T here.  The error of the moment is that of the slip
+integral (the jump's relative L2 error of this setup is 1.17 %; measured:
+M0' 1.11 % low, the midpoint stretches missing part of the sqrt profile next
+to the tips); the max slip is the middle patch's mean of the profile's peak,
+2.1 % low.
 """
 
 from __future__ import annotations
@@ -51,7 +55,7 @@ def test_moment_of_the_released_crack_matches_the_closed_form(tmp_path):
     assert spec.events.extent == W
     run_case(spec, tmp_path / "out")
     result = xfemslip.read_result(tmp_path / "out")
-    # computed from the result read back alone (the case text it carries)
+    # computed from the result read back alone (what it stores)
     inputs = event_inputs(result)
     assert inputs.extent == W and inputs.note == ""
     ((event,),) = event_sizes(result, inputs)
@@ -59,7 +63,7 @@ def test_moment_of_the_released_crack_matches_the_closed_form(tmp_path):
     kappa = 3.0 - 4.0 * NU
     exact = math.pi * A**2 * (kappa + 1.0) * dtau / 4.0  # N m / m
     error = abs(event.moment_per_length - exact) / exact
-    assert error < 0.015, error  # measured 1.24 % (low: the tips)
+    assert error < 0.015, error  # measured 1.11 % (low: the tips)
     assert event.slipped
     assert event.slipping_length == pytest.approx(2.0 * A, rel=1e-12)
     # the crack model inverts the same closed form: dtau to the moment's error
@@ -71,7 +75,9 @@ def test_moment_of_the_released_crack_matches_the_closed_form(tmp_path):
     exact_max = cf.slip_profile(
         np.array([A]), A, E, NU, "plane_strain", SIGMA0, 45.0, F
     )[0]
-    assert event.max_slip == pytest.approx(abs(exact_max), rel=0.02)
+    # the mean over the middle patch of the peak: measured 2.1 % low
+    assert event.max_slip == pytest.approx(abs(exact_max), rel=0.03)
+    assert event.max_slip < abs(exact_max)
 
 
 def test_shipped_seismic_event_case_against_its_closed_form(tmp_path):

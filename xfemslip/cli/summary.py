@@ -2,8 +2,9 @@
 
 The same per-fracture table and "what happened" line that end ``xfemslip
 run`` (:func:`event_report`), for any result read back through
-:func:`xfemslip.read_result` -- results written before the event sizes
-existed included: they are computed from the arrays and the case text.
+:func:`xfemslip.read_result`: the event sizes it stores, or, for a result
+written without them, computed from what it stores
+(:mod:`xfemslip.post.events`, which says what an older result lacks).
 """
 
 from __future__ import annotations
@@ -19,21 +20,20 @@ __all__ = ["event_report", "summary"]
 
 def event_report(result, spec=None, every_step: bool = False) -> list[str]:
     """The lines printed for ``result``: its final converged step, or every
-    one; ``spec`` the case when at hand, else rebuilt from the result's case
-    text.  None without a converged step (the status line before says so)."""
+    one; ``spec`` the case when at hand (its events.extent), else what the
+    result stores.  None without a converged step (the status line before
+    says so)."""
     from xfemslip.post.events import (
         event_inputs,
         event_sizes,
         increment_line,
-        stored_inputs,
         summary_lines,
     )
     from xfemslip.post.hydraulics import permeability_lines, ratio_phrase
 
     if not result.steps:
         return []
-    stored = result.events is not None and spec is None
-    inputs = stored_inputs(result.events) if stored else event_inputs(result, spec)
+    inputs = event_inputs(result, spec)
     sizes = event_sizes(result, inputs)
     shown = range(len(sizes)) if every_step else [len(sizes) - 1]
     lines = []

@@ -18,12 +18,23 @@ import numpy as np
 
 from xfemslip import kernels
 from xfemslip.case.specs import AUTO_PENALTY, CONTACT_PATCH_CELLS
-from xfemslip.conventions import STICK
+from xfemslip.conventions import OPEN, STICK
 from xfemslip.fem.assembly import coo_block, scatter_vector
 from xfemslip.fem.enrichment import HEAVISIDE, group_values
 from xfemslip.geometry.fracture import GEOMETRY_TOL
 
 logger = logging.getLogger(__name__)
+
+
+# The history a ContactSet commits after a converged step: what a caller that
+# steps back (a bisection) saves and restores.
+COMMITTED = (
+    "slip_committed",
+    "slip_reference",
+    "state_committed",
+    "gt_committed",
+    "pt_committed",
+)
 
 
 @dataclass
@@ -46,6 +57,8 @@ class ContactResult:
     pt: np.ndarray  # (m,) [Pa]
     state: np.ndarray  # (m,) int8
     slip_plastic: np.ndarray  # (m,) [m]
+    # ContactSet.slip_reference when it was evaluated (m,) [m]
+    slip_reference: np.ndarray = field(repr=False, default=None)
     # the displacement it was evaluated at (a reference, not a copy: the solver
     # never changes an array in place once it has been evaluated)
     u: np.ndarray = field(repr=False, default=None)  # (n_dofs,) [m]
@@ -75,6 +88,27 @@ class ContactResult:
     @property
     def point_state(self) -> np.ndarray:  # (n,) int8
         return self.state[self.contact.patch]
+
+    @property
+    def plastic_slip(self) -> np.ndarray:  # (m,) [m]
+        """The slip that slid, per patch: g_T^p less its value in the in-situ
+        state, where the patch is in contact; the whole tangential jump where
+        it is open (no shear, nothing elastic: the kernel returns g_T^p = g_T).
+
+        In contact g_T = (p_T - p_T0) / k_T + (g_T^p - g_T0^p): the first
+        term is the elastic give of the penalty, the second what slid.  A stuck
+        patch that never slipped has 0; a slipping one g_T - (p_T - p_T0) / k_T
+        (the return map, eq. 27).
+        """
+        return np.where(
+            self.state == OPEN,
+            self.slip_plastic,
+            self.slip_plastic - self.slip_reference,
+        )
+
+    @property
+    def point_plastic_slip(self) -> np.ndarray:  # (n,) [m]
+        return self.plastic_slip[self.contact.patch]
 
 
 @dataclass
@@ -109,6 +143,10 @@ class ContactSet:
     point_normal: np.ndarray = field(default=None)  # (n, 2)
     point_tangent: np.ndarray = field(default=None)  # (n, 2)
     slip_committed: np.ndarray = field(default=None)  # (m,) [m]
+    # g_T^p of a patch that has slid nothing (m,) [m]: -p_T0 / k_T, which lets
+    # the penalty carry the in-situ shear p_T0 at zero jump; 0 once the patch
+    # has opened (its faces separated and shed that shear)
+    slip_reference: np.ndarray = field(default=None)
     state_committed: np.ndarray = field(default=None)  # (m,) int8
     gt_committed: np.ndarray = field(default=None)
     pt_committed: np.ndarray = field(default=None)
@@ -171,6 +209,7 @@ class ContactSet:
             pt=pt,
             state=state,
             slip_plastic=slip,
+            slip_reference=self.slip_reference,
             u=u,
             contact=self,
         )
@@ -212,6 +251,8 @@ class ContactSet:
 
     def commit(self, result: ContactResult) -> None:
         self.slip_committed = result.slip_plastic.copy()
+        # a new array, not in place: results evaluated before keep theirs
+        self.slip_reference = np.where(result.state == OPEN, 0.0, self.slip_reference)
         self.state_committed = result.state.copy()
         self.gt_committed = result.gt.copy()
         self.pt_committed = result.pt.copy()
@@ -533,6 +574,7 @@ def build_contact(
         **par,
     )
     cs.slip_committed = slip0
+    cs.slip_reference = slip0.copy()
     cs.state_committed = np.full(n, STICK, np.int8)
     cs.gt_committed = np.zeros(n)
     cs.pt_committed = -par["kt"] * slip0

@@ -5,6 +5,11 @@ from __future__ import annotations
 import numpy as np
 
 
+def shear_modulus(young_modulus, poisson_ratio):
+    """mu = E / (2 (1 + nu)) [Pa]; scalars or arrays."""
+    return young_modulus / (2.0 * (1.0 + poisson_ratio))
+
+
 def elasticity_matrix(
     young_modulus: float, poisson_ratio: float, model: str
 ) -> np.ndarray:

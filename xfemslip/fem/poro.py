@@ -257,6 +257,14 @@ def _warn_unaligned(mesh, unit, fractures=()) -> None:
         )
 
 
+def face_zones(zones: Zones, ip, eps) -> tuple[np.ndarray, np.ndarray]:
+    """(n_ip,) zone of the + and of the - face of every interface point:
+    :meth:`Zones.at` the points x + eps n and x - eps n (eps [m], normally
+    FACE_OFFSET h_min).  A fracture inside one unit has it on both faces; a
+    fault bounding the reservoir has the reservoir on one face only."""
+    return zones.at(ip.xy + eps * ip.normal), zones.at(ip.xy - eps * ip.normal)
+
+
 def _area_majority(ec, qp_material, n_materials) -> np.ndarray:
     """(nc,) material covering most of each enriched cell's area."""
     cell_of_qp = np.repeat(np.arange(ec.cells.size), np.diff(ec.qp_offsets))
@@ -351,8 +359,7 @@ def _fluid(spec, zones, ip, eps, ratio, uniform, fractures):
     """(p_f at load factor 0 [Pa], its change / scale at 1) at every
     interface point, eq. (3): each fracture's rule on its two faces."""
     sides = []
-    for sign in (1.0, -1.0):
-        zone = zones.at(ip.xy + sign * eps * ip.normal)
+    for zone in face_zones(zones, ip, eps):
         # the depth term at the point itself (it is continuous), the face's
         # unit for its overpressure
         p0 = (

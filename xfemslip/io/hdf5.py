@@ -14,7 +14,11 @@ or for the derived quantities ``"m^2"``, ``"m^3"``, ``"N m/m"``, ``"N m"``)::
     /fields/principal_stress  (M, 2) float64 [Pa]     s_max, s_min
     /fractures/<i>/s, points, slip, opening, normal_traction, shear_traction,
                    state (int8: 0 open, 1 stick, 2 slip),
-                   contact_pressure = max(0, -normal_traction) [Pa]
+                   contact_pressure = max(0, -normal_traction) [Pa],
+                   plastic_slip [m] (the slip that slid; root and every step)
+    /fractures/<i>/shear_modulus, poisson_ratio  (K,) at the contact points
+                   [Pa], [-], and attribute ends (2,) [m]: root only, the
+                   same at every step (FractureProperties)
     with [pore_pressure] (xfemslip.fem.poro) also: /fields/effective_stress (M, 3)
     sigma + alpha p I, /fields/pore_pressure (M,), and per fracture
     fluid_pressure and effective_normal_traction (normal_traction is total)
@@ -25,7 +29,7 @@ or for the derived quantities ``"m^2"``, ``"m^3"``, ``"N m/m"``, ``"N m"``)::
                               steps by F fractures: step (S,), slipped (S, F)
                               int8, max_slip, slipping_length, extent [m],
                               moment_per_length [N m/m], moment [N m],
-                              stress_drop [Pa] (0 without slipping length),
+                              stress_drop [Pa] (NaN where undefined),
                               max_slip_increment [m] and
                               moment_per_length_increment [N m/m] of the
                               step's own slip; attr extent_given
@@ -60,7 +64,7 @@ import numpy as np
 from xfemslip import __version__, interrupt
 from xfemslip.conventions import STATE_CODES
 from xfemslip.io.atomic import atomic_path, refuse_non_finite
-from xfemslip.post.fields import FractureFields, StepFields
+from xfemslip.post.fields import FractureFields, FractureProperties, StepFields
 from xfemslip.post.result import EventTable, PermeabilityHistory
 
 logger = logging.getLogger(__name__)
@@ -92,6 +96,7 @@ def write_result(
     load_steps: int,
     events: EventTable | None = None,
     permeability: PermeabilityHistory | None = None,
+    properties: Sequence[FractureProperties] | None = None,
 ) -> None:
     """Write ``result.h5`` atomically.
 
@@ -116,6 +121,9 @@ def write_result(
         Number of load steps of the case; ``/steps/`` is written when > 1.
     events, permeability : optional
         The derived tables ``/events`` and ``/permeability`` of the steps.
+    properties : list of FractureProperties, optional
+        Per fracture (same order as the steps' fractures) its ends and elastic
+        constants at its contact points, written into ``/fractures/<i>``.
 
     Raises
     ------
@@ -136,6 +144,8 @@ def write_result(
         image = io.BytesIO()
         with h5py.File(image, "w", track_order=True) as h5:
             _fill(h5, root_attrs, points, cells, steps, load_steps)
+            if steps and properties:
+                _write_properties(h5["fractures"], properties)
             if steps:
                 _write_derived(h5, steps, events, permeability)
         with open(tmp, "wb") as fh:
@@ -261,6 +271,7 @@ def _write_fracture(group: h5py.Group, fracture: FractureFields) -> None:
     # + 0.0 turns the -0.0 of max(-0.0, 0.0) into 0.0.
     _dataset(group, "contact_pressure", np.maximum(-normal, 0.0) + 0.0, "Pa")
     optional = (
+        ("plastic_slip", "m"),  # None only in a result read from an older file
         ("fluid_pressure", "Pa"),  # with pore pressure
         ("effective_normal_traction", "Pa"),
         ("aperture", "m"),  # with [permeability]
@@ -272,6 +283,25 @@ def _write_fracture(group: h5py.Group, fracture: FractureFields) -> None:
             _dataset(
                 group, name, _as_array(value, np.float64, (n_points,), name), units
             )
+
+
+def _write_properties(
+    group: h5py.Group, properties: Sequence[FractureProperties]
+) -> None:
+    """``/fractures/<i>/shear_modulus``, ``poisson_ratio`` and the attribute
+    ``ends`` of every fracture (``group`` is ``/fractures``)."""
+    if len(properties) != len(group):
+        raise ValueError(
+            f"write_result: {len(properties)} fracture properties for "
+            f"{len(group)} fractures"
+        )
+    for index, prop in enumerate(properties):
+        g = group[str(index)]
+        n_points = g["s"].shape[0]
+        for name, units in (("shear_modulus", "Pa"), ("poisson_ratio", "-")):
+            value = _as_array(getattr(prop, name), np.float64, (n_points,), name)
+            _dataset(g, name, value, units)
+        g.attrs["ends"] = _as_array(prop.ends, np.float64, (2,), "ends")
 
 
 # (name, units) of the event datasets, each (S, F)
@@ -302,9 +332,8 @@ def _write_derived(h5, steps, events, permeability) -> None:
         )
         for name, units in EVENT_DATASETS:
             value = _as_array(getattr(events, name), np.float64, shape, name)
-            if name == "stress_drop":  # undefined without slipping length
-                value = np.where(np.isfinite(value), value, 0.0)
-            _dataset(group, name, value, units)
+            # NaN where the crack model is undefined (no slipping length)
+            _dataset(group, name, value, units, nan=name == "stress_drop")
         moment = events.moment_per_length * events.extent
         _dataset(group, "moment", _as_array(moment, np.float64, shape, "moment"), "N m")
     if permeability is not None:
@@ -334,11 +363,14 @@ def _write_derived(h5, steps, events, permeability) -> None:
 
 
 def _dataset(
-    group: h5py.Group, name: str, value: np.ndarray, units: str
+    group: h5py.Group, name: str, value: np.ndarray, units: str, nan: bool = False
 ) -> h5py.Dataset:
-    """Create one dataset without timestamps and tag it with its units."""
+    """Create one dataset without timestamps and tag it with its units
+    (``nan``: NaN stands for "undefined" in it; inf is refused all the same)."""
     interrupt.checkpoint()  # between data sets: a deferred signal stops here
-    refuse_non_finite(value, f"{group.name}/{name}")
+    refuse_non_finite(
+        np.where(np.isnan(value), 0.0, value) if nan else value, f"{group.name}/{name}"
+    )
     dataset = group.create_dataset(name, data=value, track_times=False)
     dataset.attrs["units"] = units
     return dataset

@@ -18,7 +18,7 @@ import h5py
 import numpy as np
 
 from xfemslip.errors import UsageError
-from xfemslip.post.fields import FractureFields, StepFields
+from xfemslip.post.fields import FractureFields, FractureProperties, StepFields
 from xfemslip.post.result import EventTable, PermeabilityHistory, Result
 
 __all__ = ["FRACTURE_ARRAYS", "read_attrs", "read_result"]
@@ -35,6 +35,7 @@ FRACTURE_ARRAYS = (
     "state",
 )
 OPTIONAL_FRACTURE_ARRAYS = (
+    "plastic_slip",  # not in a result written before it was kept
     "fluid_pressure",
     "effective_normal_traction",
     "aperture",
@@ -92,6 +93,29 @@ def _fractures(group: h5py.Group | None) -> list[FractureFields]:
         arrays = {key: g[key][()] for key in FRACTURE_ARRAYS}
         arrays |= {key: g[key][()] for key in OPTIONAL_FRACTURE_ARRAYS if key in g}
         out.append(FractureFields(**arrays))
+    return out
+
+
+def _properties(h5: h5py.File) -> list[FractureProperties] | None:
+    """``/fractures/<i>`` shear_modulus, poisson_ratio and attribute ends of
+    every fracture; None when a fracture lacks one (a result written before
+    they were kept) or when the file has no fracture."""
+    if "fractures" not in h5:
+        return None
+    parent = h5["fractures"]
+    out = []
+    for name in sorted(parent, key=int):
+        g = parent[name]
+        if not {"shear_modulus", "poisson_ratio"} <= set(g) or "ends" not in g.attrs:
+            return None
+        lo, hi = (float(v) for v in g.attrs["ends"])
+        out.append(
+            FractureProperties(
+                ends=(lo, hi),
+                shear_modulus=g["shear_modulus"][()],
+                poisson_ratio=g["poisson_ratio"][()],
+            )
+        )
     return out
 
 
@@ -166,7 +190,8 @@ def _events(h5: h5py.File) -> EventTable | None:
         max_slip=g["max_slip"][()],
         slipping_length=length,
         moment_per_length=moment,
-        # written as 0 where the crack model has no slipping length or moment
+        # NaN where the crack model has no slipping length or moment (stored
+        # so; a file of an older version holds 0 there)
         stress_drop=np.where((length > 0.0) & (moment > 0.0), drop, np.nan),
         extent=g["extent"][()],
         extent_given=bool(g.attrs["extent_given"]),
@@ -209,6 +234,7 @@ def read_result(path: str | Path) -> Result:
                 cells=h5["mesh/cells"][()],
                 steps=_steps(h5, attrs),
                 out_dir=path.parent,
+                fracture_properties=_properties(h5),
                 events=_events(h5),
                 permeability=_permeability(h5),
             )

@@ -70,6 +70,7 @@ def write_results(
         load_steps=result.load_steps,
         events=result.events,
         permeability=result.permeability,
+        properties=result.fracture_properties,
     )
     if "vtu" in formats and result.steps:
         # the ParaView files: those of the split mesh, and the description

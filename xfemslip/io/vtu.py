@@ -39,7 +39,7 @@ from xfemslip.post.fields import FractureFields, VisMesh
 logger = logging.getLogger(__name__)
 
 FRACTURE_POINT_DATA = ("slip", "opening", "normal_traction", "shear_traction")
-OPTIONAL_FRACTURE_POINT_DATA = ("aperture", "transmissivity")
+OPTIONAL_FRACTURE_POINT_DATA = ("plastic_slip", "aperture", "transmissivity")
 
 
 def write_bulk(
@@ -141,7 +141,8 @@ def write_fractures(
     run_id : int, optional
         The output set's id (field data ``run_id``, as in :func:`write_bulk`).
 
-    Point data: ``slip``, ``opening`` [m], ``normal_traction``,
+    Point data: ``slip``, ``plastic_slip`` (the slip that slid), ``opening``
+    [m], ``normal_traction``,
     ``shear_traction``, ``contact_pressure`` = max(0, -normal_traction) [Pa],
     ``state`` (int32: 0 open, 1 stick, 2 slip), ``s`` [m] and ``fracture``
     (the index), with ``faces`` the two displacements above, and with
@@ -261,7 +262,9 @@ def _fracture_part(
     part["state"] = np.asarray(fields.state, dtype=np.int32).reshape(n_points)
     part["s"] = s
     part["fracture"] = np.full(n_points, index, dtype=np.int32)
-    for name in OPTIONAL_FRACTURE_POINT_DATA:  # [permeability]: a [m], a^3/12 [m^3]
+    # plastic_slip [m] (None only when read from an older result.h5);
+    # [permeability]: aperture [m], transmissivity a^3 / 12 [m^3]
+    for name in OPTIONAL_FRACTURE_POINT_DATA:
         value = getattr(fields, name, None)
         if value is not None:
             part[name] = np.asarray(value, dtype=np.float64).reshape(n_points)

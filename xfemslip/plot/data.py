@@ -31,7 +31,8 @@ class FractureData:
     index: int
     s: np.ndarray  # (K,) [m]
     points: np.ndarray  # (K, 2) [m]
-    slip: np.ndarray  # (K,) [m]
+    slip: np.ndarray  # (K,) tangential jump [m]
+    slid: np.ndarray  # (K,) the slip that slid (FractureFields.slid) [m]
     # (K,) [Pa]: the effective normal traction sigma_n + p_f when the result
     # has pore pressure (what the Coulomb criterion sees), else sigma_n
     normal_traction: np.ndarray
@@ -222,6 +223,7 @@ def _fracture_data(result, case: dict, path: Path) -> list[FractureData]:
                 s=ff.s,
                 points=ff.points,
                 slip=ff.slip,
+                slid=ff.slid,
                 normal_traction=(
                     ff.effective_normal_traction
                     if ff.effective_normal_traction is not None

@@ -26,8 +26,9 @@ def _pyplot():
 def plot_slip_vs_depletion(
     report, out_dir: Path, dpi: float = 110.0, name: str | None = None
 ) -> Path:
-    """Max |slip| and slipping length of each fracture against the pressure
-    drop; ``name`` (the case's) titles the figure."""
+    """Max |slip| that slid and slipping length of each fracture against the
+    pressure drop (``report.rows``, the event sizes); ``name`` (the case's)
+    titles the figure."""
     plt = _pyplot()
     rows = report.rows
     drop = np.array([-r[2] for r in rows]) / 1e6  # pressure drop [MPa]
@@ -41,7 +42,7 @@ def plot_slip_vs_depletion(
             for ax in (a1, a2):
                 ax.axvline(-onset.dp_critical / 1e6, color=line.get_color(), ls=":")
     a1.set_xlabel("pore-pressure drop $-\\Delta p$ [MPa]")
-    a1.set_ylabel("max |slip| [mm]")
+    a1.set_ylabel("max |slip| that slid [mm]")
     a2.set_xlabel("pore-pressure drop $-\\Delta p$ [MPa]")
     a2.set_ylabel("slipping length [m]")
     a1.legend(fontsize=8)

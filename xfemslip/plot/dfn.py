@@ -2,7 +2,8 @@
 a figure is drawn; ``matplotlib.figure.Figure``, no pyplot, no GUI backend).
 
 ``figure_network``: the fractures of a case in its domain, coloured by
-``|slip|`` at the contact points when a ``result.h5`` is given (slipping
+the ``|slip|`` that slid (the plastic slip) at the contact points when a
+``result.h5`` is given (slipping
 fractures drawn thicker), else by origin; with a sweep's ``summary.csv`` a
 second panel shows how many fractures slip over the realizations.
 """
@@ -36,7 +37,8 @@ def _domain_frame(ax, spec) -> None:
 
 
 def read_result_slip(result: Path, n_fractures: int) -> list[tuple]:
-    """[(points (K, 2), slip (K,), state (K,))] per fracture of a result.h5."""
+    """[(points (K, 2), slip (K,), state (K,))] per fracture of a result.h5:
+    the slip that slid (``FractureFields.slid``)."""
     read = read_result(result)
     fractures = read.fractures if read.steps else []
     if len(fractures) < n_fractures:
@@ -44,7 +46,7 @@ def read_result_slip(result: Path, n_fractures: int) -> list[tuple]:
             f"{result}: no /fractures/{len(fractures)}: not a result of this case "
             f"({n_fractures} fractures)"
         )
-    return [(f.points, f.slip, f.state) for f in fractures[:n_fractures]]
+    return [(f.points, f.slid, f.state) for f in fractures[:n_fractures]]
 
 
 def _draw_slip(fig, ax, fields) -> None:

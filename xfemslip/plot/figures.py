@@ -248,9 +248,10 @@ def figure_deformed(
 
 
 def figure_slip(results: Sequence[ResultData]) -> Figure:
-    """|slip| [mm] along every fracture against arc length, results overlaid;
-    one colour per result (or per fracture of a single result), distinct for
-    any number of them."""
+    """The |slip| that slid [mm] along every fracture against arc length
+    (solid; dashed: the tangential jump, which adds the elastic give of the
+    penalty), results overlaid; one colour per result (or per fracture of a
+    single result), distinct for any number of them."""
     fig = Figure(figsize=(6.4, 4.2), layout="constrained")
     ax = fig.subplots()
     many = len(results) if len(results) > 1 else max(len(results[0].fractures), 1)
@@ -267,12 +268,13 @@ def figure_slip(results: Sequence[ResultData]) -> Figure:
             s = fr.s - fr.s.min() if fr.s.size else fr.s
             # one result with several fractures (a network): one colour each
             colour = colours[(k if len(results) > 1 else fr.index) % len(colours)]
-            mm = 1e3 * np.abs(fr.slip)
+            mm = 1e3 * np.abs(fr.slid)
             (line,) = ax.plot(s, mm, lw=1.4, color=colour, label=label)
+            ax.plot(s, 1e3 * np.abs(fr.slip), lw=0.7, ls="--", color=colour)
             in_slip = fr.state == SLIP
             ax.plot(s[in_slip], mm[in_slip], ".", ms=3, color=line.get_color())
     ax.set_xlabel("distance from the first tip along the fracture x_0 [m]")
-    ax.set_ylabel("slip |[[u]] . t| [mm]")
+    ax.set_ylabel("slip that slid [mm] (dashed: jump |[[u]] . t|)")
     names = ", ".join(dict.fromkeys(data.name for data in results if data.name))
     ax.set_title(
         f"{names}\nslip along the fracture (dots: points in slip)", fontsize=10
@@ -322,14 +324,14 @@ def fracture_pieces(fr) -> tuple[np.ndarray, np.ndarray]:
 
 
 def figure_network(data: ResultData, scale: float | None = None) -> Figure:
-    """A fracture network: |slip| [mm] along every fracture over the
-    deformed, split mesh (left) and the contact state of every point (right),
+    """A fracture network: the |slip| that slid [mm] along every fracture over
+    the deformed, split mesh (left) and the contact state of every point (right),
     each fracture numbered as in the case file."""
     fig, axes = _grid(1, 2)
     ax_slip, ax_state = axes[0]
     factor = scale if scale is not None else auto_scale(data)
     _draw_mesh(ax_slip, data, factor)
-    slips = [np.abs(f.slip) for f in data.fractures if f.slip.size]
+    slips = [np.abs(f.slid) for f in data.fractures if f.slid.size]
     top = max((float(v.max()) for v in slips), default=0.0) or 1.0
     norm = Normalize(0.0, 1e3 * top)
     mappable = None
@@ -345,7 +347,7 @@ def figure_network(data: ResultData, scale: float | None = None) -> Figure:
         moved = pieces + factor * data.displacement[near].reshape(pieces.shape)
         mappable = LineCollection(
             moved,
-            array=1e3 * np.abs(fr.slip[owner]),
+            array=1e3 * np.abs(fr.slid[owner]),
             cmap="plasma",
             norm=norm,
             linewidths=2.2,
@@ -360,12 +362,12 @@ def figure_network(data: ResultData, scale: float | None = None) -> Figure:
         ax_state.annotate(
             str(fr.index), m, fontsize=7, xytext=(3, 3), textcoords="offset points"
         )
-    fig.colorbar(mappable, ax=ax_slip, label="|slip| [mm]", shrink=0.8)
+    fig.colorbar(mappable, ax=ax_slip, label="|slip| that slid [mm]", shrink=0.8)
     ax_slip.autoscale_view()
     _frame(
         ax_slip,
         data,
-        f"{data.label}\n|slip| on the deformed, split mesh (x {factor:.3g})",
+        f"{data.label}\n|slip| that slid, on the deformed, split mesh (x {factor:.3g})",
         fractures=False,
     )
     b = data.points

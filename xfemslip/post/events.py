@@ -1,47 +1,42 @@
 """How big an event the slip is: per fracture and load step, and in words.
 
-Per fracture and converged load step, from the slip of that step (cumulative
-from the in-situ state, as ``result.h5`` stores it): the seismic moment per
-unit out-of-plane length M0' = mu int |s| ds, the crack-model static stress
-drop, the max |slip|, the slipping length and the moment magnitude
+Per fracture and converged load step, from the slip that slid up to that step
+(``plastic_slip``: cumulative from the in-situ state, the elastic give of the
+penalty left out, so a stuck fracture has none): the seismic moment per unit
+out-of-plane length M0' = int mu |d| ds, the crack-model static stress drop,
+the max |d|, the slipping length and the moment magnitude
 Mw = (2/3) (log10(M0' W) - 9.1) for an out-of-plane extent W
 (:mod:`xfemslip.post.seismic`).  W is ``events.extent`` when the case gives it,
 else the fracture's own slipping length; every magnitude is printed with the
 W it used.
 
-The integrals weigh each contact point with the stretch of fracture it stands
-for (:func:`xfemslip.post.metrics.point_stretches`), the ends reaching the
-part of the fracture inside the domain, like the sweep metrics.  mu is the
-shear modulus of ``[material]``, or of ``[reservoir]`` for a fracture whose
-middle contact point lies in the reservoir.
+Everything comes from what the result stores: the slip and state of every
+step, and per fracture (``Result.fracture_properties``) the shear modulus and
+Poisson's ratio at each contact point and the ends of the fracture inside the
+domain.  The integrals weigh each contact point with the stretch of fracture
+it stands for (:func:`xfemslip.post.metrics.point_stretches`), like the sweep
+metrics.
 
 A run keeps them (:func:`event_table`, ``Result.events``, the ``/events``
-group of ``result.h5``), and :func:`event_sizes` reads them from there; a
-result written without them has them computed from its arrays and the case
-it ran (the ``case_toml`` every result carries).
+group of ``result.h5``), and :func:`event_sizes` reads them from there.  A
+result written by an older version lacks some of it: without
+``plastic_slip`` its slip is the tangential jump (stuck points' elastic give
+included), without the fracture properties there is no moment (mu unknown)
+and the ends are estimated from the contact points; :func:`event_inputs`
+says so in its ``note``, which the printouts show.
 """
 
 from __future__ import annotations
 
 import math
-import tomllib
 from dataclasses import dataclass
-from pathlib import Path
 
 import numpy as np
 
-from xfemslip.case import loads_case
 from xfemslip.conventions import SLIP
-from xfemslip.errors import CaseError, XfemslipError
-from xfemslip.geometry.regions import in_region
-from xfemslip.post.metrics import arc_extent, point_stretches
+from xfemslip.post.metrics import point_stretches
 from xfemslip.post.result import EventTable, Result
-from xfemslip.post.seismic import (
-    moment_magnitude,
-    moment_per_length,
-    shear_modulus,
-    stress_drop,
-)
+from xfemslip.post.seismic import moment_magnitude, moment_per_length, stress_drop
 
 __all__ = [
     "CASE_COLUMNS",
@@ -54,7 +49,6 @@ __all__ = [
     "event_table",
     "fracture_metrics",
     "increment_line",
-    "stored_inputs",
     "summary_lines",
 ]
 
@@ -65,15 +59,15 @@ class FractureEvent:
 
     fracture: int  # case-file index
     slipped: bool  # a contact point in state SLIP at this step
-    max_slip: float  # max |slip| [m]
+    max_slip: float  # max |slip that slid| [m]
     slipping_length: float  # [m]
-    moment_per_length: float  # M0' [N m / m]
-    stress_drop: float  # crack model [Pa]; NaN without slip
+    moment_per_length: float  # M0' [N m / m]; NaN: mu unknown
+    stress_drop: float  # moment-equivalent crack drop [Pa]; NaN: undefined
     extent: float  # the W of the magnitude [m] (0 without slip and extent)
     magnitude: float  # Mw for M0' W; -inf without moment
-    # of this step alone: the slip it added (s_k - s_k-1, s_0 = 0 in situ)
-    max_slip_increment: float = 0.0  # max |ds| [m]
-    moment_per_length_increment: float = 0.0  # mu int |ds| ds [N m / m]
+    # of this step alone: the slip it added (d_k - d_k-1, d_0 = 0 in situ)
+    max_slip_increment: float = 0.0  # max |dd| [m]
+    moment_per_length_increment: float = 0.0  # int mu |dd| ds [N m / m]
 
     @property
     def moment(self) -> float:
@@ -88,52 +82,21 @@ class FractureEvent:
 
 @dataclass(frozen=True)
 class EventInputs:
-    """What the event sizes need beyond the result's arrays.
+    """What the event sizes need beyond the slip and state of the steps.
 
-    ``mu`` (F,) [Pa] per fracture, ``nu`` and ``model`` of the elastic law
-    around each, ``ends`` (F, 2) the arc-length range [m] of each fracture
-    inside the domain, ``extent`` W [m] or None (each fracture's slipping
-    length), ``note`` a caveat to print ("" when none).
+    Per fracture ``mu`` and ``nu`` at its contact points ((K,) arrays [Pa],
+    [-]; NaN when the result does not store them), ``ends`` the arc-length
+    range [m] of the fracture inside the domain; ``model`` the elastic model
+    (plane strain or stress), ``extent`` W [m] or None (each fracture's
+    slipping length), ``note`` what the numbers lack ("" when nothing).
     """
 
-    mu: tuple[float, ...]
-    nu: tuple[float, ...]
+    mu: tuple[np.ndarray, ...]
+    nu: tuple[np.ndarray, ...]
     model: str
     ends: tuple[tuple[float, float], ...]
     extent: float | None
     note: str = ""
-
-
-def _from_spec(spec, result: Result) -> EventInputs:
-    m = spec.material
-    box = (
-        spec.origin[0],
-        spec.origin[0] + spec.size[0],
-        spec.origin[1],
-        spec.origin[1] + spec.size[1],
-    )
-    mus, nus = [], []
-    fields = result.final.fractures if result.steps else []
-    for k, _ in enumerate(spec.fractures):
-        E, nu = m.E, m.nu
-        r = spec.reservoir
-        if r is not None and k < len(fields) and fields[k].points.size:
-            middle = fields[k].points[len(fields[k].points) // 2][None, :]
-            if bool(in_region(middle, r)[0]):
-                E, nu = r.E, r.nu
-        mus.append(shear_modulus(E, nu))
-        nus.append(nu)
-    ends = tuple(arc_extent(f.points, box) for f in spec.fractures)
-    extent = spec.events.extent if spec.events is not None else None
-    return EventInputs(tuple(mus), tuple(nus), m.model, ends, extent)
-
-
-def stored_inputs(table: EventTable) -> EventInputs:
-    """What the printout needs of the inputs when the event sizes are read
-    from ``table``: whether W is events.extent."""
-    given = table.extent_given and table.extent.size
-    extent = float(table.extent.flat[0]) if given else None
-    return EventInputs((), (), "", (), extent)
 
 
 def _contact_ends(s: np.ndarray) -> tuple[float, float]:
@@ -144,66 +107,75 @@ def _contact_ends(s: np.ndarray) -> tuple[float, float]:
     return float(s[0] - 0.5 * (s[1] - s[0])), float(s[-1] + 0.5 * (s[-1] - s[-2]))
 
 
-def _from_text(text: str, result: Result, reason: str) -> EventInputs:
-    """Material and extent from the case text, fracture ends from the contact
-    points: when the case cannot be rebuilt (files it names are elsewhere)."""
-    try:
-        case = tomllib.loads(text)
-    except tomllib.TOMLDecodeError:
-        case = {}
-    material = case.get("material", {}) if isinstance(case, dict) else {}
-    E, nu = material.get("E"), material.get("nu")
-    if not isinstance(E, int | float) or not isinstance(nu, int | float):
-        raise CaseError(Path("case_toml"), [("material", "E and nu not found")])
-    model = material.get("model", "plane_strain")
-    events = case.get("events", {})
-    extent = events.get("extent") if isinstance(events, dict) else None
-    fields = result.final.fractures if result.steps else []
-    n = len(fields)
-    return EventInputs(
-        (shear_modulus(float(E), float(nu)),) * n,
-        (float(nu),) * n,
-        str(model),
-        tuple(_contact_ends(np.asarray(f.s, float)) for f in fields),
-        float(extent) if isinstance(extent, int | float) else None,
-        note=f"fracture ends estimated from the contact points ({reason})",
+def _stored(result: Result) -> bool:
+    """Whether the result keeps its event sizes for every step."""
+    return result.events is not None and result.events.max_slip.shape[0] == len(
+        result.steps
     )
 
 
+# What a result written by an older version lacks, in words.
+NO_PLASTIC_SLIP = (
+    "this result has no plastic_slip (written by an older version): its slip, "
+    "M0' and Mw count the tangential jump, the elastic give of stuck points "
+    "included; run the case again for the slip that slid"
+)
+NO_PROPERTIES = (
+    "this result has no shear modulus of its fractures (written by an older "
+    "version): no moment, stress drop or Mw; fracture ends estimated from the "
+    "contact points"
+)
+
+
 def event_inputs(result: Result, spec=None) -> EventInputs:
-    """The :class:`EventInputs` of ``result``: from ``spec`` (the case it ran)
-    when given, else rebuilt from the case text the result carries."""
+    """The :class:`EventInputs` of ``result``, from what it stores; W is
+    ``events.extent`` of ``spec`` (the case it ran) when given, else the one
+    its ``/events`` recorded, else each fracture's slipping length."""
+    fields = result.steps[-1].fractures if result.steps else []
+    extent = None
     if spec is not None:
-        return _from_spec(spec, result)
-    text = str(result.attrs.get("case_toml", ""))
-    folder = result.out_dir if result.out_dir is not None else Path(".")
-    try:
-        return _from_spec(loads_case(text, folder / "case.toml"), result)
-    except XfemslipError as err:
-        problems = getattr(err, "problems", None)
-        where = problems[0][0] if problems else type(err).__name__
-        return _from_text(text, result, f"the case does not load here: {where}")
+        extent = spec.events.extent if spec.events is not None else None
+    elif result.events is not None and result.events.extent_given:
+        extent = (
+            float(result.events.extent.flat[0]) if result.events.extent.size else None
+        )
+    notes = []
+    if any(ff.plastic_slip is None for step in result.steps for ff in step.fractures):
+        notes.append(NO_PLASTIC_SLIP)
+    props = result.fracture_properties
+    if props is not None and len(props) == len(fields):
+        mu = tuple(np.asarray(p.shear_modulus, float) for p in props)
+        nu = tuple(np.asarray(p.poisson_ratio, float) for p in props)
+        ends = tuple(p.ends for p in props)
+    else:
+        mu = tuple(np.full(np.shape(ff.s), np.nan) for ff in fields)
+        nu = mu
+        ends = tuple(_contact_ends(np.asarray(ff.s, float)) for ff in fields)
+        if not _stored(result):
+            notes.append(NO_PROPERTIES)
+    model = str(result.attrs.get("material_model", "plane_strain"))
+    return EventInputs(mu, nu, model, ends, extent, "; ".join(notes))
 
 
 def _fracture_event(index, ff, inputs: EventInputs, before=None) -> FractureEvent:
-    """``before``: the fracture's slip at the step before (None: in situ)."""
-    s, slip, state = np.asarray(ff.s, float), np.asarray(ff.slip, float), ff.state
-    step_slip = slip - (np.asarray(before, float) if before is not None else 0.0)
+    """``before``: the fracture's slid slip at the step before (None: in situ)."""
+    s, slid, state = np.asarray(ff.s, float), np.asarray(ff.slid, float), ff.state
+    step_slip = slid - (np.asarray(before, float) if before is not None else 0.0)
     stretch = point_stretches(s, *inputs.ends[index])
     mu, nu = inputs.mu[index], inputs.nu[index]
-    m0 = moment_per_length(mu, stretch, slip)
+    m0 = moment_per_length(mu, stretch, slid)
     length = float(np.sum(stretch[np.asarray(state) == SLIP]))
     extent = inputs.extent if inputs.extent is not None else length
     return FractureEvent(
         fracture=index,
         slipped=bool(np.any(np.asarray(state) == SLIP)),
-        max_slip=float(np.max(np.abs(slip))) if slip.size else 0.0,
+        max_slip=float(np.max(np.abs(slid))) if slid.size else 0.0,
         slipping_length=length,
         moment_per_length=m0,
-        stress_drop=stress_drop(m0, length, mu, nu, inputs.model),
+        stress_drop=stress_drop(mu, nu, inputs.model, stretch, slid, length),
         extent=extent,
         magnitude=moment_magnitude(m0 * extent),
-        max_slip_increment=float(np.max(np.abs(step_slip))) if slip.size else 0.0,
+        max_slip_increment=float(np.max(np.abs(step_slip))) if slid.size else 0.0,
         moment_per_length_increment=moment_per_length(mu, stretch, step_slip),
     )
 
@@ -213,7 +185,7 @@ def _computed(result: Result, inputs: EventInputs) -> list[list[FractureEvent]]:
     for step in result.steps:
         out.append(
             [
-                _fracture_event(i, ff, inputs, before[i].slip if before else None)
+                _fracture_event(i, ff, inputs, before[i].slid if before else None)
                 for i, ff in enumerate(step.fractures)
             ]
         )
@@ -221,7 +193,7 @@ def _computed(result: Result, inputs: EventInputs) -> list[list[FractureEvent]]:
     return out
 
 
-def _stored(table: EventTable) -> list[list[FractureEvent]]:
+def _from_table(table: EventTable) -> list[list[FractureEvent]]:
     steps, n = table.max_slip.shape
     out = []
     for k in range(steps):
@@ -252,10 +224,8 @@ def event_sizes(result: Result, inputs: EventInputs) -> list[list[FractureEvent]
     """Per converged load step, the :class:`FractureEvent` of every fracture:
     those the result keeps (``result.events``) when it has them, else
     computed from its fields."""
-    if result.events is not None and result.events.max_slip.shape[0] == len(
-        result.steps
-    ):
-        return _stored(result.events)
+    if _stored(result):
+        return _from_table(result.events)
     return _computed(result, inputs)
 
 
@@ -316,11 +286,14 @@ def summary_lines(
     lines = [head]
     for e in events:
         drop = f"{e.stress_drop / 1e6:.3g}" if math.isfinite(e.stress_drop) else "-"
-        w = f"{e.extent:.3g}" if e.extent > 0 else "-"
+        m0 = e.moment_per_length
+        moment = f"{m0:.4g}" if math.isfinite(m0) else "-"
+        # W only beside a magnitude
+        w = f"{e.extent:.3g}" if math.isfinite(e.magnitude) else "-"
         lines.append(
             f"{e.fracture:>8}  {'yes' if e.slipped else 'no':>7}  "
             f"{e.max_slip * 1e3:>13.4g}  {e.slipping_length:>12.4g}  "
-            f"{e.moment_per_length:>12.4g}  {drop:>10}  {_mw_text(e):>6}  {w}"
+            f"{moment:>12}  {drop:>10}  {_mw_text(e):>6}  {w}"
         )
     lines.append(what_happened(events, inputs) + (f"; {also}" if also else ""))
     if inputs.note:
@@ -353,12 +326,14 @@ def what_happened(events: list[FractureEvent], inputs: EventInputs) -> str:
     n = len(events)
     if not slipped:
         top = max(events, key=lambda e: e.max_slip)
-        return (
-            f"no fracture slipped ({n} in all); the largest jump, "
-            f"{top.max_slip * 1e3:.3g} mm on fracture {top.fracture}, is elastic"
-        )
+        if top.max_slip > 0.0:  # it slid at an earlier step and stuck again
+            return (
+                f"no fracture slips at this step ({n} in all); fracture "
+                f"{top.fracture} slid {top.max_slip * 1e3:.3g} mm before"
+            )
+        return f"no fracture slipped ({n} in all)"
     top = max(slipped, key=lambda e: e.max_slip)
-    big = max(slipped, key=lambda e: e.moment)
+    big = max(slipped, key=lambda e: e.moment if math.isfinite(e.moment) else -1.0)
     noun = "fracture" if n == 1 else "fractures"
     line = (
         f"{len(slipped)} of {n} {noun} slipped; max slip {top.max_slip * 1e3:.3g} mm "
@@ -399,8 +374,7 @@ def fracture_metrics(result: Result, spec) -> dict:
     own summary, :mod:`xfemslip.studies.dfn_summary`)."""
     if not result.steps:
         return {}
-    stored = result.events is not None
-    inputs = stored_inputs(result.events) if stored else event_inputs(result, spec)
+    inputs = event_inputs(result, spec)
     events = event_sizes(result, inputs)[-1]
     magnitudes = [e.magnitude for e in events if math.isfinite(e.magnitude)]
     out = {

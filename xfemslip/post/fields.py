@@ -22,8 +22,9 @@ import numpy as np
 
 from xfemslip.contact.interface import JUMP_PROBE
 from xfemslip.fem.enrichment import HEAVISIDE, find_candidates, group_values
-from xfemslip.fem.poro import cell_centres
-from xfemslip.fem.zones import in_situ_stress
+from xfemslip.fem.material import shear_modulus
+from xfemslip.fem.poro import FACE_OFFSET, cell_centres, face_zones
+from xfemslip.fem.zones import build_zones, in_situ_stress
 from xfemslip.geometry.fracture import GEOMETRY_TOL
 
 
@@ -38,12 +39,34 @@ class FractureFields:
     normal_traction: np.ndarray  # (K,) p_N [Pa], compression negative
     shear_traction: np.ndarray  # (K,) p_T along t [Pa]
     state: np.ndarray  # (K,) int8: 0 open, 1 stick, 2 slip
+    # the slip that slid, along t (ContactResult.plastic_slip): the committed
+    # plastic slip of the point's patch from the in-situ state, the whole jump
+    # where open; None in a result written without it
+    plastic_slip: np.ndarray | None = None  # (K,) [m]
     # with [pore_pressure] only (xfemslip.fem.poro); normal_traction is then total
     fluid_pressure: np.ndarray | None = None  # (K,) p_f [Pa]
     effective_normal_traction: np.ndarray | None = None  # (K,) p_N + p_f [Pa]
     # with [permeability] only (xfemslip.post.hydraulics)
     aperture: np.ndarray | None = None  # (K,) hydraulic aperture a [m]
     transmissivity: np.ndarray | None = None  # (K,) a^3 / 12 [m^3]
+
+    @property
+    def slid(self) -> np.ndarray:
+        """(K,) [m] the slip that slid: ``plastic_slip``, or the tangential
+        jump ``slip`` for a result written without it (the elastic give of
+        stuck points then counts as slip)."""
+        return self.slip if self.plastic_slip is None else self.plastic_slip
+
+
+@dataclass
+class FractureProperties:
+    """What the derived quantities of one fracture need of the model, the same
+    at every step (``result.h5``: ``/fractures/<i>/shear_modulus``,
+    ``poisson_ratio`` and the attribute ``ends``)."""
+
+    ends: tuple[float, float]  # arc-length range of the fracture inside the domain [m]
+    shear_modulus: np.ndarray  # (K,) mu at its contact points, sorted by s [Pa]
+    poisson_ratio: np.ndarray  # (K,) nu there [-]
 
 
 @dataclass
@@ -167,6 +190,7 @@ def fracture_fields(ip, res, n_fractures, fluid=None) -> list[FractureFields]:
                 normal_traction=pn,
                 shear_traction=res.point_pt[m].copy(),
                 state=res.point_state[m].astype(np.int8),
+                plastic_slip=res.point_plastic_slip[m].copy(),
                 **extra,
             )
         )
@@ -351,6 +375,41 @@ def step_fields(model, r) -> StepFields:
     )
 
 
+def fracture_properties(model) -> list[FractureProperties]:
+    """What the derived quantities need of each fracture of ``model`` (a
+    :class:`xfemslip.simulation.Model`), in position order: the arc-length
+    range of its polyline as built (clipped to the domain), and the shear
+    modulus and Poisson's ratio at its contact points, sorted by s as in
+    :func:`fracture_fields`.
+
+    The elastic constants at a contact point are the mean of those of the
+    zones on its two faces (:func:`xfemslip.fem.poro.face_zones`, sampled
+    FACE_OFFSET h_min off the fracture as the fluid pressure is): a fracture
+    inside one unit has that unit's, a fault bounding the reservoir the mean
+    of the reservoir's and the host's.
+    """
+    spec, ip = model.spec, model.ip
+    zones = model.materials.zones if model.materials else build_zones(spec)
+    E, nu = np.asarray(zones.E, float), np.asarray(zones.nu, float)
+    plus, minus = face_zones(zones, ip, FACE_OFFSET * model.mesh.h_min)
+    mu = shear_modulus(E, nu)
+    point_mu = 0.5 * (mu[plus] + mu[minus])
+    point_nu = 0.5 * (nu[plus] + nu[minus])
+    out = []
+    for fi, fr in enumerate(model.fractures):
+        m = np.nonzero(ip.fracture == fi)[0]
+        m = m[np.argsort(ip.s[m], kind="stable")]
+        ends = (float(fr.s_start[0]), float(fr.s_start[-1] + fr.length[-1]))
+        out.append(
+            FractureProperties(
+                ends=ends,
+                shear_modulus=point_mu[m].copy(),
+                poisson_ratio=point_nu[m].copy(),
+            )
+        )
+    return out
+
+
 def stress_for_paraview(stress, stress_zz) -> dict[str, np.ndarray]:
     """The element stress as ParaView reads it: ``stress_tensor`` (M, 6) in
     VTK's symmetric-tensor order XX, YY, ZZ, XY, YZ, XZ (so ParaView's tensor
@@ -383,9 +442,15 @@ def first_non_finite(steps) -> tuple[int, str] | None:
             "principal_stress": f.principal_stress,
         }
         for i, fr in enumerate(f.fractures):
-            for name in ("slip", "opening", "normal_traction", "shear_traction"):
+            for name in (
+                "slip",
+                "opening",
+                "normal_traction",
+                "shear_traction",
+                "plastic_slip",
+            ):
                 arrays[f"fractures[{i}].{name}"] = getattr(fr, name)
         for name, value in arrays.items():
-            if not np.all(np.isfinite(value)):
+            if value is not None and not np.all(np.isfinite(value)):
                 return index, name
     return None

@@ -19,6 +19,7 @@ from xfemslip.post.result import Result
 __all__ = [
     "METRICS",
     "arc_extent",
+    "fracture_ends",
     "point_stretches",
     "result_metrics",
     "slipping_length",
@@ -70,22 +71,32 @@ def slipping_length(s, state, s_lo: float, s_hi: float) -> float:
     return float(np.sum(stretch[np.asarray(state) == SLIP]))
 
 
-def result_metrics(result: Result, spec) -> dict:
-    """The METRICS of a result (final step) of the case ``spec``."""
+def fracture_ends(result: Result, spec) -> list[tuple[float, float]]:
+    """The arc-length range [m] of each fracture of ``result`` inside the
+    domain: as the result stores it (``fracture_properties``), else from the
+    case ``spec`` (a result written before the ends were kept)."""
+    if result.fracture_properties is not None:
+        return [p.ends for p in result.fracture_properties]
     box = (
         spec.origin[0],
         spec.origin[0] + spec.size[0],
         spec.origin[1],
         spec.origin[1] + spec.size[1],
     )
+    return [arc_extent(fracture.points, box) for fracture in spec.fractures]
+
+
+def result_metrics(result: Result, spec) -> dict:
+    """The METRICS of a result (final step) of the case ``spec``; the slip is
+    the one that slid (``FractureFields.slid``)."""
     slip_max, length, n_slip, n_points = 0.0, 0.0, 0, 0
     slipping_means = []  # mean |slip| of each fracture with a point in slip
     fields = result.final.fractures if result.steps else []
-    for fracture, ff in zip(spec.fractures, fields, strict=False):
-        s, slip, state = ff.s, ff.slip, ff.state
+    for ends, ff in zip(fracture_ends(result, spec), fields, strict=False):
+        s, slip, state = ff.s, ff.slid, ff.state
         if slip.size:
             slip_max = max(slip_max, float(np.max(np.abs(slip))))
-        stretch = point_stretches(s, *arc_extent(fracture.points, box))
+        stretch = point_stretches(s, *ends)
         length += float(np.sum(stretch[state == SLIP]))
         if np.any(state == SLIP):
             slipping_means.append(

@@ -14,7 +14,10 @@ arrays (``output-format.md``):
 - ``steps``: a :class:`~xfemslip.post.fields.StepFields` per converged load
   step, in order: displacement (N, 2) [m], the fields of every fracture
   (``s``, ``points``, ``slip``, ``opening``, ``normal_traction``,
-  ``shear_traction``, ``state``), and the element stresses.  ``result.h5``
+  ``shear_traction``, ``state``, ``plastic_slip``), and the element stresses;
+- ``fracture_properties``: per fracture its ends and the shear modulus and
+  Poisson's ratio at its contact points
+  (:class:`~xfemslip.post.fields.FractureProperties`).  ``result.h5``
   keeps the element stresses of the final step only, so in a result read
   back they are None for the other steps.
 
@@ -31,7 +34,7 @@ from typing import Any
 
 import numpy as np
 
-from xfemslip.post.fields import FractureFields, StepFields
+from xfemslip.post.fields import FractureFields, FractureProperties, StepFields
 
 __all__ = ["TIMED_ATTRS", "EventTable", "PermeabilityHistory", "Result", "run_id"]
 
@@ -42,10 +45,10 @@ class EventTable:
     (:mod:`xfemslip.post.events`): arrays (S, F), S steps by F fractures."""
 
     slipped: np.ndarray  # bool: a contact point in state slip
-    max_slip: np.ndarray  # max |slip| [m]
+    max_slip: np.ndarray  # max |slip| that slid (plastic_slip) [m]
     slipping_length: np.ndarray  # [m]
     moment_per_length: np.ndarray  # M0' [N m / m]
-    stress_drop: np.ndarray  # crack model [Pa]; NaN without slipping length
+    stress_drop: np.ndarray  # moment-equivalent crack drop [Pa]; NaN: undefined
     extent: np.ndarray  # the W of the magnitude [m]
     extent_given: bool  # W is events.extent (else each slipping length)
     # of each step alone (its slip minus the step before's; in situ: 0)
@@ -87,6 +90,9 @@ class Result:
     steps: list[StepFields] = field(default_factory=list)
     # the folder the output set was written to (None: nothing written)
     out_dir: Path | None = None
+    # of the case (not in run_id: the case text is): per fracture its ends and
+    # elastic constants at its contact points (None: written without them)
+    fracture_properties: list[FractureProperties] | None = None
     # derived from the steps and the case (not in run_id): the event sizes,
     # and the block's permeability with [permeability]
     events: EventTable | None = None

@@ -34,6 +34,7 @@ from pathlib import Path
 
 import numpy as np
 
+from xfemslip.contact.interface import COMMITTED
 from xfemslip.conventions import SLIP
 from xfemslip.errors import ConvergenceError, UsageError
 from xfemslip.io.atomic import atomic_path
@@ -85,18 +86,11 @@ class DepletionReport:
 
 def _history(contact):
     """Copy of the committed friction history of a contact set."""
-    return tuple(
-        getattr(contact, n).copy()
-        for n in ("slip_committed", "state_committed", "gt_committed", "pt_committed")
-    )
+    return tuple(getattr(contact, name).copy() for name in COMMITTED)
 
 
 def _restore(contact, history) -> None:
-    for name, value in zip(
-        ("slip_committed", "state_committed", "gt_committed", "pt_committed"),
-        history,
-        strict=True,
-    ):
+    for name, value in zip(COMMITTED, history, strict=True):
         setattr(contact, name, value.copy())
 
 
@@ -139,20 +133,19 @@ def _linear_onset(contact, fi, pn0, pt0, lam_lo, pn_lo, pt_lo) -> float:
     return float(cand.min()) if cand.size else np.nan
 
 
-def _table_rows(model, results, change) -> list:
-    """Slip vs depletion rows: step, dp, per fracture max |slip| and slip length."""
-    rows = [(0, 0.0, 0.0, [(0.0, 0.0)] * len(model.fractures))]
-    c, ip = model.contact, model.ip
-    for r in results:
-        per = []
-        gt = r.contact.point_gt
-        state = r.contact.point_state
-        for fi in range(len(model.fractures)):
-            m = ip.fracture == fi
-            slip_len = float(ip.weight[m & (state == SLIP)].sum())
-            per.append((float(np.max(np.abs(gt[m]), initial=0.0)), slip_len))
-        rows.append((r.step, r.load_factor, r.load_factor * change, per))
-    del c
+def _table_rows(result, change, n) -> list:
+    """Slip vs depletion rows: step, load factor, dp, and per fracture the max
+    slip and the slipping length of its event sizes (``result.events``,
+    :mod:`xfemslip.post.events`: the slip that slid, the elastic give of stuck
+    points left out), from the in-situ state (step 0) on; n fractures."""
+    rows = [(0, 0.0, 0.0, [(0.0, 0.0)] * n)]
+    events = result.events
+    for k, step in enumerate(result.steps):
+        per = [
+            (float(events.max_slip[k, i]), float(events.slipping_length[k, i]))
+            for i in range(n)
+        ]
+        rows.append((step.step, step.load_factor, step.load_factor * change, per))
     return rows
 
 
@@ -375,7 +368,7 @@ def deplete(spec, out_dir=None, *, tolerance=None, plot=False, overwrite=False):
     def finish(done, folder: Path) -> None:
         """The tables and figures, into the output set before it is swapped in."""
         # a failed step keeps what converged, as `run` does
-        report.rows = _table_rows(done.model, done.results, change)
+        report.rows = _table_rows(done.result, change, len(done.model.fractures))
         report.out_dir = done.out_dir
         names = write_tables(report, folder)
         if plot:
@@ -468,7 +461,8 @@ def format_report(report: DepletionReport) -> str:
             f"{f'({o.x:.4g}, {o.y:.4g})':>26} {o.dp_linear:>15.6g}"
         )
     lines.append(
-        "slip vs depletion (max |slip| [m] / slipping length [m] per fracture):"
+        "slip vs depletion (max |slip| that slid [m] / slipping length [m] per "
+        "fracture):"
     )
     n = len(report.onsets)
     lines.append(

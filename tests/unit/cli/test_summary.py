@@ -1,9 +1,10 @@
 """The event table that ends ``xfemslip run`` and ``xfemslip summary``.
 
 The numbers of the table are checked against the result's arrays, computed
-here independently: each contact point weighs the stretch between the
-midpoints to its neighbours, the ends of a fracture inside the domain at
-s = 0 and s = its length; mu = E / (2 (1 + nu)); Mw from Hanks & Kanamori.
+here independently: the slip is the one that slid (``plastic_slip``), each
+contact point weighs the stretch between the midpoints to its neighbours,
+the ends of a fracture inside the domain at s = 0 and s = its length;
+mu = E / (2 (1 + nu)); Mw = (2/3) (log10 M0 - 9.1) (IASPEI).
 """
 
 from __future__ import annotations
@@ -75,13 +76,12 @@ def _expected(result, extent=None):
         mid = 0.5 * (ff.s[1:] + ff.s[:-1])
         stretch = np.diff(np.concatenate([[0.0], mid, [length]]))
         slipping = ff.state == 2
-        m0 = MU * float(np.sum(stretch * np.abs(ff.slip)))
+        m0 = MU * float(np.sum(stretch * np.abs(ff.plastic_slip)))
         lslip = float(np.sum(stretch[slipping]))
         w = extent if extent is not None else lslip
         mw = (2 / 3) * (math.log10(m0 * w) - 9.1) if m0 * w > 0 else -math.inf
-        rows.append(
-            (bool(slipping.any()), np.abs(ff.slip).max() * 1e3, lslip, m0, mw, w)
-        )
+        max_mm = np.abs(ff.plastic_slip).max() * 1e3
+        rows.append((bool(slipping.any()), max_mm, lslip, m0, mw, w))
     return rows
 
 
@@ -150,14 +150,16 @@ def test_summary_steps_prints_a_table_per_load_step(ran):
     read = xfemslip.read_result(out)
     blocks = result.output.split("fractures at step ")[1:]
     assert [b.split(" ", 1)[0] for b in blocks] == ["1", "2"]
-    first, second = (np.abs(s.fractures[0].slip).max() for s in read.steps)
+    first, second = (np.abs(s.fractures[0].plastic_slip).max() for s in read.steps)
     assert second > 1.01 * first
     for block, step in zip(blocks, read.steps, strict=True):
         rows = _table("\n".join(block.splitlines()[1:]))
         for row, ff in zip(rows, step.fractures, strict=True):
-            assert float(row[2]) == pytest.approx(np.abs(ff.slip).max() * 1e3, 1e-3)
+            slid = np.abs(ff.plastic_slip).max() * 1e3
+            assert float(row[2]) == pytest.approx(slid, rel=1e-3, abs=1e-12)
     # each step ends with what its own slip added (fracture 0 slips in both)
-    grow = np.abs(read.steps[1].fractures[0].slip - read.steps[0].fractures[0].slip)
+    one, two = (step.fractures[0].plastic_slip for step in read.steps)
+    grow = np.abs(two - one)
     last = blocks[1].splitlines()[-1]
     assert last.startswith("this step alone: fracture 0 +")
     assert float(last.split("+", 1)[1].split(" mm")[0]) == pytest.approx(
@@ -182,34 +184,67 @@ def test_events_extent_is_the_w_of_every_magnitude(tmp_path):
     assert result.output.strip().endswith("for W = 300 m (events.extent)")
 
 
-def test_summary_of_a_result_whose_case_files_are_elsewhere(ran, tmp_path):
-    """A result without stored event sizes (written before they were kept)
-    whose [network] CSV is not next to it: the fracture ends come from the
-    contact points, and the summary says so."""
+def _as_written_before(folder, keep_events: bool) -> None:
+    """Strip from a result.h5 what an older version did not write: the
+    plastic slip, the fractures' elastic constants and ends, the elastic
+    model, and /events unless ``keep_events``."""
+    with h5py.File(folder / "result.h5", "r+") as h5:
+        del h5.attrs["material_model"]
+        if not keep_events:
+            del h5["events"]
+        groups = [h5["fractures"]]
+        groups += [h5[f"steps/{k}/fractures"] for k in h5["steps"]]
+        for parent in groups:
+            for g in parent.values():
+                for name in ("plastic_slip", "shear_modulus", "poisson_ratio"):
+                    if name in g:
+                        del g[name]
+                if "ends" in g.attrs:
+                    del g.attrs["ends"]
+
+
+def test_summary_of_an_older_result_counts_the_jump_and_says_so(ran, tmp_path):
+    """A result written before the plastic slip, the elastic constants and
+    the event sizes were kept: the max slip is that of the tangential jump,
+    the slipping length uses ends estimated from the contact points, no
+    moment or magnitude (mu unknown), and the summary says all of it."""
     _, out = ran
-    (tmp_path / "seg.csv").write_text("x0,y0,x1,y1\n0.4,1.5,1.6,1.5\n")
-    copy = tmp_path / "copy"
-    shutil.copytree(out, copy)
-    with h5py.File(copy / "result.h5", "r+") as h5:
-        del h5["events"]
-        text = h5.attrs["case_toml"]
-        text = text.decode() if isinstance(text, bytes) else text
-        # the third fracture as a network.file member instead
-        h5.attrs["case_toml"] = (
-            text.replace(
-                "[[fractures]]\npoints = [[0.4, 1.5], [1.6, 1.5]]\nfriction = 0.1\n"
-                "cohesion = 0.0\n",
-                "",
-            )
-            + '[network]\nfile = "seg.csv"\nfriction = 0.1\n'
-        )
-    result = CliRunner().invoke(cli, ["summary", str(copy)])
+    older = tmp_path / "older"
+    shutil.copytree(out, older)
+    _as_written_before(older, keep_events=False)
+    read = xfemslip.read_result(older)
+    assert read.events is None and read.fracture_properties is None
+    assert read.fractures[0].plastic_slip is None
+    result = CliRunner().invoke(cli, ["summary", str(older)])
     assert result.exit_code == 0, result.output
-    assert "note: fracture ends estimated from the contact points" in result.output
-    assert "network.file" in result.output
-    exp = _expected(xfemslip.read_result(out))
-    row = _table(result.output)[0]
-    assert float(row[4]) == pytest.approx(exp[0][3], rel=0.05)
+    assert "the elastic give of stuck points included" in result.output
+    assert "fracture ends estimated from the contact points" in result.output
+    for row, ff in zip(_table(result.output), read.fractures, strict=True):
+        s = ff.s
+        ends = (s[0] - 0.5 * (s[1] - s[0]), s[-1] + 0.5 * (s[-1] - s[-2]))
+        mid = 0.5 * (s[1:] + s[:-1])
+        stretch = np.diff(np.concatenate([[ends[0]], mid, [ends[1]]]))
+        assert float(row[2]) == pytest.approx(np.abs(ff.slip).max() * 1e3, 1e-3)
+        assert float(row[3]) == pytest.approx(
+            np.sum(stretch[ff.state == 2]), rel=1e-3, abs=1e-12
+        )
+        assert row[4] == "-" and row[6] == "-"
+
+
+def test_summary_of_an_older_result_with_events_shows_them_with_a_note(ran, tmp_path):
+    """An older result that kept /events: its stored table, and the note that
+    its slip is the tangential jump."""
+    _, out = ran
+    older = tmp_path / "older"
+    shutil.copytree(out, older)
+    _as_written_before(older, keep_events=True)
+    runner = CliRunner()
+    original = runner.invoke(cli, ["summary", str(out)])
+    result = runner.invoke(cli, ["summary", str(older)])
+    assert result.exit_code == 0, result.output
+    assert _table(result.output) == _table(original.output)
+    assert "note: this result has no plastic_slip" in result.output
+    assert "note:" not in original.output
 
 
 def test_summary_of_a_missing_file_or_not_a_result_exits_2(tmp_path):
@@ -239,26 +274,35 @@ def test_result_h5_keeps_the_event_sizes_of_every_step(ran):
         assert group["moment"].attrs["units"] == "N m"
         assert group["max_slip"].shape == (2, len(FRACTURES))
         moment = group["moment"][()]
+        stress_drop = group["stress_drop"][()]
     events = result.events
     assert not events.extent_given
     for i, exp in enumerate(_expected(result)):
         slipped, max_mm, lslip, m0, _, w = exp
         assert bool(events.slipped[-1, i]) == slipped
-        assert events.max_slip[-1, i] * 1e3 == pytest.approx(max_mm, rel=1e-12)
+        assert events.max_slip[-1, i] * 1e3 == pytest.approx(
+            max_mm, rel=1e-12, abs=1e-300
+        )
         assert events.slipping_length[-1, i] == pytest.approx(lslip, rel=1e-12)
-        assert events.moment_per_length[-1, i] == pytest.approx(m0, rel=1e-12)
-        assert moment[-1, i] == pytest.approx(m0 * w, rel=1e-12)
-        # the stress drop is undefined (NaN in memory, 0 in the file) without slip
+        assert events.moment_per_length[-1, i] == pytest.approx(
+            m0, rel=1e-12, abs=1e-300
+        )
+        assert moment[-1, i] == pytest.approx(m0 * w, rel=1e-12, abs=1e-300)
+        # the stress drop is undefined without slip: NaN, in memory and in the file
         assert math.isnan(events.stress_drop[-1, i]) == (lslip == 0.0)
+        assert math.isnan(stress_drop[-1, i]) == (lslip == 0.0)
     # the increments of step 2: mu int |s2 - s1| ds, and step 1's are its own
     for i, (points, _) in enumerate(FRACTURES):
         s1, s2 = (step.fractures[i] for step in result.steps)
         mid = 0.5 * (s2.s[1:] + s2.s[:-1])
         stretch = np.diff(np.concatenate([[0.0], mid, [math.dist(*points)]]))
-        inc = MU * float(np.sum(stretch * np.abs(s2.slip - s1.slip)))
-        assert events.moment_per_length_increment[1, i] == pytest.approx(inc, 1e-12)
+        added = s2.plastic_slip - s1.plastic_slip
+        inc = MU * float(np.sum(stretch * np.abs(added)))
+        assert events.moment_per_length_increment[1, i] == pytest.approx(
+            inc, rel=1e-12, abs=1e-300
+        )
         assert events.max_slip_increment[1, i] == pytest.approx(
-            np.abs(s2.slip - s1.slip).max(), rel=1e-12
+            np.abs(added).max(), rel=1e-12, abs=1e-300
         )
         assert events.moment_per_length_increment[0, i] == pytest.approx(
             events.moment_per_length[0, i], rel=1e-12

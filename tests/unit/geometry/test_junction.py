@@ -297,8 +297,8 @@ def test_junction_function_jumps_only_next_to_its_junction(kind):
 
 def test_network_figure_is_written(tmp_path):
     """plot_results(kinds=["network"]) on a small T-junction run: one PNG,
-    with the slip colour scale running up to the largest |slip| of the run
-    (in mm)."""
+    with the slip colour scale running up to the largest |slip| that slid in
+    the run (its plastic slip, in mm)."""
     from matplotlib.figure import Figure  # noqa: F401  (matplotlib present)
 
     from xfemslip.case import loads_case
@@ -317,6 +317,6 @@ def test_network_figure_is_written(tmp_path):
     data = figure_data(tmp_path / "out")
     fig = figure_network(data)
     slip_axes = fig.axes[0]
-    top = max(float(np.abs(f.slip).max()) for f in data.fractures)
+    top = max(float(np.abs(f.slid).max()) for f in data.fractures)
     lc = [c for c in slip_axes.collections if c.get_array() is not None]
     assert len(lc) == 2 and lc[0].norm.vmax == 1e3 * top

@@ -11,12 +11,14 @@ import meshio
 import numpy as np
 import pytest
 
+import xfemslip
 from xfemslip import __version__
 from xfemslip.errors import OutputError
 from xfemslip.io.atomic import atomic_path
 from xfemslip.io.hdf5 import write_result
 from xfemslip.io.vtu import write_bulk, write_fractures, write_pvd
 from xfemslip.post.fields import FractureFields, StepFields, VisMesh
+from xfemslip.post.result import EventTable
 
 FRACTURE_UNITS = {
     "s": "m",
@@ -259,6 +261,45 @@ def test_result_h5_rejects_wrong_shapes(tmp_path):
         )
     assert not (tmp_path / "result.h5").exists()
     assert os.listdir(tmp_path) == []
+
+
+def _events(drop) -> EventTable:
+    """An /events table of 2 steps by 1 fracture with the stress drops
+    ``drop`` (2, 1)."""
+    ones = np.ones((2, 1))
+    return EventTable(
+        slipped=np.array([[False], [True]]),
+        max_slip=ones * [[0.0], [1e-3]],
+        slipping_length=ones * [[0.0], [0.5]],
+        moment_per_length=ones * [[0.0], [2e6]],
+        stress_drop=np.asarray(drop, float),
+        extent=ones * [[0.0], [0.5]],
+        extent_given=False,
+        max_slip_increment=ones * [[0.0], [1e-3]],
+        moment_per_length_increment=ones * [[0.0], [2e6]],
+    )
+
+
+def test_undefined_stress_drop_is_stored_as_nan(tmp_path):
+    """/events/stress_drop holds NaN where the crack model is undefined (no
+    slipping length) and reads back as NaN; inf is refused all the same."""
+    points, cells = _mesh()
+    common = dict(
+        points=points,
+        cells=cells,
+        steps=[_step(1), _step(2)],
+        attrs=_attrs(2),
+        load_steps=2,
+    )
+    write_result(tmp_path / "result.h5", events=_events([[np.nan], [3.0e6]]), **common)
+    with h5py.File(tmp_path / "result.h5") as h5:
+        drop = h5["events/stress_drop"][()]
+    assert np.isnan(drop[0, 0]) and drop[1, 0] == 3.0e6
+    read = xfemslip.read_result(tmp_path / "result.h5").events.stress_drop
+    assert np.isnan(read[0, 0]) and read[1, 0] == 3.0e6
+    with pytest.raises(OutputError, match="stress_drop"):
+        write_result(tmp_path / "bad.h5", events=_events([[np.inf], [3.0e6]]), **common)
+    assert not (tmp_path / "bad.h5").exists()
 
 
 # --------------------------------------------------------------------------- vtu

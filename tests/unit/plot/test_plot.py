@@ -75,11 +75,15 @@ def test_slip_figure_draws_the_result_data(two_runs):
     fig = figure_slip(results)
     lines = [ln for ln in fig.axes[0].lines if ln.get_linestyle() == "-"]
     assert len(lines) == 2
-    for line, out in zip(lines, two_runs, strict=True):
+    dashed = [ln for ln in fig.axes[0].lines if ln.get_linestyle() == "--"]
+    for line, jump, out in zip(lines, dashed, two_runs, strict=True):
         with h5py.File(out / "result.h5") as f:
             s, slip = f["fractures/0/s"][()], f["fractures/0/slip"][()]
+            slid = f["fractures/0/plastic_slip"][()]
         np.testing.assert_array_equal(line.get_xdata(), s - s.min())
-        np.testing.assert_array_equal(line.get_ydata(), 1e3 * np.abs(slip))  # mm
+        # solid: what slid, dashed: the jump (mm)
+        np.testing.assert_array_equal(line.get_ydata(), 1e3 * np.abs(slid))
+        np.testing.assert_array_equal(jump.get_ydata(), 1e3 * np.abs(slip))
         assert line.get_label() == f"tiny (angle = {out.name[-2:]} deg)"
 
 
@@ -128,6 +132,7 @@ def test_piece_outlines_drop_inner_edges_of_one_side():
         s=np.linspace(0, 1, 5),
         points=diag,
         slip=np.zeros(5),
+        slid=np.zeros(5),
         normal_traction=np.zeros(5),
         shear_traction=np.zeros(5),
         state=np.zeros(5),

@@ -78,6 +78,7 @@ class _Tractions:
         self.state = np.zeros(pn.size, np.int8)
         self.point_pn, self.point_pt, self.point_gn, self.point_gt = pn, pt, zero, zero
         self.point_state = self.state
+        self.point_plastic_slip = zero
 
 
 @pytest.fixture(scope="module")

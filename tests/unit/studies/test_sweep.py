@@ -371,10 +371,10 @@ def test_run_sweep_summary_skip_and_failure(tmp_path, base):
     assert "did not converge" in rows[0].error.lower() or "step 1" in rows[0].error
     ok = rows[1].metrics
     with h5py.File(out / rows[1].case_id / "result.h5") as f:
-        slip = f["fractures/0/slip"][()]
+        slid = f["fractures/0/plastic_slip"][()]  # max slip: what slid
         state = f["fractures/0/state"][()]
         iterations = int(f.attrs["newton_iterations"])
-    assert ok["max_abs_slip_m"] == pytest.approx(np.abs(slip).max(), rel=1e-12)
+    assert ok["max_abs_slip_m"] == pytest.approx(np.abs(slid).max(), rel=1e-12)
     assert ok["slip_share"] == pytest.approx(np.mean(state == 2))
     assert ok["newton_iterations"] == iterations and ok["converged"] is True
     # every point slips here: the slipping length is the fracture's, 0.6 m
@@ -399,7 +399,8 @@ def test_run_sweep_summary_skip_and_failure(tmp_path, base):
 def test_summary_adds_event_and_permeability_columns_after_the_metrics(tmp_path, base):
     """summary.csv keeps every earlier column, in order, and adds the event
     size of each fracture (from the member's /events, checked here against
-    its arrays: Mw = 2/3 (log10(mu int |s| ds W) - 9.1), the slipping length
+    its arrays: Mw = 2/3 (log10(mu int |d| ds W) - 9.1) with d the plastic
+    slip, the slipping length
     and W = events.extent) and, with [permeability], the ratios."""
     text = base.read_text() + (
         "[events]\nextent = 100.0\n[permeability]\naperture = 1.0e-4\n"
@@ -420,7 +421,7 @@ def test_summary_adds_event_and_permeability_columns_after_the_metrics(tmp_path,
     mid = 0.5 * (ff.s[1:] + ff.s[:-1])
     length = CASE["fractures"][0]["length"]  # inside the domain
     stretch = np.diff(np.concatenate([[0.0], mid, [length]]))
-    m0 = mu * float(np.sum(stretch * np.abs(ff.slip)))
+    m0 = mu * float(np.sum(stretch * np.abs(ff.plastic_slip)))  # what slid
     mw = 2.0 / 3.0 * (math.log10(m0 * 100.0) - 9.1)
     assert float(line["fracture0_moment_per_length_Nm_per_m"]) == pytest.approx(
         m0, rel=1e-5

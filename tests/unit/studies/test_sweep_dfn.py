@@ -68,16 +68,19 @@ def _rows(path):
         return list(csv.DictReader(fh))
 
 
-def _fracture_reference(fracture, length):
-    """(slips?, max |slip|, trapezoid-weighted mean |slip|) of one fracture.
+def _fracture_reference(fracture, length, ends):
+    """(slips?, max |slip|, trapezoid-weighted mean |slip|) of one fracture,
+    the slip that slid (its plastic slip).
 
     Independent of sweep_run: weights from the gaps between the points, each
-    split half and half, the end points reaching s = 0 and s = length (the
-    fracture lies wholly in the domain with outside = "reject"), or beyond:
-    an end that stops short of another fracture is extended onto it (a T,
-    by less than h / 2), so its points may reach s < 0 or s > length."""
-    s, slip, state = fracture.s, fracture.slip, fracture.state
-    lo, hi = min(0.0, s[0]), max(length, s[-1])
+    split half and half, the end points reaching the fracture's ends as
+    built, which result.h5 stores: s = 0 and s = length (the fracture lies
+    wholly in the domain with outside = "reject"), or beyond: an end that
+    stops short of another fracture is extended onto it (a T, by less than
+    h / 2), so its points may reach s < 0 or s > length."""
+    s, slip, state = fracture.s, fracture.plastic_slip, fracture.state
+    lo, hi = ends
+    assert lo <= min(0.0, s[0]) + 1e-12 and hi >= max(length, s[-1]) - 1e-12
     assert hi - lo < length + 0.05  # h = 0.05: at most h / 2 at each end
     gaps = np.diff(np.concatenate([[lo], s, [hi]]))
     weight = 0.5 * (gaps[:-1] + gaps[1:])
@@ -107,12 +110,14 @@ def test_three_realizations_end_to_end(tmp_path):
         spec = loads_case((folder / "case.toml").read_text(), folder / "case.toml")
         assert row["status"] == "ok" and row["converged"] == "true"
         assert int(row["fractures"]) == len(spec.fractures) == 6
-        fractures = xfemslip.read_result(folder / "result.h5").fractures
+        read = xfemslip.read_result(folder / "result.h5")
+        fractures = read.fractures
         assert len(fractures) == 6
         refs = [
             _fracture_reference(
                 fractures[i],
                 float(np.hypot(*np.diff(spec.fractures[i].points, axis=0).T).sum()),
+                read.fracture_properties[i].ends,
             )
             for i in range(6)
         ]
