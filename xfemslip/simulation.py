@@ -72,6 +72,9 @@ class Model:
     kernels: str  # kernel backend ("numba" | "numpy", kernels.choose)
     materials: Materials | None = None  # per-cell constants ([reservoir])
     pore: PorePressure | None = None  # [pore_pressure]
+    # per fracture, the arc lengths where the rock on a face changes
+    # (xfemslip.fem.zones.loading_breaks)
+    breaks: list | None = None
 
 
 @contextlib.contextmanager
@@ -214,6 +217,7 @@ def build_model(spec) -> Model:
         kernels=kernel_backend,
         materials=materials,
         pore=pore,
+        breaks=breaks,
     )
     check_memory(spec, model_footprint(model))  # before the LU and the steps
     return model
@@ -384,6 +388,16 @@ def solve_and_write(
     return done
 
 
+def _depth_datum(spec) -> float | None:
+    """The y [m] of zero depth of a case whose state varies with depth."""
+    if spec.loading.in_situ is not None:
+        return spec.loading.in_situ.datum
+    pore = spec.pore_pressure
+    if pore is not None and pore.gradient != 0.0:
+        return pore.datum
+    return None
+
+
 def collect_result(model: Model, results, *, converged, wall):
     """The Result of the converged steps ``results`` and, when a step holds
     NaN or inf, the ConvergenceError that says so (the finite steps before it
@@ -419,6 +433,9 @@ def collect_result(model: Model, results, *, converged, wall):
         "status_codes": STATE_CODES,
         "material_model": spec.material.model,
     }
+    datum = _depth_datum(spec)
+    if datum is not None:  # profiles give depths below it (xfemslip.post.profile)
+        attrs["depth_datum"] = float(datum)
     attrs["run_id"] = run_id(attrs, model.mesh.nodes, model.mesh.cells, fields)
     result = Result(attrs, model.mesh.nodes, model.mesh.cells, fields)
     # of the case and derived from the fields, so outside run_id

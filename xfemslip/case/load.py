@@ -282,7 +282,8 @@ def _read_formats(table: Table) -> tuple[str, ...] | None:
     if not isinstance(value, list) or not value:
         table.error(
             "formats",
-            f'expected a non-empty array of formats ("h5", "vtu"), got {show(value)}',
+            f'expected a non-empty array of formats ("h5", "vtu", "csv"), got '
+            f"{show(value)}",
         )
         return None
     key = table.key("formats")

@@ -226,7 +226,7 @@ class SolverSpec:
 @dataclass(frozen=True, kw_only=True)
 class OutputSpec:
     directory: Path  # resolved: output.directory, else out/<name> (relative to cwd)
-    formats: tuple[str, ...] = ("h5", "vtu")
+    formats: tuple[str, ...] = ("h5", "vtu", "csv")
 
 
 @dataclass(frozen=True, kw_only=True)

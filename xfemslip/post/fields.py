@@ -21,10 +21,11 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from xfemslip.contact.interface import JUMP_PROBE
+from xfemslip.conventions import STICK
 from xfemslip.fem.enrichment import HEAVISIDE, find_candidates, group_values
 from xfemslip.fem.material import shear_modulus
-from xfemslip.fem.poro import FACE_OFFSET, cell_centres, face_zones
-from xfemslip.fem.zones import build_zones, in_situ_stress
+from xfemslip.fem.poro import FACE_OFFSET, cell_centres, domain_box, face_zones
+from xfemslip.fem.zones import build_zones, in_situ_stress, loading_breaks
 from xfemslip.geometry.fracture import GEOMETRY_TOL
 
 
@@ -49,6 +50,9 @@ class FractureFields:
     # with [permeability] only (xfemslip.post.hydraulics)
     aperture: np.ndarray | None = None  # (K,) hydraulic aperture a [m]
     transmissivity: np.ndarray | None = None  # (K,) a^3 / 12 [m^3]
+    # |p_T| / (c + f max(0, -p_N')) of a stuck point, 1 where it slips or is
+    # open (coulomb_utilisation); None in a result written without it
+    utilisation: np.ndarray | None = None  # (K,) [-]
 
     @property
     def slid(self) -> np.ndarray:
@@ -67,6 +71,16 @@ class FractureProperties:
     ends: tuple[float, float]  # arc-length range of the fracture inside the domain [m]
     shear_modulus: np.ndarray  # (K,) mu at its contact points, sorted by s [Pa]
     poisson_ratio: np.ndarray  # (K,) nu there [-]
+    # the in-situ state at the contact points (effective normal and shear
+    # traction, utilisation), None in a result written without them
+    in_situ_normal_traction: np.ndarray | None = None  # (K,) p_N0' [Pa]
+    in_situ_shear_traction: np.ndarray | None = None  # (K,) p_T0 [Pa]
+    in_situ_utilisation: np.ndarray | None = None  # (K,) [-]
+    # where the rock on a face changes along it (arc lengths [m]) and the
+    # units on its + and - faces on each stretch between (len(breaks) + 1)
+    breaks: np.ndarray | None = None
+    units_plus: tuple[str, ...] = ()
+    units_minus: tuple[str, ...] = ()
 
 
 @dataclass
@@ -163,6 +177,19 @@ def bulk_fields(
     return stress, szz, principal
 
 
+def coulomb_utilisation(pn, pt, state, friction, cohesion) -> np.ndarray:
+    """|p_T| / (c + f max(0, -p_N')) [-] of each contact point or patch: how
+    much of its Coulomb strength a stuck point uses; 1 where it slips (on the
+    bound) or is open (no strength left); 0 for a stuck point without shear
+    or strength.  p_N' is the effective normal traction the contact law acts
+    on (tension positive)."""
+    strength = cohesion + friction * np.maximum(0.0, -np.asarray(pn, float))
+    ratio = np.divide(
+        np.abs(pt), strength, out=np.zeros(np.shape(strength)), where=strength > 0.0
+    )
+    return np.where(np.asarray(state) == STICK, np.minimum(ratio, 1.0), 1.0)
+
+
 def fracture_fields(ip, res, n_fractures, fluid=None) -> list[FractureFields]:
     """Contact fields per fracture, ordered by arc length.
 
@@ -171,6 +198,12 @@ def fracture_fields(ip, res, n_fractures, fluid=None) -> list[FractureFields]:
     ``normal_traction`` is the total sigma_n' - p_f and the effective one and
     p_f are reported too (xfemslip.fem.poro).
     """
+    c = getattr(res, "contact", None)
+    use = (
+        coulomb_utilisation(res.pn, res.pt, res.state, c.friction, c.cohesion)[c.patch]
+        if c is not None
+        else None
+    )
     out = []
     for fi in range(n_fractures):
         m = np.nonzero(ip.fracture == fi)[0]
@@ -191,6 +224,7 @@ def fracture_fields(ip, res, n_fractures, fluid=None) -> list[FractureFields]:
                 shear_traction=res.point_pt[m].copy(),
                 state=res.point_state[m].astype(np.int8),
                 plastic_slip=res.point_plastic_slip[m].copy(),
+                utilisation=None if use is None else use[m].copy(),
                 **extra,
             )
         )
@@ -391,20 +425,39 @@ def fracture_properties(model) -> list[FractureProperties]:
     spec, ip = model.spec, model.ip
     zones = model.materials.zones if model.materials else build_zones(spec)
     E, nu = np.asarray(zones.E, float), np.asarray(zones.nu, float)
-    plus, minus = face_zones(zones, ip, FACE_OFFSET * model.mesh.h_min)
+    eps = FACE_OFFSET * model.mesh.h_min
+    plus, minus = face_zones(zones, ip, eps)
     mu = shear_modulus(E, nu)
     point_mu = 0.5 * (mu[plus] + mu[minus])
     point_nu = 0.5 * (nu[plus] + nu[minus])
+    c = model.contact
+    pn0 = c.pn0  # effective where there is pore pressure (make_contact_effective)
+    pt0 = -c.kt * c.slip_reference
+    state0 = np.full(c.n, STICK, np.int8)
+    use0 = coulomb_utilisation(pn0, pt0, state0, c.friction, c.cohesion)
+    use0 = np.where(pn0 > 0.0, 1.0, use0)  # in tension in situ: it opens
+    breaks = model.breaks
+    if breaks is None:
+        breaks = loading_breaks(zones, model.fractures, domain_box(model.mesh), eps)
     out = []
     for fi, fr in enumerate(model.fractures):
         m = np.nonzero(ip.fracture == fi)[0]
         m = m[np.argsort(ip.s[m], kind="stable")]
         ends = (float(fr.s_start[0]), float(fr.s_start[-1] + fr.length[-1]))
+        cuts = np.asarray(breaks[fi], float)
+        mids = np.concatenate([[ends[0]], cuts, [ends[1]]])
+        xy, normal = fr.point_at(0.5 * (mids[1:] + mids[:-1]))
         out.append(
             FractureProperties(
                 ends=ends,
                 shear_modulus=point_mu[m].copy(),
                 poisson_ratio=point_nu[m].copy(),
+                in_situ_normal_traction=pn0[c.patch[m]].copy(),
+                in_situ_shear_traction=pt0[c.patch[m]].copy(),
+                in_situ_utilisation=use0[c.patch[m]].copy(),
+                breaks=cuts,
+                units_plus=tuple(zones.names[z] for z in zones.at(xy + eps * normal)),
+                units_minus=tuple(zones.names[z] for z in zones.at(xy - eps * normal)),
             )
         )
     return out
