@@ -27,15 +27,18 @@ from xfemslip.fem.enrichment import EnrichedCells, build_enriched_cells, find_ca
 from xfemslip.fem.material import elasticity_matrix
 from xfemslip.fem.mesh import Mesh, build_mesh
 from xfemslip.fem.poro import (
+    FACE_OFFSET,
     Materials,
     PorePressure,
     body_load,
     build_materials,
     build_pore_pressure,
+    domain_box,
     fracture_load,
     make_contact_effective,
 )
 from xfemslip.fem.quadrature import InterfacePoints, interface_points
+from xfemslip.fem.zones import build_zones, in_situ_stress, loading_breaks
 from xfemslip.geometry.junctions import build_fractures
 from xfemslip.io.results import run_folder, write_results
 from xfemslip.memory import check_memory, enriched_footprint, model_footprint
@@ -69,6 +72,9 @@ class Model:
     kernels: str  # kernel backend ("numba" | "numpy", kernels.choose)
     materials: Materials | None = None  # per-cell constants ([reservoir])
     pore: PorePressure | None = None  # [pore_pressure]
+    # per fracture, the arc lengths where the rock on a face changes
+    # (xfemslip.fem.zones.loading_breaks)
+    breaks: list | None = None
 
 
 @contextlib.contextmanager
@@ -85,9 +91,22 @@ def _geometry(spec):
     allocated for a case that would not fit)."""
     check_memory(spec)
     mesh = build_mesh(spec.mesh.x, spec.mesh.y)
-    box = np.array([mesh.x[0], mesh.x[-1], mesh.y[0], mesh.y[-1]])
+    box = np.array(domain_box(mesh))
     with _naming_the_file(spec):
         return mesh, build_fractures(mesh, spec.fractures, box)
+
+
+def _contact_in_situ(spec, zones, ip, eps):
+    """The in-situ stress the fractures start with: ``initial_stress`` (xx,
+    yy, xy) when uniform (or None), else (n_ip, 3) [Pa] at every interface
+    point, the mean of its two faces (xfemslip.fem.zones.in_situ_stress)."""
+    if spec.loading.in_situ is None:
+        return spec.loading.initial_stress
+    faces = []
+    for sign in (1.0, -1.0):
+        xy = ip.xy + sign * eps * ip.normal
+        faces.append(in_situ_stress(spec, zones, xy, zones.at(xy)))
+    return 0.5 * (faces[0] + faces[1])
 
 
 def check_geometry(spec) -> None:
@@ -115,9 +134,12 @@ def build_model(spec) -> Model:
     check_memory(spec, enriched_footprint(spec, mesh, fractures, cand))
     ec = build_enriched_cells(mesh, fractures, cand)
     kernel_backend = kernels.choose(spec.solver.kernels, kernel_work(ec))
-    ip = interface_points(fractures, mesh.h_min)
+    zones = build_zones(spec)
+    eps = FACE_OFFSET * mesh.h_min
+    breaks = loading_breaks(zones, fractures, domain_box(mesh), eps)
+    ip = interface_points(fractures, mesh.h_min, breaks)
     materials = build_materials(spec, mesh, ec, fractures)
-    if spec.reservoir is None:
+    if not spec.units:
         bulk = assemble_bulk(mesh, D, cand, ec, ip, backend=kernel_backend)
     else:
         bulk = assemble_bulk(
@@ -130,7 +152,7 @@ def build_model(spec) -> Model:
             materials.qp,
             backend=kernel_backend,
         )
-    pore = build_pore_pressure(spec, materials, ec, ip, mesh.h_min)
+    pore = build_pore_pressure(spec, materials, mesh, ec, ip, spec.fractures)
     contact = build_contact(
         mesh,
         fractures,
@@ -138,10 +160,11 @@ def build_model(spec) -> Model:
         ec,
         cand,
         bulk.dofmap,
-        spec.loading.initial_stress,
+        _contact_in_situ(spec, zones, ip, eps),
         mat.E,
         spec.solver.contact_patch,
         kernels=kernel_backend,
+        breaks=breaks,
     )
     with _naming_the_file(spec):
         bc = hold_enriched(dirichlet(mesh, spec.boundary), cand, bulk.dofmap)
@@ -149,7 +172,7 @@ def build_model(spec) -> Model:
         mesh, spec.boundary, spec.loading, ec, cand, bulk.dofmap, fractures
     )
     if pore is not None:  # Biot body load and fracture fluid load (xfemslip.fem.poro)
-        make_contact_effective(contact, pore)
+        make_contact_effective(contact, pore, ip)
         F = (
             F
             + body_load(mesh, bulk, pore, ec, kernel_backend)
@@ -194,6 +217,7 @@ def build_model(spec) -> Model:
         kernels=kernel_backend,
         materials=materials,
         pore=pore,
+        breaks=breaks,
     )
     check_memory(spec, model_footprint(model))  # before the LU and the steps
     return model
@@ -219,7 +243,7 @@ def _log_in_situ_release(model: Model, zero) -> None:
     above the friction limit, or tension) and how much of it the first load
     step releases (ContactSet.in_situ_force)."""
     c = model.contact
-    if model.spec.loading.initial_stress is None or not np.any(zero.state != STICK):
+    if not model.spec.loading.has_in_situ or not np.any(zero.state != STICK):
         return
     pt_in_situ = c.kt * (0.0 - c.slip_committed)
     for fi, fr in enumerate(model.fractures):
@@ -364,6 +388,16 @@ def solve_and_write(
     return done
 
 
+def _depth_datum(spec) -> float | None:
+    """The y [m] of zero depth of a case whose state varies with depth."""
+    if spec.loading.in_situ is not None:
+        return spec.loading.in_situ.datum
+    pore = spec.pore_pressure
+    if pore is not None and pore.gradient != 0.0:
+        return pore.datum
+    return None
+
+
 def collect_result(model: Model, results, *, converged, wall):
     """The Result of the converged steps ``results`` and, when a step holds
     NaN or inf, the ConvergenceError that says so (the finite steps before it
@@ -399,6 +433,9 @@ def collect_result(model: Model, results, *, converged, wall):
         "status_codes": STATE_CODES,
         "material_model": spec.material.model,
     }
+    datum = _depth_datum(spec)
+    if datum is not None:  # profiles give depths below it (xfemslip.post.profile)
+        attrs["depth_datum"] = float(datum)
     attrs["run_id"] = run_id(attrs, model.mesh.nodes, model.mesh.cells, fields)
     result = Result(attrs, model.mesh.nodes, model.mesh.cells, fields)
     # of the case and derived from the fields, so outside run_id

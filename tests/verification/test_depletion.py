@@ -31,7 +31,6 @@ import pytest
 
 from tests.support.depletion_cases import offset_fault_case
 from xfemslip.case import build, loads_case
-from xfemslip.fem.poro import fluid_pressure
 from xfemslip.post.fields import step_fields
 from xfemslip.reference.closed_form_depletion import (
     critical_change_uniaxial,
@@ -253,7 +252,7 @@ def _stuck_fault_errors(h, **kw):
     ref_patch = np.bincount(cs.patch, weights=ip.weight * ref) / W
     yc = np.bincount(cs.patch, weights=ip.weight * ip.xy[:, 1]) / W
     dist = np.min(np.abs(yc[:, None] - np.array([a, b, c, d])), axis=1) - W / 2
-    keep = dist > 4.0 * h
+    keep = dist > 4.0 * h * (1.0 + 1e-9)  # patches ending 4 h away: out
     assert np.all(res.state == 1)
     err = res.pt[keep] - ref_patch[keep]
     rms = np.sqrt(np.mean(err**2) / np.mean(ref_patch[keep] ** 2))
@@ -267,29 +266,24 @@ def test_offset_fault_stuck_shear_traction():
     rollers at +-3 km (graded mesh, uniform h near the fault).  The fault is
     ON the pressure boundary x = 0, mid-cell (the cut cells are split per
     quadrature point, xfemslip.fem.poro), so the four reservoir corners, where
-    (J1) has log singularities, lie on the fault itself.  Measured (rms / max
-    relative error over patches > 4 h from the corners): h = 10 m 3.6 % /
-    5.2 %; h = 5 m 2.9 % / 2.7 %; h = 2.5 m 1.6 % / 2.9 % (rms order 0.3,
-    0.8; with the contact patches built before the network merge, which
-    walked each segment from its first point, h = 10 m gave 4.3 % / 6.5 %
-    and h = 1.25 m 0.87 % / 1.5 %).  Larger than with the fault
-    half a cell off the boundary (2.3 / 1.3 / 0.64 % rms there): the patches
-    kept are 4 h from singularities now on the fault, not h / 2 beside it;
-    away from the corners both set-ups agree (e.g. 0.25 % at y = 15 m,
-    h = 2.5 m).
+    (J1) has log singularities, lie on the fault itself, and the contact
+    patches end there (xfemslip.fem.zones.loading_breaks).  Measured (rms /
+    max relative error over patches > 4 h from the corners): h = 10 m
+    7.4 % / 11 % (the 30 m between two corners is three cells); h = 5 m
+    2.7 % / 2.8 %; h = 2.5 m 0.91 % / 1.3 % (rms order 1.4, 1.6).
     """
     rms10, max10 = _stuck_fault_errors(10.0)
     rms5, max5 = _stuck_fault_errors(5.0)
-    assert rms10 < 0.045 and max10 < 0.065
-    assert rms5 < 0.034 and max5 < 0.033
-    assert rms5 < 0.9 * rms10  # converging (slowly: corners on the fault)
+    assert rms10 < 0.08 and max10 < 0.12
+    assert rms5 < 0.03 and max5 < 0.031
+    assert rms5 < 0.4 * rms10  # converging
 
 
 @pytest.mark.slow
 def test_offset_fault_stuck_shear_traction_fine():
-    """The stuck fault of the test above at h = 2.5 m (rms 1.6 %, max 2.9 %)."""
+    """The stuck fault of the test above at h = 2.5 m (rms 0.91 %, max 1.3 %)."""
     rms, mx = _stuck_fault_errors(2.5)
-    assert rms < 0.02 and mx < 0.035
+    assert rms < 0.01 and mx < 0.015
 
 
 def test_offset_fault_fluid_pressure_is_the_mean_of_the_faces():
@@ -304,9 +298,9 @@ def test_offset_fault_fluid_pressure_is_the_mean_of_the_faces():
     left = (y > a) & (y < b)
     right = (y > c) & (y < d)
     want = 10.0e6 - 10.0e6 * (left.astype(float) + right) / 2.0
-    got = fluid_pressure(model.ip, model.pore, 1.0)
+    got = model.pore.fluid(1.0)
     np.testing.assert_allclose(got, want, rtol=1e-15)
-    assert {0.0, 0.5, 1.0} == set(np.unique(model.pore.point_changes))
+    assert {0.0, 0.5, 1.0} == set(np.unique(model.pore.point_ratio))
     cb = model.mesh.bounds
     yc = 0.5 * (cb[:, 2] + cb[:, 3])
     cut = (cb[:, 0] < 0.0) & (cb[:, 1] > 0.0)

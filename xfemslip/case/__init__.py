@@ -49,11 +49,7 @@ from xfemslip.case.options import (
     STRESS_KEYS,
     TOP_KEYS,
 )
-from xfemslip.case.pore import (
-    PORE_PRESSURE_KEYS,
-    PORE_PRESSURE_REGIONS,
-    RESERVOIR_KEYS,
-)
+from xfemslip.case.pore import PORE_PRESSURE_KEYS, PORE_PRESSURE_REGIONS
 from xfemslip.case.specs import (
     AUTO_PENALTY,
     CONTACT_PATCH_CELLS,
@@ -64,16 +60,20 @@ from xfemslip.case.specs import (
     EventsSpec,
     FractureSpec,
     HydraulicSpec,
+    InSituSpec,
     LoadingSpec,
     MaterialSpec,
     MeshSpec,
     OutputSpec,
     PermeabilitySpec,
     PorePressureSpec,
+    RegionSpec,
     ReservoirSpec,
     SolverSpec,
+    UnitSpec,
 )
 from xfemslip.case.tables import Option, Range
+from xfemslip.case.units import RESERVOIR_KEYS, UNIT_KEYS
 
 __all__ = [
     "AUTO_PENALTY",
@@ -106,12 +106,14 @@ __all__ = [
     "TIP_KEYS",
     "TIP_KINDS",
     "TOP_KEYS",
+    "UNIT_KEYS",
     "BoundarySpec",
     "CaseSpec",
     "EdgeSpec",
     "EventsSpec",
     "FractureSpec",
     "HydraulicSpec",
+    "InSituSpec",
     "LoadingSpec",
     "MaterialSpec",
     "MeshSpec",
@@ -120,8 +122,10 @@ __all__ = [
     "PermeabilitySpec",
     "PorePressureSpec",
     "Range",
+    "RegionSpec",
     "ReservoirSpec",
     "SolverSpec",
+    "UnitSpec",
     "describe",
     "load_case",
     "loads_case",

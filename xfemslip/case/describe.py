@@ -22,6 +22,7 @@ from xfemslip.case.specs import (
     SolverSpec,
 )
 from xfemslip.case.tables import fmt
+from xfemslip.fem.zones import build_zones, in_situ_stress, initial_pressure
 from xfemslip.reference.screen import coulomb_margin, plane_stresses
 
 
@@ -105,12 +106,22 @@ def in_situ_margin(spec: CaseSpec, fracture: FractureSpec) -> tuple[float, float
     other.  (nan, nan) without ``loading.initial_stress``.
     """
     stress = spec.loading.initial_stress
-    if stress is None:
+    if stress is None and spec.loading.in_situ is None:
         return math.nan, math.nan
     p0 = spec.pore_pressure.initial if spec.pore_pressure is not None else 0.0
     seg = np.diff(fracture.points, axis=0)
     angles = np.degrees(np.arctan2(seg[:, 1], seg[:, 0]))
-    sigma_n, tau = plane_stresses(stress, angles)
+    if stress is not None:
+        sigma_n, tau = plane_stresses(stress, angles)
+    else:  # varying with depth: at each segment's middle
+        zones = build_zones(spec)
+        mid = 0.5 * (fracture.points[1:] + fracture.points[:-1])
+        zone = zones.at(mid)
+        p0 = initial_pressure(spec, zones, mid, zone)
+        S = in_situ_stress(spec, zones, mid, zone, p0)
+        pairs = [plane_stresses(S[k], angles[k]) for k in range(len(angles))]
+        sigma_n = np.array([float(a) for a, _ in pairs])
+        tau = np.array([float(b) for _, b in pairs])
     sigma_n = sigma_n + p0
     margin = coulomb_margin(sigma_n, tau, fracture.friction, fracture.cohesion)
     worst = int(np.argmax(sigma_n)) if np.any(sigma_n > 0.0) else int(np.argmin(margin))
@@ -136,8 +147,11 @@ def _margin_text(spec: CaseSpec, fracture: FractureSpec) -> str:
     return text + " (stable)"
 
 
-def _describe_edge(name: str, edge: EdgeSpec) -> str:
-    """One edge's boundary condition."""
+def _describe_edge(name: str, edge: EdgeSpec, in_situ=False) -> str:
+    """One edge's boundary condition (``in_situ``: the in-situ stress varies
+    with depth, and a traction edge keeps its in-situ traction)."""
+    if edge.kind == "traction" and in_situ:
+        return f"  {name}: traction = its in-situ traction (unchanged)"
     if edge.kind == "traction":
         return f"  {name}: traction = loading.stress . n"
     if edge.kind == "free":
@@ -172,18 +186,75 @@ def _describe_stress(stress: tuple[float, float, float] | None) -> str:
     return f"(xx, yy, xy) = ({values}) {LoadingSpec.UNITS['stress']}"
 
 
+def _describe_in_situ(spec: CaseSpec) -> str:
+    """The in-situ stress: uniform, or how it grows with depth."""
+    s = spec.loading.in_situ
+    if s is None:
+        return f"initial_stress {_describe_stress(spec.loading.initial_stress)}"
+    if s.gravity is not None:
+        yy = f"{fmt(s.yy)} Pa - g = {fmt(s.gravity)} m/s^2 x the rock above"
+    else:
+        yy = f"{fmt(s.yy)} Pa + {fmt(s.gradient_yy)} Pa/m x depth"
+    if s.ratio_xx is None:
+        xx = f"{fmt(s.xx)} Pa + {fmt(s.gradient_xx)} Pa/m x depth"
+    elif s.ratio_xx == "uniaxial_strain":
+        xx = "sigma'_xx = nu / (1 - nu) sigma'_yy in each unit"
+    else:
+        xx = f"sigma'_xx = {fmt(s.ratio_xx)} sigma'_yy"
+    return (
+        f"initial_stress with depth below y = {fmt(s.datum)} m: sigma_yy = {yy}; "
+        f"{xx}; sigma_xy = {fmt(s.xy)} Pa"
+    )
+
+
+def _describe_units(spec: CaseSpec) -> list[str]:
+    """One line per rock unit of [[units]]."""
+    lines = []
+    if spec.reservoir is not None or not spec.units:
+        return lines
+    zones = build_zones(spec)
+    for unit, zs in zip(spec.units, zones.unit_zones, strict=True):
+        r = unit.region
+        if r.kind == "layer":
+            where = f"layer {fmt(r.base)} < y < {fmt(r.top)} m"
+        elif r.kind == "offset":
+            where = (
+                f"layer {fmt(r.base)} < y < {fmt(r.top)} m displaced "
+                f"{fmt(r.throw)} m down on the {r.lowered} of fractures[{r.fracture}]"
+            )
+        elif r.kind == "polygon":
+            where = f"polygon of {len(r.polygon)} vertices"
+        else:
+            where = f"{len(r.boxes)} box(es)"
+        dp = ", ".join(f"{zones.names[z]} {fmt(float(zones.change[z]))} Pa" for z in zs)
+        lines.append(
+            f"unit {unit.name!r}: {where}; E = {fmt(unit.E)} Pa, nu = "
+            f"{fmt(unit.nu)}, biot {fmt(float(zones.biot[zs[0]]))}; "
+            f"pore-pressure change {dp}"
+        )
+    return lines
+
+
 def _describe_pore(spec: CaseSpec) -> list[str]:
     """[pore_pressure] and [reservoir] lines (none when absent)."""
     lines = []
     p = spec.pore_pressure
     if p is not None:
-        where = "the reservoir" if p.region == "reservoir" else "the whole model"
+        where = {"reservoir": "the reservoir", "all": "the whole model"}.get(
+            p.region, f"unit {p.region!r}"
+        )
+        grad = (
+            f" + {fmt(p.gradient)} Pa/m x depth below y = {fmt(p.datum)} m"
+            if p.gradient
+            else ""
+        )
         lines.append(
-            f"pore pressure: initial {fmt(p.initial)} Pa, change {fmt(p.change)} Pa "
-            f"over the load steps (< 0 = depletion), Biot coefficient "
-            f"{fmt(p.biot)}, acting in {where}; "
+            f"pore pressure: initial {fmt(p.initial)} Pa{grad}, change "
+            f"{fmt(p.change)} Pa over the load steps (< 0 = depletion), Biot "
+            f"coefficient {fmt(p.biot)}, acting in {where}; "
             "effective stress in the bulk (Biot) and on the fractures (Terzaghi)"
         )
+    lines += _describe_units(spec)
     r = spec.reservoir
     if r is not None:
         rows = r.boxes if r.polygon is None else r.polygon
@@ -297,11 +368,12 @@ def describe(spec: CaseSpec) -> str:
     steps = spec.loading.steps
     lines += [
         f"loading: stress {_describe_stress(spec.loading.stress)}; "
-        f"initial_stress {_describe_stress(spec.loading.initial_stress)}; "
+        f"{_describe_in_situ(spec)}; "
         f"{steps} step{'' if steps == 1 else 's'}",
         "boundary:",
     ]
-    lines += [_describe_edge(e, getattr(spec.boundary, e)) for e in EDGES]
+    depth = spec.loading.in_situ is not None
+    lines += [_describe_edge(e, getattr(spec.boundary, e), depth) for e in EDGES]
     lines += _describe_pore(spec)
     lines.append(_describe_events(spec))
     lines += _describe_permeability(spec)

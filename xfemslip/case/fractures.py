@@ -17,6 +17,7 @@ from xfemslip.case.tables import (
     MAX_COORDINATE,
     NON_NEGATIVE,
     POSITIVE,
+    Range,
     Table,
     check_number,
     check_vector,
@@ -32,6 +33,12 @@ FRACTURE_KEYS = (
     "length",
     "angle",
     "points",
+    "point",
+    "dip",
+    "dip_direction",
+    "top",
+    "base",
+    "fluid_pressure",
     "friction",
     "cohesion",
     "kn",
@@ -41,6 +48,11 @@ FRACTURE_KEYS = (
 )
 TIP_KINDS = ("branch", "ramp")
 TIP_KEYS = ("kind", "radius")
+DIP_DIRECTIONS = ("right", "left")
+# the fluid pressure in a fracture from the pore pressures of its two faces
+# (xfemslip.fem.zones.fluid_rule), or a number [Pa]
+FLUID_RULES = ("mean", "higher", "lower")
+DIP_KEYS = ("point", "dip", "dip_direction", "top", "base")
 
 
 def _cos_sin_degrees(angle: float) -> tuple[float, float]:
@@ -84,8 +96,71 @@ def _read_points(table: Table) -> np.ndarray | None:
     )
 
 
+def _dip_points(table: Table) -> np.ndarray | None:
+    """The two ends of a fault given as drawn: ``point`` on it, ``dip`` [deg]
+    below the horizontal towards ``dip_direction`` ("right" = +x, default),
+    and either ``length`` (centred on the point) or ``top`` and ``base`` (the
+    y of its upper and lower end).  The upper end comes first, so t points
+    down the dip."""
+    extent = [k for k in ("length", "top", "base") if table.has(k)]
+    if table.has("length") and (table.has("top") or table.has("base")):
+        table.error(
+            None, f"give either length or top and base, not both (got {extent})"
+        )
+        return None
+    point = table.numbers("point", 2, hint=" (a point on the fault [x, y])")
+    dip = table.number(
+        "dip", rule=Range(0.0, 90.0, lo_open=True), hint=" (degrees below horizontal)"
+    )
+    direction = table.choice("dip_direction", DIP_DIRECTIONS, "right")
+    if table.has("length") or not (table.has("top") or table.has("base")):
+        length = table.number(
+            "length", rule=POSITIVE, hint=" (or top and base: the y of its ends)"
+        )
+        top = base = None
+    else:
+        length = None
+        top, base = table.number("top"), table.number("base")
+        if top is not None and base is not None and not top > base:
+            table.error("top", f"must be above base, got top {top:g} <= base {base:g}")
+            return None
+    if point is None or dip is None or direction is None:
+        return None
+    if length is None and (top is None or base is None):
+        return None
+    c, s = _cos_sin_degrees(dip)  # down the dip: (+-cos, -sin)
+    down = np.array([c if direction == "right" else -c, -s])
+    p = np.asarray(point, float)
+    with np.errstate(over="ignore", invalid="ignore"):
+        if length is not None:
+            points = np.array([p - 0.5 * length * down, p + 0.5 * length * down])
+        else:
+            points = np.array(
+                [p + (p[1] - top) / s * down, p + (p[1] - base) / s * down]
+            )
+    if not np.isfinite(points).all():
+        table.error(None, "the fault's ends overflow")
+        return None
+    return points
+
+
 def _fracture_points(table: Table) -> np.ndarray | None:
-    """Polyline vertices from ``points`` or from ``center``/``length``/``angle``."""
+    """Polyline vertices from ``points``, from ``center``/``length``/``angle``,
+    or from ``point``/``dip`` (:func:`_dip_points`)."""
+    if table.has("dip") or table.has("point"):
+        other = [k for k in ("points", "center", "angle") if table.has(k)]
+        if other:
+            table.error(
+                None,
+                "give a fault as point and dip, as points, or as center, length "
+                f"and angle, not mixed (got dip/point and {', '.join(other)})",
+            )
+            return None
+        return _dip_points(table)
+    stray = [k for k in ("dip_direction", "top", "base") if table.has(k)]
+    if stray:
+        table.error(stray[0], "only used with point and dip")
+        return None
     given = [k for k in ("center", "length", "angle") if table.has(k)]
     if given and table.has("points"):
         table.error(
@@ -133,6 +208,7 @@ def _read_fracture(table: Table, index: int, grid: Grid | None) -> FractureSpec 
     kt = table.number("kt", None, rule=POSITIVE)
     tip, radius = read_tip(table)
     hydraulic = read_hydraulic(table)
+    fluid = read_fluid_rule(table)
     if points is not None and np.abs(points).max() > MAX_COORDINATE:
         table.error(
             "points" if table.has("points") else "length",
@@ -154,6 +230,23 @@ def _read_fracture(table: Table, index: int, grid: Grid | None) -> FractureSpec 
         tip=tip,
         tip_radius=radius,
         hydraulic=hydraulic,
+        fluid_pressure=fluid if fluid is not None else "mean",
+    )
+
+
+def read_fluid_rule(table: Table) -> str | float | None:
+    """``fluid_pressure``: "mean" (default), "higher", "lower" of the pore
+    pressures on the two faces, or a number [Pa] >= 0 (sealing: the fracture
+    holds that pressure throughout)."""
+    if not table.has("fluid_pressure"):
+        return "mean"
+    value = table.data["fluid_pressure"]
+    if isinstance(value, str):
+        return table.choice("fluid_pressure", FLUID_RULES)
+    return table.number(
+        "fluid_pressure",
+        rule=NON_NEGATIVE,
+        hint=' ("mean", "higher", "lower" or a pressure in Pa)',
     )
 
 

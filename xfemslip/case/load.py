@@ -35,6 +35,7 @@ from xfemslip.case.grid import read_grid
 from xfemslip.case.hydraulics import read_permeability
 from xfemslip.case.network import read_network
 from xfemslip.case.options import (
+    IN_SITU_KEYS,
     MATERIAL_MODELS,
     MAX_STEPS,
     OUTPUT_FORMATS,
@@ -42,15 +43,17 @@ from xfemslip.case.options import (
     STRESS_KEYS,
     TOP_KEYS,
 )
-from xfemslip.case.pore import read_pore_pressure, read_reservoir
+from xfemslip.case.pore import check_region, read_pore_pressure
 from xfemslip.case.specs import (
     CaseSpec,
+    InSituSpec,
     LoadingSpec,
     MaterialSpec,
     OutputSpec,
     SolverSpec,
 )
 from xfemslip.case.tables import POSITIVE, Range, Table, check_choice, show
+from xfemslip.case.units import read_reservoir, read_units, reservoir_unit
 from xfemslip.errors import CaseError
 
 __all__ = ["load_case", "loads_case"]
@@ -86,16 +89,17 @@ def _read_name(root: Table, path: Path) -> str | None:
 
 
 def _read_material(root: Table) -> MaterialSpec | None:
-    """[material]: E > 0, 0 <= nu < 0.5, model."""
-    table = root.table("material", ("E", "nu", "model"), required=True)
+    """[material]: E > 0, 0 <= nu < 0.5, model, density > 0 [kg/m^3]."""
+    table = root.table("material", ("E", "nu", "model", "density"), required=True)
     if table is None:
         return None
     E = table.number("E", rule=POSITIVE)
     nu = table.number("nu", rule=Range(0.0, 0.5, hi_open=True))
     model = table.choice("model", MATERIAL_MODELS, "plane_strain")
+    density = table.number("density", None, POSITIVE)
     if E is None or nu is None or model is None:
         return None
-    return MaterialSpec(E=E, nu=nu, model=model)
+    return MaterialSpec(E=E, nu=nu, model=model, density=density)
 
 
 # --------------------------------------------------------------------------- #
@@ -113,24 +117,132 @@ def _read_stress(loading: Table, name: str) -> tuple[float, float, float] | None
     return None if None in (xx, yy, xy) else (xx, yy, xy)
 
 
+def _depth_dependent(loading: Table) -> bool:
+    """Whether ``loading.initial_stress`` varies with depth (a datum key)."""
+    value = loading.data.get("initial_stress")
+    return isinstance(value, dict) and any(k in value for k in IN_SITU_KEYS)
+
+
+def _gradient(table: Table, key: str, default):
+    """A stress gradient with depth [Pa/m]: <= 0, compression growing downward."""
+    value = table.number(key, default)
+    if value is not None and value > 0.0:
+        table.error(
+            key,
+            f"must be <= 0, got {value!r}: tension is positive, so a stress that "
+            "grows more compressive with depth has a negative gradient (e.g. "
+            "-23e3 Pa/m)",
+        )
+        return None
+    return value
+
+
+def _read_in_situ(loading: Table) -> InSituSpec | None:
+    """``initial_stress`` with a ``datum``: values at the datum and how they
+    grow with depth (``InSituSpec``; xfemslip.fem.zones.in_situ_stress)."""
+    table = loading.table("initial_stress", STRESS_KEYS + IN_SITU_KEYS)
+    if table is None:
+        return None
+    start = len(table.problems)
+    datum = table.number(
+        "datum", hint=" (the y [m] of zero depth, where xx and yy are given)"
+    )
+    yy = table.number("yy", 0.0)
+    xy = table.number("xy", 0.0)
+    if table.has("gradient_yy") == table.has("gravity"):
+        table.error(
+            None,
+            "give exactly one of gradient_yy (d sigma_yy / d depth [Pa/m], "
+            "e.g. -23e3) or gravity (g [m/s^2], with the densities)",
+        )
+    gradient_yy = _gradient(table, "gradient_yy", None)
+    gravity = table.number("gravity", None, POSITIVE)
+    xx = gradient_xx = ratio = None
+    if table.has("ratio_xx"):
+        for key in ("xx", "gradient_xx"):
+            if table.has(key):
+                table.error(key, "give either ratio_xx or xx and gradient_xx")
+        value = table.data["ratio_xx"]
+        if value == "uniaxial_strain":
+            ratio = "uniaxial_strain"
+        elif isinstance(value, str):
+            table.error(
+                "ratio_xx",
+                f'expected a number or "uniaxial_strain", got {show(value)}',
+            )
+        else:
+            ratio = table.number(
+                "ratio_xx",
+                rule=Range(0.0, 100.0),
+                hint=' (a ratio of effective stresses, or "uniaxial_strain")',
+            )
+    else:
+        xx = table.number(
+            "xx", hint=" (or ratio_xx = sigma'_xx / sigma'_yy, with a datum)"
+        )
+        gradient_xx = _gradient(table, "gradient_xx", 0.0)
+    if len(table.problems) > start or datum is None:
+        return None
+    return InSituSpec(
+        datum=datum,
+        yy=yy,
+        gradient_yy=gradient_yy,
+        gravity=gravity,
+        xx=xx,
+        gradient_xx=gradient_xx,
+        ratio_xx=ratio,
+        xy=xy,
+    )
+
+
 def _read_loading(root: Table, needs_stress: list[str]) -> LoadingSpec | None:
-    """[loading]; ``stress`` is required when an edge carries a traction."""
+    """[loading]; ``stress`` is required when an edge carries a traction,
+    unless the in-situ stress varies with depth (its edges keep it)."""
     table = root.table("loading", ("stress", "initial_stress", "steps"))
     if table is None:
         return None
     start = len(table.problems)
     stress = _read_stress(table, "stress")
-    if needs_stress and not table.has("stress"):
-        edges = ", ".join(f"boundary.{e}" for e in needs_stress)
-        table.error(
-            "stress",
-            f"required key missing: {edges} carries a traction = loading.stress . n",
-        )
-    initial_stress = _read_stress(table, "initial_stress")
+    in_situ = None
+    if _depth_dependent(table):
+        in_situ = _read_in_situ(table)
+        initial_stress = None
+        if table.has("stress"):
+            table.error(
+                "stress",
+                "is a uniform far-field stress, and loading.initial_stress "
+                "varies with depth: leave loading.stress out (traction edges "
+                "keep their in-situ traction)",
+            )
+    else:
+        initial_stress = _read_stress(table, "initial_stress")
+        if needs_stress and not table.has("stress"):
+            edges = ", ".join(f"boundary.{e}" for e in needs_stress)
+            table.error(
+                "stress",
+                f"required key missing: {edges} carries a traction = "
+                "loading.stress . n",
+            )
     steps = table.integer("steps", 1, Range(1, MAX_STEPS))
     if len(table.problems) > start:
         return None
-    return LoadingSpec(stress=stress, initial_stress=initial_stress, steps=steps)
+    return LoadingSpec(
+        stress=stress, initial_stress=initial_stress, steps=steps, in_situ=in_situ
+    )
+
+
+def _check_densities(root: Table, loading, material, units) -> None:
+    """``gravity`` needs a density everywhere: [material] and every unit."""
+    if loading is None or loading.in_situ is None or loading.in_situ.gravity is None:
+        return
+    if material is not None and material.density is None:
+        root.problems.append(
+            (
+                "material.density",
+                "required key missing: loading.initial_stress.gravity integrates "
+                "the densities [kg/m^3] of the rock above each point",
+            )
+        )
 
 
 def _read_solver(root: Table) -> SolverSpec | None:
@@ -170,7 +282,8 @@ def _read_formats(table: Table) -> tuple[str, ...] | None:
     if not isinstance(value, list) or not value:
         table.error(
             "formats",
-            f'expected a non-empty array of formats ("h5", "vtu"), got {show(value)}',
+            f'expected a non-empty array of formats ("h5", "vtu", "csv"), got '
+            f"{show(value)}",
         )
         return None
     key = table.key("formats")
@@ -260,8 +373,14 @@ def loads_case(text: str, path: str | Path = "<string>") -> CaseSpec:
     loading = _read_loading(root, needs_stress)
     solver = _read_solver(root)
     output = _read_output(root, name)
-    pore_pressure = read_pore_pressure(root)
-    reservoir = read_reservoir(root, grid)
+    datum = loading.in_situ.datum if loading and loading.in_situ else None
+    pore_pressure = read_pore_pressure(root, datum)
+    reservoir = read_reservoir(root, grid, fractures)
+    units = read_units(root, grid, fractures, material)
+    if reservoir is not None:
+        units = (reservoir_unit(reservoir),)
+    check_region(root, pore_pressure, units)
+    _check_densities(root, loading, material, units)
     events = read_events(root)
     permeability = read_permeability(root, grid, fractures)
     if problems:
@@ -281,6 +400,7 @@ def loads_case(text: str, path: str | Path = "<string>") -> CaseSpec:
         output=output,
         pore_pressure=pore_pressure,
         reservoir=reservoir,
+        units=units or (),
         events=events,
         permeability=permeability,
     )

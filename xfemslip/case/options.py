@@ -38,12 +38,16 @@ TOP_KEYS = (
     "output",
     "pore_pressure",
     "reservoir",
+    "units",
     "events",
     "permeability",
 )
 STRESS_KEYS = ("xx", "yy", "xy")
+# loading.initial_stress varying with depth (xfemslip.fem.zones.in_situ_stress)
+IN_SITU_KEYS = ("datum", "gradient_xx", "gradient_yy", "ratio_xx", "gravity")
 MATERIAL_MODELS = ("plane_strain", "plane_stress")
-OUTPUT_FORMATS = ("h5", "vtu")
+# "csv": the profiles of the fractures (profile.csv, xfemslip.post.profile)
+OUTPUT_FORMATS = ("h5", "vtu", "csv")
 MAX_STEPS = 100_000
 
 

@@ -12,7 +12,9 @@ the value and why it looks wrong:
 - a penalty stiffness kn h/E or kt h/E outside the range where Newton was
   measured to converge (specs.PENALTY_RATIO_LOWEST to PENALTY_RATIO_MEASURED);
 - a fracture that reaches outside the domain (it is clipped at the boundary,
-  so its tip there becomes an edge crossing).
+  so its tip there becomes an edge crossing);
+- a unit's edge that was moved onto a fracture it lay within 0.1 cell of
+  (xfemslip.case.units.snap_to_fractures).
 """
 
 from __future__ import annotations
@@ -35,6 +37,8 @@ def plausibility_warnings(spec) -> list[str]:
     moduli = [("material.E", spec.material.E)]
     if spec.reservoir is not None:
         moduli.append(("reservoir.E", spec.reservoir.E))
+    else:
+        moduli += [(f"units[{i}].E", u.E) for i, u in enumerate(spec.units)]
     for key, E in moduli:
         if not E_RANGE[0] <= E <= E_RANGE[1]:
             out.append(
@@ -65,6 +69,14 @@ def plausibility_warnings(spec) -> list[str]:
                     f"{PENALTY_RATIO_MEASURED:g} where Newton was measured to "
                     f"converge (e.g. {1e3 * E / h:.3g} Pa/m, or leave it out)"
                 )
+    for i, unit in enumerate(spec.units):
+        key = "reservoir" if spec.reservoir is not None else f"units[{i}]"
+        for edge, fracture, distance in unit.snapped:
+            out.append(
+                f"{key}: {edge} lies {distance:.3g} m off fractures[{fracture}] "
+                "and is moved onto it (within 0.1 cell of a fracture, an edge is "
+                "taken to follow it)"
+            )
     x0, y0 = spec.origin
     x1, y1 = x0 + spec.size[0], y0 + spec.size[1]
     tol = 1e-9 * max(spec.size)

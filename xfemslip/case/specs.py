@@ -25,7 +25,13 @@ class MaterialSpec:
     E: float  # Young's modulus [Pa]
     nu: float  # Poisson's ratio [-]
     model: str  # "plane_strain" | "plane_stress"
-    UNITS: ClassVar[dict[str, str]] = {"E": "Pa", "nu": "-", "model": ""}
+    density: float | None = None  # bulk density [kg/m^3] (with gravity only)
+    UNITS: ClassVar[dict[str, str]] = {
+        "E": "Pa",
+        "nu": "-",
+        "model": "",
+        "density": "kg/m^3",
+    }
 
 
 # Penalty stiffness when a fracture omits kn / kt: k = AUTO_PENALTY * E / h with
@@ -104,6 +110,10 @@ class FractureSpec:
     tip_radius: float | None = None  # branch enrichment radius [m]; None = automatic
     source: str = ""  # "" = [[fractures]]; else where [network] took it from
     hydraulic: HydraulicSpec | None = None  # overrides of [permeability]
+    # the fluid pressure in the fracture from the pore pressures on its two
+    # faces (xfemslip.fem.zones.FLUID_RULES): "mean" | "higher" | "lower",
+    # or a number [Pa] (a sealing fracture holding a pressure of its own)
+    fluid_pressure: str | float = "mean"
     UNITS: ClassVar[dict[str, str]] = {
         "points": "m",
         "tip_radius": "m",
@@ -115,15 +125,54 @@ class FractureSpec:
 
 
 @dataclass(frozen=True, kw_only=True)
+class InSituSpec:
+    """An in-situ total stress that varies with depth (``loading.initial_stress``
+    with a datum): xfemslip.fem.zones.in_situ_stress.
+
+    Depth is ``datum - y``.  sigma_yy = yy + gradient_yy depth, or with
+    ``gravity`` yy - g int rho dz over the rock above (the units' densities);
+    sigma_xx = xx + gradient_xx depth, or from ``ratio_xx`` of the effective
+    vertical stress (a number, or "uniaxial_strain": nu / (1 - nu) of each
+    unit); sigma_xy uniform.
+    """
+
+    datum: float  # y of zero depth [m]
+    yy: float  # sigma_yy at the datum [Pa]
+    gradient_yy: float | None  # d sigma_yy / d depth [Pa/m]; None: gravity
+    gravity: float | None  # g [m/s^2] with the densities; None: gradient_yy
+    xx: float | None  # sigma_xx at the datum [Pa] (with gradient_xx)
+    gradient_xx: float | None  # [Pa/m]
+    ratio_xx: float | str | None  # sigma'_xx / sigma'_yy, or "uniaxial_strain"
+    xy: float = 0.0  # [Pa]
+    UNITS: ClassVar[dict[str, str]] = {
+        "datum": "m",
+        "yy": "Pa",
+        "gradient_yy": "Pa/m",
+        "gravity": "m/s^2",
+        "xx": "Pa",
+        "gradient_xx": "Pa/m",
+        "ratio_xx": "-",
+        "xy": "Pa",
+    }
+
+
+@dataclass(frozen=True, kw_only=True)
 class LoadingSpec:
     stress: tuple[float, float, float] | None  # final far-field (xx, yy, xy) [Pa]
-    initial_stress: tuple[float, float, float] | None  # in-situ (xx, yy, xy) [Pa]
+    # uniform in-situ (xx, yy, xy) [Pa]; None with a depth-dependent one
+    initial_stress: tuple[float, float, float] | None
     steps: int
+    in_situ: InSituSpec | None = None  # in-situ stress varying with depth
     UNITS: ClassVar[dict[str, str]] = {
         "stress": "Pa",
         "initial_stress": "Pa",
         "steps": "-",
     }
+
+    @property
+    def has_in_situ(self) -> bool:
+        """Whether the model starts from an in-situ stress (uniform or not)."""
+        return self.initial_stress is not None or self.in_situ is not None
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -177,7 +226,7 @@ class SolverSpec:
 @dataclass(frozen=True, kw_only=True)
 class OutputSpec:
     directory: Path  # resolved: output.directory, else out/<name> (relative to cwd)
-    formats: tuple[str, ...] = ("h5", "vtu")
+    formats: tuple[str, ...] = ("h5", "vtu", "csv")
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -189,15 +238,19 @@ class PorePressureSpec:
     ``[reservoir]`` only (``region = "reservoir"``).
     """
 
-    initial: float  # p0 [Pa]
+    initial: float  # p0 [Pa] (at the datum with a gradient)
     change: float  # final dp [Pa]; < 0 = depletion
     biot: float  # alpha, 0 < alpha <= 1 [-]
-    region: str  # "all" | "reservoir"
+    region: str  # "all" | "reservoir" | the name of a unit
+    gradient: float = 0.0  # d p0 / d depth [Pa/m] (hydrostatic: about 1e4)
+    datum: float = 0.0  # y of zero depth [m] (with a gradient)
     UNITS: ClassVar[dict[str, str]] = {
         "initial": "Pa",
         "change": "Pa",
         "biot": "-",
         "region": "",
+        "gradient": "Pa/m",
+        "datum": "m",
     }
 
 
@@ -215,11 +268,76 @@ class ReservoirSpec:
     E: float  # [Pa]
     nu: float  # [-]
     polygon: np.ndarray | None = None  # (k, 2) float64 [m]
+    # edges moved onto a fracture: (edge name, fracture index, distance [m])
+    snapped: tuple[tuple[str, int, float], ...] = ()
     UNITS: ClassVar[dict[str, str]] = {
         "boxes": "m",
         "polygon": "m",
         "E": "Pa",
         "nu": "-",
+    }
+
+
+@dataclass(frozen=True, kw_only=True)
+class RegionSpec:
+    """Where a rock unit lies (xfemslip.geometry.regions.in_region).
+
+    kind "boxes": ``boxes`` (k, 4) [x0, y0, x1, y1]; "polygon": ``polygon``
+    (k, 2); "layer": between the horizons ``base`` < y < ``top``; "offset":
+    a layer displaced across a fault: ``top``/``base`` on the side that is
+    not lowered, ``top - throw``/``base - throw`` on the ``lowered`` side
+    ("left" or "right" of the fault line ``fault`` (k, 2), a copy of the
+    points of fracture ``fracture``, extended straight beyond its ends).
+    """
+
+    kind: str
+    boxes: np.ndarray | None = None  # (k, 4) [m]
+    polygon: np.ndarray | None = None  # (k, 2) [m]
+    top: float | None = None  # [m]
+    base: float | None = None  # [m]
+    fault: np.ndarray | None = None  # (k, 2) [m]
+    fracture: int | None = None
+    throw: float = 0.0  # [m] >= 0
+    lowered: str = ""  # "left" | "right"
+    UNITS: ClassVar[dict[str, str]] = {
+        "boxes": "m",
+        "polygon": "m",
+        "top": "m",
+        "base": "m",
+        "throw": "m",
+    }
+
+
+@dataclass(frozen=True, kw_only=True)
+class UnitSpec:
+    """A rock unit ([[units]], or the one [reservoir]): its region and
+    constants (resolved: the host's where the case leaves one out).
+
+    Units later in the case override earlier ones where they overlap; the
+    host ([material]) is everywhere else.  ``change`` is the unit's
+    pore-pressure change at the end of loading [Pa] (None: the rule of
+    ``[pore_pressure] region``); an offset unit may give one per side
+    (``change_sides`` = (left, right)), its two compartments.
+    """
+
+    name: str
+    region: RegionSpec
+    E: float  # [Pa]
+    nu: float  # [-]
+    biot: float | None = None  # [-]; None: [pore_pressure] biot
+    density: float | None = None  # [kg/m^3]; None: [material] density
+    change: float | None = None  # [Pa]
+    change_sides: tuple[float, float] | None = None  # (left, right) [Pa]
+    overpressure: float = 0.0  # added to the initial pore pressure [Pa]
+    # edges moved onto a fracture: (edge name, fracture index, distance [m])
+    snapped: tuple[tuple[str, int, float], ...] = ()
+    UNITS: ClassVar[dict[str, str]] = {
+        "E": "Pa",
+        "nu": "-",
+        "biot": "-",
+        "density": "kg/m^3",
+        "change": "Pa",
+        "overpressure": "Pa",
     }
 
 
@@ -247,5 +365,7 @@ class CaseSpec:
     output: OutputSpec
     pore_pressure: PorePressureSpec | None = None  # None: no pore pressure
     reservoir: ReservoirSpec | None = None  # None: one material everywhere
+    # the rock units: [[units]], or [reservoir] as the unit "reservoir"
+    units: tuple[UnitSpec, ...] = ()
     events: EventsSpec | None = None  # None: no [events] table
     permeability: PermeabilitySpec | None = None  # None: no [permeability] table

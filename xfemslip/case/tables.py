@@ -133,8 +133,23 @@ def check_integer(
     return value
 
 
+# What a key a user tries means in this case format, where its name alone
+# would not say (an unknown key's message adds it).
+KEY_HINTS = {
+    "layers": "rock units are [[units]] tables (layers between horizons, "
+    "polygons, or layers displaced by a fault)",
+    "gravity": "gravity = g goes in loading.initial_stress, with the units' densities",
+    "density": "a density goes in [material] or in a [[units]] table",
+    "gradient_yy": "depth gradients go in loading.initial_stress with a datum",
+    "gradient_xx": "depth gradients go in loading.initial_stress with a datum",
+}
+
+
 def suggest(word: str, allowed: tuple[str, ...]) -> str:
-    """'; did you mean ...?' or the list of allowed words (pypa/build _find_typo)."""
+    """'; did you mean ...?' or the list of allowed words (pypa/build _find_typo),
+    or what the key means in this format (KEY_HINTS)."""
+    if word in KEY_HINTS and word not in allowed:
+        return f" ({KEY_HINTS[word]})"
     close = difflib.get_close_matches(word, allowed, n=1)
     if close:
         return f"; did you mean {close[0]!r}?"

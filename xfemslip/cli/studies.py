@@ -37,7 +37,14 @@ from xfemslip.errors import UsageError
 MAX_JOBS = 4 * (os.cpu_count() or 1)
 # A figure of a few inches at this resolution is already ~100 megapixels.
 MAX_DPI = 2400.0
-KINDS = ("displacement", "principal_stress", "deformed_mesh", "slip", "mohr")
+KINDS = (
+    "displacement",
+    "principal_stress",
+    "deformed_mesh",
+    "slip",
+    "mohr",
+    "profile",
+)
 
 
 # --------------------------------------------------------------------------- #

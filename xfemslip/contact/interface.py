@@ -330,7 +330,9 @@ def _symmetric_groups(lengths, target, max_items=None):
     return front_groups + ([middle] if middle else []) + back_groups
 
 
-def contact_patches(mesh, fractures, ip, length_cells: float) -> np.ndarray:
+def contact_patches(
+    mesh, fractures, ip, length_cells: float, breaks=None
+) -> np.ndarray:
     """Patch index (n,) of every interface point.
 
     Along each straight segment of each fracture, the pieces of the cut cells
@@ -340,7 +342,10 @@ def contact_patches(mesh, fractures, ip, length_cells: float) -> np.ndarray:
     toward its middle (``_symmetric_groups``: the patches do not depend on the
     fracture's point order).  A patch never spans a kink of the polyline, so
     its normal is one, nor a junction with another fracture (each branch has
-    its own tractions).  ``length_cells = 0`` gives one patch per point.
+    its own tractions), nor a point of ``breaks[f]`` (arc lengths [m] of
+    fracture f where its loading jumps: a reservoir corner on a fault; the
+    interface points are split there too).  ``length_cells = 0`` gives one
+    patch per point.
     """
     n = ip.n
     if n == 0 or length_cells <= 0.0:
@@ -352,7 +357,10 @@ def contact_patches(mesh, fractures, ip, length_cells: float) -> np.ndarray:
         m = ip.fracture == fi
         ends = fr.s_start + fr.length
         seg[m] = np.minimum(np.searchsorted(ends, ip.s[m], side="right"), ends.size - 1)
-        part[m] = np.searchsorted(np.asarray(fr.junction_s, float), ip.s[m])
+        splits = np.asarray(fr.junction_s, float)
+        if breaks is not None and len(breaks[fi]):
+            splits = np.sort(np.concatenate([splits, breaks[fi]]))
+        part[m] = np.searchsorted(splits, ip.s[m])
     patch = np.empty(n, np.int64)
     next_id = 0
     order = np.lexsort((ip.s, part, seg, ip.fracture))
@@ -484,12 +492,17 @@ def build_contact(
     patch_cells=None,
     *,
     kernels: str,
+    breaks=None,
 ) -> ContactSet:
     """Interface operators from the interface points and the enriched cells.
 
-    initial_stress : (xx, yy, xy) or None; the faces start closed and stuck
-    with traction sigma0 . n (the committed plastic slip is set so that the
-    stick traction at zero jump is the in-situ shear traction).
+    initial_stress : (xx, yy, xy), or (n_ip, 3) per interface point (an
+    in-situ stress varying with depth: the patch takes its points' weighted
+    mean), or None; the faces start closed and stuck with traction sigma0 . n
+    (the committed plastic slip is set so that the stick traction at zero
+    jump is the in-situ shear traction).
+    breaks : per fracture, the arc lengths where patches must end
+    (contact_patches).
     E : Young's modulus [Pa], for the automatic penalty of fractures without
     kn / kt (AUTO_PENALTY * E / h, h = sqrt of the area of the patch's cells).
     patch_cells : length of a contact patch in local cell sizes (0: pointwise;
@@ -500,7 +513,7 @@ def build_contact(
     coef, dofs = _jump_operators(mesh, fractures, ip, ec, cand, dofmap)
     if patch_cells is None:
         patch_cells = CONTACT_PATCH_CELLS
-    patch = contact_patches(mesh, fractures, ip, patch_cells)
+    patch = contact_patches(mesh, fractures, ip, patch_cells, breaks)
     p_coef, p_dofs, W = _patch_operators(patch, ip.weight, coef, dofs)
     n = W.size
     _, first = np.unique(patch, return_index=True)  # one point of each patch
@@ -521,7 +534,22 @@ def build_contact(
             par[name][auto] = AUTO_PENALTY * E / h[auto]
     pn0 = np.zeros(n)
     slip0 = np.zeros(n)
-    if initial_stress is not None:
+    if initial_stress is not None and np.ndim(initial_stress) == 2:
+        S = (
+            np.column_stack(
+                [
+                    np.bincount(patch, weights=ip.weight * c, minlength=n)
+                    for c in np.asarray(initial_stress, float).T
+                ]
+            )
+            / W[:, None]
+        )  # (n, 3) patch means
+        tx = normal[:, 0] * S[:, 0] + normal[:, 1] * S[:, 2]
+        ty = normal[:, 0] * S[:, 2] + normal[:, 1] * S[:, 1]
+        pn0 = tx * normal[:, 0] + ty * normal[:, 1]
+        pt0 = tx * tangent[:, 0] + ty * tangent[:, 1]
+        slip0 = -pt0 / par["kt"]
+    elif initial_stress is not None:
         sxx, syy, sxy = initial_stress
         sig = np.array([[sxx, sxy], [sxy, syy]])
         trac = normal @ sig

@@ -3,16 +3,18 @@
 Signs: tension positive; the pore pressure p is positive when the fluid pushes.
 
 Bulk (Biot).  The total stress is sigma = sigma' - alpha p I, with the
-effective stress sigma' = sigma0' + D eps(u) (D of the cell's material).  The
-model starts in equilibrium with the in-situ total stress sigma0
-(``loading.initial_stress``) and the initial pore pressure p0 (uniform), so
-sigma0' = sigma0 + alpha p0 I.  A load step changes p by lambda * dp (dp =
-``pore_pressure.change``, < 0 = depletion) where the pressure changes (the
-whole model or the reservoir cells).  Equilibrium of the increment,
-int B^T (D eps - alpha lambda dp m) dOmega = lambda F_boundary with
-m = [1, 1, 0], moves the pressure term to the right-hand side as the body load
+effective stress sigma' = sigma0' + D eps(u) (D and alpha of the zone at the
+point, :mod:`xfemslip.fem.zones`).  The model starts in equilibrium with the
+in-situ total stress sigma0 (``loading.initial_stress``, uniform or growing
+with depth) and the initial pore pressure p0 (uniform, or with a gradient and
+the units' overpressures), so sigma0' = sigma0 + alpha p0 I.  A load step
+changes p by lambda * dp, dp the pore-pressure change of the zone
+(``pore_pressure.change`` in its region, or the unit's own ``change``; < 0 =
+depletion).  Equilibrium of the increment, int B^T (D eps - alpha lambda dp
+m) dOmega = lambda F_boundary with m = [1, 1, 0], moves the pressure term to
+the right-hand side as the body load
 
-    F_body = lambda * int_region B^T m alpha dp dOmega           (1)
+    F_body = lambda * int B^T m alpha dp dOmega                  (1)
 
 Under depletion (dp < 0) F_body pulls every boundary of the depleting region
 inwards: the region contracts.
@@ -35,21 +37,25 @@ sigma'_yy) and sigma_zz = sigma'_zz - alpha p, the in-situ sigma0'_zz taken as
 nu (sigma0'_xx + sigma0'_yy) (as without pore pressure).
 
 Fractures (Terzaghi, Biot coefficient 1 on the faces).  The fluid in a
-fracture has the pore pressure around it, taken as the MEAN of the pore
-pressures on its two faces: at each contact point x with normal n,
+fracture takes its pressure from the pore pressures p(x + eps n) and
+p(x - eps n) on its two faces at each contact point x (eps = FACE_OFFSET
+h_min), by the fracture's ``fluid_pressure`` rule
+(:func:`xfemslip.fem.zones.fluid_value`):
 
-    p_f = p0 + lambda dp (c(x + eps n) + c(x - eps n)) / 2        (3)
+    p_f = mean | higher | lower of the two, or a fixed value      (3)
 
-with c = 1 where the pressure changes (a point of the region) and 0
-elsewhere, eps = FACE_OFFSET h_min.  A fracture inside the depleting region
-has p_f = p0 + lambda dp, one outside p0, and a fault ON the region's
-boundary (a sealing fault between a depleting reservoir and undepleted rock,
-the offset-reservoir set-up of Jansen & Meulenbroek 2022) p0 + lambda dp / 2
-where one side depletes: the fault-zone fluid is taken at the mean of the
-pressures it separates (the pressure is discontinuous across a sealing fault
-and the contact law needs one p_f per point).  The contact law (penalty +
-Coulomb) acts on the EFFECTIVE normal traction sigma_n' = sigma_n + p_f: its
-in-situ value is (sigma0 + p0 I) . n . n, and |tau| <= c - f sigma_n'.  The
+A fracture inside a depleting region has p_f = p0 + lambda dp, one outside
+p0; a fault ON a region's boundary (between a depleting reservoir and
+undepleted rock, the offset-reservoir set-up of Jansen & Meulenbroek 2022)
+takes by default the mean, p0 + lambda dp / 2 where one side depletes (the
+pressure is discontinuous across a sealing fault and the contact law needs
+one p_f per point); "higher" or "lower" take one side's, a number holds the
+fault's own pressure (sealed).  The rule is applied to the face pressures at
+the start and at the end of loading and p_f follows the straight line
+between (exact when the same face stays the higher one, as with equal
+initial pressures).  The contact law (penalty + Coulomb) acts on the
+EFFECTIVE normal traction sigma_n' = sigma_n + p_f: its in-situ value is
+sigma0 . n . n + p_f(0), and |tau| <= c - f sigma_n'.  The
 faces also carry the fluid pressure -p_f n; its change is the load on the
 enriched dofs
 
@@ -61,10 +67,9 @@ fracture whose fluid has the surrounding pressure does not perturb a uniform
 depletion up to the penalty compliance (checked in
 tests/verification/test_depletion.py).
 
-Material regions.  An intact cell belongs to the reservoir when its centre
-lies in the ``[reservoir]`` region (its boxes or its polygon,
-xfemslip.geometry.regions); its stiffness, its stress and its pore-pressure change
-are those of the reservoir.  Region edges that do not fall on mesh lines
+Material regions.  An intact cell belongs to the zone its centre lies in
+(:meth:`xfemslip.fem.zones.Zones.at`); its stiffness, its stress and its
+pore-pressure change are those of the zone.  Region edges that do not fall on mesh lines
 are snapped to the cells this way, and the run logs a warning naming the
 edge.  Enriched cells (cut, tip and blending cells) are classified
 per QUADRATURE POINT of their sub-cell rule instead: the stiffness is
@@ -75,6 +80,11 @@ exactly even when it cuts the cells mid-cell (no warning then): the pressure
 and material jump at the fault itself.  An enriched cell reports (stress,
 pore pressure) with the material covering most of its area and the
 area-weighted mean pressure change.
+
+Changes are kept as ratios to a scale (``pore_pressure.change``, or 1 Pa
+when that is 0): a case whose zones all change by that one value or not at
+all gives ratios of exactly 1 and 0, so its loads come out of the same
+floating-point operations whatever the number of zones.
 """
 
 from __future__ import annotations
@@ -86,11 +96,17 @@ import numpy as np
 
 from xfemslip.fem.assembly import enriched_part_bbar
 from xfemslip.fem.material import elasticity_matrix
-from xfemslip.geometry.regions import edges, in_region
+from xfemslip.fem.zones import (
+    HOST,
+    Zones,
+    build_zones,
+    fluid_value,
+    initial_pressure,
+)
+from xfemslip.geometry.regions import edges
 
 logger = logging.getLogger(__name__)
 
-HOST, RESERVOIR = 0, 1
 # A box edge closer than this to a mesh line (relative to the local cell size)
 # lies on it: no warning.
 ALIGN_TOL = 1.0e-9
@@ -98,42 +114,76 @@ ALIGN_TOL = 1.0e-9
 # smallest cell size) for the fluid pressure (3): far below any cell size, far
 # above the round-off of the point coordinates.
 FACE_OFFSET = 1.0e-6
+# Enriched cells' Biot load (1) by groups of quadrature points with one
+# (alpha, dp) each, at most this many groups; more distinct values (a field)
+# are integrated by sign, each with weights w |alpha dp|.
+MAX_LOAD_GROUPS = 16
 
 
 @dataclass(frozen=True)
 class Materials:
-    """Elastic constants per material and the material of every cell."""
+    """Elastic constants per zone and the zone of every cell."""
 
-    D: np.ndarray  # (k, 3, 3) [Pa]; 0 = host ([material]), 1 = reservoir
+    D: np.ndarray  # (k, 3, 3) [Pa]; zone 0 = host ([material])
     nu: np.ndarray  # (k,) [-]
     E: np.ndarray  # (k,) [Pa]
-    cell: np.ndarray  # (n_cells,) int64 material of each cell (by centre;
-    # enriched cells: the material covering most of their area)
+    cell: np.ndarray  # (n_cells,) int64 zone of each cell (by centre;
+    # enriched cells: the zone covering most of their area)
     model: str
-    qp: np.ndarray | None = None  # (nq,) int64 material of each enriched-cell QP
+    qp: np.ndarray | None = None  # (nq,) int64 zone of each enriched-cell QP
+    zones: Zones | None = None
+
+    @property
+    def several(self) -> bool:
+        """Whether the model has more than the host's constants."""
+        return self.D.shape[0] > 1
 
 
 @dataclass(frozen=True)
 class PorePressure:
-    """Pore pressure of a case: p(lambda) = initial + lambda * change in region."""
+    """Pore pressure of a case: p(lambda) = p0 + lambda * scale * ratio.
 
-    initial: float  # p0 [Pa]
-    change: float  # dp at load factor 1 [Pa]
-    biot: float  # alpha [-]
-    cell_changes: np.ndarray  # (n_cells,) bool: the pressure changes there (centre)
-    cell_fraction: np.ndarray  # (n_cells,) float: area fraction where it changes
-    qp_changes: np.ndarray  # (nq,) float 1/0 at the enriched cells' QPs
-    point_changes: np.ndarray  # (n_ip,) float: mean of the two faces, eq. (3)
+    ``scale`` is ``pore_pressure.change`` (1 Pa when it is 0); the ratios
+    carry each zone's change relative to it.
+    """
+
+    initial: float  # [pore_pressure] initial [Pa] (at its datum)
+    change: float  # [pore_pressure] change at load factor 1 [Pa]
+    biot: float  # [pore_pressure] biot, the host's alpha [-]
+    scale: float  # [Pa]
+    cell_p0: np.ndarray  # (n_cells,) initial pore pressure [Pa]
+    cell_biot: np.ndarray  # (n_cells,) alpha of each cell's zone [-]
+    cell_load: np.ndarray  # (n_cells,) alpha dp / scale of intact cells [-]
+    cell_fraction: np.ndarray  # (n_cells,) area mean of dp / scale [-]
+    qp_alpha: np.ndarray  # (nq,) alpha at the enriched cells' QPs [-]
+    qp_ratio: np.ndarray  # (nq,) dp / scale there [-]
+    point_p0: np.ndarray  # (n_ip,) fluid pressure at load factor 0, eq. (3) [Pa]
+    point_ratio: np.ndarray  # (n_ip,) its change / scale at load factor 1 [-]
+    uniform_p0: float | None = None  # p0 where it is one value (else None)
 
     def cell_pressure(self, lam: float) -> np.ndarray:
         """(n_cells,) pore pressure at load factor lam (area mean) [Pa]."""
-        return self.initial + lam * self.change * self.cell_fraction
+        return self.cell_p0 + lam * self.scale * self.cell_fraction
+
+    def fluid(self, lam: float) -> np.ndarray:
+        """(n_ip,) fluid pressure in the fractures, eq. (3) [Pa]."""
+        return self.point_p0 + lam * self.scale * self.point_ratio
 
 
 def cell_centres(mesh) -> np.ndarray:
     """(n_cells, 2) cell centres [m]."""
     b = mesh.bounds
     return np.column_stack([0.5 * (b[:, 0] + b[:, 1]), 0.5 * (b[:, 2] + b[:, 3])])
+
+
+def domain_box(mesh) -> tuple[float, float, float, float]:
+    """(x0, x1, y0, y1) of the mesh [m]."""
+    return (
+        float(mesh.x[0]),
+        float(mesh.x[-1]),
+        float(mesh.y[0]),
+        float(mesh.y[-1]),
+    )
 
 
 def _on_fracture(fractures, p, q, tol) -> bool:
@@ -180,12 +230,12 @@ def _clip_to_domain(mesh, p, q):
     return None if t0 >= t1 else (p + t0 * d, p + t1 * d)
 
 
-def _warn_unaligned(mesh, reservoir, fractures=()) -> None:
-    """Log a warning for each region edge inside the domain off the mesh
+def _warn_unaligned(mesh, unit, fractures=()) -> None:
+    """Log a warning for each edge of a unit inside the domain off the mesh
     lines, unless a fracture covers it (its cut cells are split per QP)."""
     tol = ALIGN_TOL * mesh.h_min
     off = []
-    for name, p, q in edges(reservoir):
+    for name, p, q in edges(unit.region, domain_box(mesh)):
         if _on_mesh_line(mesh, p, q):
             continue
         part = _clip_to_domain(mesh, p, q)
@@ -196,35 +246,23 @@ def _warn_unaligned(mesh, reservoir, fractures=()) -> None:
     subjects = [f"{name} is" for name in off]
     if len(off) > 4:
         subjects = [f"{', '.join(off[:3])} and {len(off) - 3:,} more edges are"]
+    label = "reservoir" if unit.name == "reservoir" else f"unit {unit.name!r}:"
     for subject in subjects:
         logger.warning(
-            "reservoir %s not on a mesh line; the cells whose centre is "
-            "inside the region form the reservoir",
+            "%s %s not on a mesh line; the cells whose centre is inside the "
+            "region form the %s",
+            label,
             subject,
+            "reservoir" if unit.name == "reservoir" else "unit",
         )
 
 
-def material_at(spec, xy) -> np.ndarray:
-    """(n,) int64 material at the points ``xy`` (n, 2) [m]: RESERVOIR where
-    a point lies in the ``[reservoir]`` region
-    (:func:`xfemslip.geometry.regions.in_region`), else HOST.  The one rule
-    for cell centres, quadrature points and the faces of fractures."""
-    xy = np.asarray(xy, float).reshape(-1, 2)
-    material = np.full(xy.shape[0], HOST, np.int64)
-    if spec.reservoir is not None:
-        material[in_region(xy, spec.reservoir)] = RESERVOIR
-    return material
-
-
-def face_materials(spec, ip, eps) -> tuple[np.ndarray, np.ndarray]:
-    """(n_ip,) material of the + and of the - face of every interface point:
-    :func:`material_at` the points x + eps n and x - eps n (eps [m], normally
-    FACE_OFFSET h_min).  A fracture inside one material has it on both faces;
-    a fault bounding the reservoir has the reservoir on one face only."""
-    return (
-        material_at(spec, ip.xy + eps * ip.normal),
-        material_at(spec, ip.xy - eps * ip.normal),
-    )
+def face_zones(zones: Zones, ip, eps) -> tuple[np.ndarray, np.ndarray]:
+    """(n_ip,) zone of the + and of the - face of every interface point:
+    :meth:`Zones.at` the points x + eps n and x - eps n (eps [m], normally
+    FACE_OFFSET h_min).  A fracture inside one unit has it on both faces; a
+    fault bounding the reservoir has the reservoir on one face only."""
+    return zones.at(ip.xy + eps * ip.normal), zones.at(ip.xy - eps * ip.normal)
 
 
 def _area_majority(ec, qp_material, n_materials) -> np.ndarray:
@@ -236,71 +274,114 @@ def _area_majority(ec, qp_material, n_materials) -> np.ndarray:
 
 
 def build_materials(spec, mesh, ec=None, fractures=()) -> Materials:
-    """Host ([material]) and, with [reservoir], reservoir constants per cell and,
-    given the enriched cells ``ec``, per enriched-cell quadrature point."""
-    m = spec.material
-    E, nu = [m.E], [m.nu]
-    cell = material_at(spec, cell_centres(mesh))
+    """The zones' constants, the zone of every cell and, given the enriched
+    cells ``ec``, of every enriched-cell quadrature point."""
+    zones = build_zones(spec)
+    cell = np.full(mesh.n_cells, HOST, np.int64)
     qp = None
-    r = spec.reservoir
-    if r is not None:
-        E.append(r.E)
-        nu.append(r.nu)
-        _warn_unaligned(mesh, r, fractures)
+    if spec.units:
+        cell = zones.at(cell_centres(mesh))
+        for unit in spec.units:
+            _warn_unaligned(mesh, unit, fractures)
         if ec is not None and ec.cells.size:
-            qp = material_at(spec, ec.qp_xy)
-            cell[ec.cells] = _area_majority(ec, qp, 2)
-    D = np.stack([elasticity_matrix(e, v, m.model) for e, v in zip(E, nu, strict=True)])
+            qp = zones.at(ec.qp_xy)
+            cell[ec.cells] = _area_majority(ec, qp, zones.n)
+    D = np.stack(
+        [
+            elasticity_matrix(e, v, spec.material.model)
+            for e, v in zip(zones.E, zones.nu, strict=True)
+        ]
+    )
     return Materials(
-        D=D, nu=np.array(nu), E=np.array(E), cell=cell, model=m.model, qp=qp
+        D=D,
+        nu=zones.nu.copy(),
+        E=zones.E.copy(),
+        cell=cell,
+        model=spec.material.model,
+        qp=qp,
+        zones=zones,
     )
 
 
 def build_pore_pressure(
-    spec, materials: Materials, ec=None, ip=None, h_min=1.0
+    spec, materials: Materials, mesh, ec=None, ip=None, fractures=()
 ) -> PorePressure | None:
     """The case's pore pressure, or None without [pore_pressure].
 
-    ec, ip : enriched cells and interface points (per-QP and per-point regions);
-    h_min : smallest cell size [m] (the face offset of eq. 3).
+    ec, ip : enriched cells and interface points (per-QP and per-point
+    zones); fractures : the FractureSpecs of the case, by interface point
+    ``ip.fracture`` (their fluid_pressure rule).
     """
     p = spec.pore_pressure
     if p is None:
         return None
+    zones = materials.zones
+    scale = p.change if p.change != 0.0 else 1.0
+    ratio = zones.change / scale  # (k,): exactly 1.0 or 0.0 where it is
+    alpha = zones.biot
     n_qp = 0 if ec is None else ec.qp_w.size
-    if p.region == "reservoir":
-        changes = materials.cell == RESERVOIR
-        qp = np.zeros(n_qp) if materials.qp is None else materials.qp == RESERVOIR
-    else:
-        changes = np.ones(materials.cell.size, bool)
-        qp = np.ones(n_qp)
-    qp = np.asarray(qp, float)
-    fraction = changes.astype(float)
+    qp_zone = materials.qp if materials.qp is not None else np.zeros(n_qp, np.int64)
+    fraction = ratio[materials.cell]
     if n_qp:
         cell_of_qp = np.repeat(np.arange(ec.cells.size), np.diff(ec.qp_offsets))
         area = np.bincount(cell_of_qp, weights=ec.qp_w, minlength=ec.cells.size)
-        part = np.bincount(cell_of_qp, weights=ec.qp_w * qp, minlength=ec.cells.size)
+        part = np.bincount(
+            cell_of_qp, weights=ec.qp_w * ratio[qp_zone], minlength=ec.cells.size
+        )
         fraction[ec.cells] = part / area
-    points = np.zeros(0)
+    uniform = p.gradient == 0.0 and not np.any(zones.overpressure)
+    if uniform:
+        cell_p0 = np.full(materials.cell.size, p.initial)
+    else:
+        cell_p0 = initial_pressure(spec, zones, cell_centres(mesh), materials.cell)
+    point_p0, point_ratio = np.zeros(0), np.zeros(0)
     if ip is not None:
-        points = _face_mean(spec, ip, FACE_OFFSET * h_min)
+        eps = FACE_OFFSET * mesh.h_min
+        point_p0, point_ratio = _fluid(spec, zones, ip, eps, ratio, uniform, fractures)
     return PorePressure(
         initial=p.initial,
         change=p.change,
         biot=p.biot,
-        cell_changes=changes,
+        scale=scale,
+        cell_p0=cell_p0,
+        cell_biot=alpha[materials.cell],
+        cell_load=(alpha * ratio)[materials.cell],
         cell_fraction=fraction,
-        qp_changes=qp,
-        point_changes=points,
+        qp_alpha=alpha[qp_zone],
+        qp_ratio=ratio[qp_zone],
+        point_p0=point_p0,
+        point_ratio=point_ratio,
+        uniform_p0=p.initial if uniform else None,
     )
 
 
-def _face_mean(spec, ip, eps) -> np.ndarray:
-    """(n_ip,) mean over the two faces of c (1 = the pressure changes), eq. (3)."""
-    if spec.pore_pressure.region != "reservoir":
-        return np.ones(ip.n)
-    plus, minus = (face == RESERVOIR for face in face_materials(spec, ip, eps))
-    return 0.5 * (plus.astype(float) + minus)
+def _fluid(spec, zones, ip, eps, ratio, uniform, fractures):
+    """(p_f at load factor 0 [Pa], its change / scale at 1) at every
+    interface point, eq. (3): each fracture's rule on its two faces."""
+    sides = []
+    for zone in face_zones(zones, ip, eps):
+        # the depth term at the point itself (it is continuous), the face's
+        # unit for its overpressure
+        p0 = (
+            np.full(ip.n, spec.pore_pressure.initial)
+            if uniform
+            else initial_pressure(spec, zones, ip.xy, zone)
+        )
+        sides.append((p0, ratio[zone]))
+    (p0_plus, r_plus), (p0_minus, r_minus) = sides
+    rules = [getattr(f, "fluid_pressure", "mean") for f in fractures]
+    if not rules or all(r == "mean" for r in rules):
+        return 0.5 * (p0_plus + p0_minus), 0.5 * (r_plus + r_minus)
+    scale = spec.pore_pressure.change or 1.0
+    start = np.empty(ip.n)
+    end = np.empty(ip.n)
+    for fi, rule in enumerate(rules):
+        m = ip.fracture == fi
+        start[m] = fluid_value(rule, p0_plus[m], p0_minus[m])
+        end[m] = fluid_value(
+            rule, p0_plus[m] + scale * r_plus[m], p0_minus[m] + scale * r_minus[m]
+        )
+    return start, (end - start) / scale
 
 
 def body_load(mesh, bulk, pore: PorePressure, ec, backend: str) -> np.ndarray:
@@ -308,13 +389,13 @@ def body_load(mesh, bulk, pore: PorePressure, ec, backend: str) -> np.ndarray:
 
     Intact rectangle: int dN_a/dx dOmega = x_a hy / 2, int dN_a/dy = y_a hx / 2
     (x_a, y_a = -/+1 the corner signs).  Enriched cell (``ec``, same order as
-    ``bulk.enriched_cells``): sum_q w_q B_q^T m alpha dp(x_q) = alpha dp A_c
-    Bbar_c^T m, Bbar_c the average strain operator over the part of the cell
-    whose QPs lie where the pressure changes (its area A_c), computed by the
-    model's kernel ``backend``.
+    ``bulk.enriched_cells``): sum_q w_q B_q^T m alpha dp(x_q), by groups of
+    QPs with one (alpha, dp): alpha dp A_g Bbar_g^T m, Bbar_g the average
+    strain operator over the group's part of the cell (its area A_g),
+    computed by the model's kernel ``backend``.
     """
     F = np.zeros(bulk.dofmap.n_dofs)
-    q = pore.biot * pore.change * pore.cell_changes  # (n_cells,) [Pa]
+    q = pore.scale * pore.cell_load  # (n_cells,) alpha dp [Pa]
     std = bulk.std_cells
     b = mesh.bounds[std]
     hx, hy = b[:, 1] - b[:, 0], b[:, 3] - b[:, 2]
@@ -326,17 +407,46 @@ def body_load(mesh, bulk, pore: PorePressure, ec, backend: str) -> np.ndarray:
     np.add.at(F, 2 * nodes, fx)
     np.add.at(F, 2 * nodes + 1, fy)
     if ec.cells.size:
-        w = ec.qp_w * pore.qp_changes
-        cell_of_qp = np.repeat(np.arange(ec.cells.size), np.diff(ec.qp_offsets))
-        area = np.bincount(cell_of_qp, weights=w, minlength=ec.cells.size)
-        rows = np.nonzero(area > 0.0)[0]
-        Bbar = enriched_part_bbar(mesh, ec, rows, w, backend)
-        # Bbar^T m = rows exx + eyy of the average operator
-        fe = (pore.biot * pore.change * area[rows])[:, None] * (Bbar[:, 0] + Bbar[:, 1])
-        dofs = bulk.enr_dofs[rows]
-        keep = dofs >= 0
-        np.add.at(F, dofs[keep], fe[keep])
+        for w, factor in _load_groups(ec, pore):
+            _add_enriched_load(F, mesh, bulk, ec, w, factor, pore.scale, backend)
     return F
+
+
+def _load_groups(ec, pore: PorePressure):
+    """(QP weights, factor) of each group of enriched-cell QPs whose Biot load
+    is factor * sum_q w_q B_q^T m: one group per distinct (alpha, dp / scale)
+    (factor alpha scale and the ratio), or, with many distinct values, one per
+    sign of alpha dp (weights w |alpha dp / scale|, factor +-scale)."""
+    pairs = np.column_stack([pore.qp_alpha, pore.qp_ratio])
+    values = np.unique(pairs[pairs[:, 1] != 0.0], axis=0)
+    if len(values) <= MAX_LOAD_GROUPS:
+        for a, r in values:
+            mine = (pore.qp_alpha == a) & (pore.qp_ratio == r)
+            w = ec.qp_w * mine
+            yield w, (a, r)
+        return
+    v = pore.qp_alpha * pore.qp_ratio
+    for sign in (1.0, -1.0):
+        w = ec.qp_w * np.where(sign * v > 0.0, np.abs(v), 0.0)
+        if w.any():
+            yield w, (sign, 1.0)
+
+
+def _add_enriched_load(F, mesh, bulk, ec, w, factor, scale, backend) -> None:
+    """F += (alpha scale A) r Bbar^T m over the enriched cells holding weight
+    w, (alpha, r) = ``factor``."""
+    a, r = factor
+    cell_of_qp = np.repeat(np.arange(ec.cells.size), np.diff(ec.qp_offsets))
+    area = np.bincount(cell_of_qp, weights=w, minlength=ec.cells.size)
+    rows = np.nonzero(area > 0.0)[0]
+    if rows.size == 0:
+        return
+    Bbar = enriched_part_bbar(mesh, ec, rows, w, backend)
+    # Bbar^T m = rows exx + eyy of the average operator
+    fe = ((a * scale * area[rows]) * r)[:, None] * (Bbar[:, 0] + Bbar[:, 1])
+    dofs = bulk.enr_dofs[rows]
+    keep = dofs >= 0
+    np.add.at(F, dofs[keep], fe[keep])
 
 
 def fracture_load(contact, ip, pore: PorePressure) -> np.ndarray:
@@ -350,7 +460,7 @@ def fracture_load(contact, ip, pore: PorePressure) -> np.ndarray:
     dofs, coef = contact.point_dofs, contact.point_coef
     if dofs.shape[1] == 0:
         return F
-    g = ip.weight * pore.change * pore.point_changes
+    g = ip.weight * pore.scale * pore.point_ratio
     for c in range(2):
         d = dofs[:, c::2]
         v = coef * (g * contact.point_normal[:, c])[:, None]
@@ -359,12 +469,14 @@ def fracture_load(contact, ip, pore: PorePressure) -> np.ndarray:
     return F
 
 
-def make_contact_effective(contact, pore: PorePressure) -> None:
+def make_contact_effective(contact, pore: PorePressure, ip) -> None:
     """Shift the in-situ normal traction of every patch to the effective one,
-    sigma_n0' = sigma_n0 + p0 (the initial pressure is uniform)."""
-    contact.pn0 = contact.pn0 + pore.initial
-
-
-def fluid_pressure(ip, pore: PorePressure, lam: float) -> np.ndarray:
-    """(n,) fluid pressure in the fractures at the interface points, eq. (3) [Pa]."""
-    return pore.initial + lam * pore.change * pore.point_changes
+    sigma_n0' = sigma_n0 + p_f(0), p_f(0) of eq. (3) averaged over the patch."""
+    if pore.uniform_p0 is not None and np.all(pore.point_p0 == pore.uniform_p0):
+        contact.pn0 = contact.pn0 + pore.uniform_p0
+        return
+    W = np.bincount(contact.patch, weights=ip.weight, minlength=contact.n)
+    p0 = np.bincount(
+        contact.patch, weights=ip.weight * pore.point_p0, minlength=contact.n
+    )
+    contact.pn0 = contact.pn0 + p0 / W

@@ -165,8 +165,13 @@ class InterfacePoints:
         return self.fracture.size
 
 
-def interface_points(fractures, min_cell: float | None = None) -> InterfacePoints:
-    """Gauss points on every piece of every fracture, split at the ramp kinks.
+def interface_points(
+    fractures, min_cell: float | None = None, breaks=None
+) -> InterfacePoints:
+    """Gauss points on every piece of every fracture, split at the ramp kinks
+    and at the arc lengths ``breaks[f]`` (n_f,) [m] of each fracture f (where
+    its loading jumps: :func:`xfemslip.fem.zones.loading_breaks`), so that
+    no quadrature segment straddles a jump.
 
     min_cell : smallest element size [m]; sub-pieces shorter than
     GEOMETRY_TOL * min_cell (a kink falling on a piece's end) are skipped
@@ -182,6 +187,9 @@ def interface_points(fractures, min_cell: float | None = None) -> InterfacePoint
             p0 = fr.points[seg]
             d = fr.points[seg + 1] - p0
             cuts = [ta, tb]
+            if breaks is not None and len(breaks[fi]):
+                t = (np.asarray(breaks[fi]) - fr.s_start[seg]) / fr.length[seg]
+                cuts.extend(t[(t > ta) & (t < tb)])
             for tip in fr.tips:
                 dd = d @ tip.direction
                 if abs(dd) > 0.0:

@@ -210,6 +210,16 @@ class Fracture:
         """The junction lines across which an arm's function J jumps."""
         return [(c.point, c.normal) for arm in self.arms for c in arm]
 
+    def point_at(self, s) -> tuple[np.ndarray, np.ndarray]:
+        """(xy (n, 2), normal (n, 2)) at arc lengths s (n,) [m] along the
+        (clipped) polyline; beyond its ends, on its first or last segment's
+        line."""
+        s = np.atleast_1d(np.asarray(s, float))
+        ends = self.s_start + self.length
+        seg = np.minimum(np.searchsorted(ends, s), self.length.size - 1)
+        t = (s - self.s_start[seg])[:, None]
+        return self.points[seg] + t * self.tangent[seg], self.normal[seg]
+
     def arc_length(self, seg: np.ndarray, t: np.ndarray) -> np.ndarray:
         """Arc length [m] of the points at parameter t of segments seg."""
         return self.s_start[seg] + t * self.length[seg]

@@ -1,9 +1,12 @@
-"""Reservoir regions: axis-aligned boxes or one simple polygon (pure NumPy).
+"""Regions of rock units: boxes, one simple polygon, a layer between two
+horizons, or a layer displaced across a fault (pure NumPy).
 
-Used by xfemslip.case.pore (validation: does the region hold a cell centre, is the
-polygon simple) and poro.py (which cells, quadrature points and fracture
-faces lie in the reservoir).  Membership is strict for boxes; a point exactly
-on a polygon edge may fall on either side (even-odd rule).
+Used by xfemslip.case (validation: does the region hold a cell centre, is the
+polygon simple) and xfemslip.fem.zones (which cells, quadrature points and
+fracture faces lie in which unit).  Membership is strict for boxes and
+layers; a point exactly on a polygon edge may fall on either side (even-odd
+rule).  A displaced layer ("offset") takes its side of the fault from the
+fault line itself, so its boundary along the fault is the fault, exactly.
 """
 
 from __future__ import annotations
@@ -64,20 +67,73 @@ def in_polygon(xy: np.ndarray, polygon: np.ndarray) -> np.ndarray:
     return crossings % 2 == 1
 
 
-def in_region(xy: np.ndarray, reservoir) -> np.ndarray:
-    """(n,) bool: points in the reservoir (its polygon, else its boxes)."""
-    if reservoir.polygon is not None:
-        return in_polygon(xy, reservoir.polygon)
-    return in_boxes(xy, reservoir.boxes)
+def fault_x(y: np.ndarray, fault: np.ndarray) -> np.ndarray:
+    """x [m] of the fault line at heights y: the polyline ``fault`` (k, 2),
+    strictly monotone in y, extended straight beyond its ends."""
+    P = np.asarray(fault, float)
+    if P[-1, 1] < P[0, 1]:
+        P = P[::-1]
+    y = np.asarray(y, float)
+    x = np.interp(y, P[:, 1], P[:, 0])
+    below, above = y < P[0, 1], y > P[-1, 1]
+    if below.any():
+        slope = (P[1, 0] - P[0, 0]) / (P[1, 1] - P[0, 1])
+        x = np.where(below, P[0, 0] + slope * (y - P[0, 1]), x)
+    if above.any():
+        slope = (P[-1, 0] - P[-2, 0]) / (P[-1, 1] - P[-2, 1])
+        x = np.where(above, P[-1, 0] + slope * (y - P[-1, 1]), x)
+    return x
 
 
-def edges(reservoir) -> list[tuple[str, np.ndarray, np.ndarray]]:
-    """(name, start, end) of every edge of the region, named by case key."""
-    if reservoir.polygon is not None:
-        P = np.asarray(reservoir.polygon, float)
+def fault_side(xy: np.ndarray, fault: np.ndarray) -> np.ndarray:
+    """(n,) bool: points right of the fault line (x > fault_x(y))."""
+    xy = np.asarray(xy, float).reshape(-1, 2)
+    return xy[:, 0] > fault_x(xy[:, 1], fault)
+
+
+def in_layer(xy: np.ndarray, base: float, top: float) -> np.ndarray:
+    """(n,) bool: points strictly between the horizons y = base < top."""
+    y = np.asarray(xy, float).reshape(-1, 2)[:, 1]
+    return (y > base) & (y < top)
+
+
+def offset_span(region, right: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(base, top) [m] of a displaced layer on each point's side of its fault
+    (``right``: (n,) bool from :func:`fault_side`)."""
+    lowered = right if region.lowered == "right" else ~right
+    shift = np.where(lowered, region.throw, 0.0)
+    return region.base - shift, region.top - shift
+
+
+def in_region(xy: np.ndarray, region) -> np.ndarray:
+    """(n,) bool: points in the region (a RegionSpec, or a ReservoirSpec:
+    its polygon, else its boxes)."""
+    kind = getattr(region, "kind", None)
+    if kind == "layer":
+        return in_layer(xy, region.base, region.top)
+    if kind == "offset":
+        xy = np.asarray(xy, float).reshape(-1, 2)
+        base, top = offset_span(region, fault_side(xy, region.fault))
+        return (xy[:, 1] > base) & (xy[:, 1] < top)
+    if region.polygon is not None:
+        return in_polygon(xy, region.polygon)
+    return in_boxes(xy, region.boxes)
+
+
+def edges(region, box=None) -> list[tuple[str, np.ndarray, np.ndarray]]:
+    """(name, start, end) of every edge of the region, named by case key.
+
+    A layer's horizons (and a displaced layer's, each ending at the fault)
+    run across ``box`` = (x0, x1, y0, y1), the domain; without it they are
+    left out."""
+    kind = getattr(region, "kind", None)
+    if kind in ("layer", "offset"):
+        return [] if box is None else _horizon_edges(region, box)
+    if region.polygon is not None:
+        P = np.asarray(region.polygon, float)
         return [(f"polygon edge {i}", P[i], P[(i + 1) % len(P)]) for i in range(len(P))]
     out = []
-    for i, (x0, y0, x1, y1) in enumerate(np.asarray(reservoir.boxes, float)):
+    for i, (x0, y0, x1, y1) in enumerate(np.asarray(region.boxes, float)):
         out += [
             (f"box {i}: x0 = {x0:g}", np.array([x0, y0]), np.array([x0, y1])),
             (f"box {i}: x1 = {x1:g}", np.array([x1, y0]), np.array([x1, y1])),
@@ -103,3 +159,29 @@ def polygon_problem(polygon: np.ndarray) -> str | None:
     if area == 0.0:
         return "has zero area"
     return None
+
+
+def _horizon_edges(region, box) -> list[tuple[str, np.ndarray, np.ndarray]]:
+    """The horizons of a layer across the domain ``box`` (x0, x1, y0, y1);
+    those of a displaced layer end at its fault, one piece per side."""
+    x0, x1 = float(box[0]), float(box[1])
+    if region.kind == "layer":
+        return [
+            (f"{name} = {y:g}", np.array([x0, y]), np.array([x1, y]))
+            for name, y in (("top", region.top), ("base", region.base))
+        ]
+    out = []
+    for side, right in (("left", False), ("right", True)):
+        base, top = offset_span(region, np.array([right]))
+        for name, y in (("top", float(top[0])), ("base", float(base[0]))):
+            xf = float(fault_x(np.array([y]), region.fault)[0])
+            a, b = (x0, min(xf, x1)) if not right else (max(xf, x0), x1)
+            if a < b:
+                out.append(
+                    (
+                        f"{name} on the {side} = {y:g}",
+                        np.array([a, y]),
+                        np.array([b, y]),
+                    )
+                )
+    return out

@@ -80,6 +80,7 @@ RUN_FILES = (
     "fractures.pvd",
     "result.xdmf",
     "result_steps.xdmf",
+    "profile.csv",
 )
 # Every name an xfemslip command writes into a result folder: an earlier one is
 # never carried into a new set, whichever command wrote it.

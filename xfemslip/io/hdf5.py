@@ -276,6 +276,7 @@ def _write_fracture(group: h5py.Group, fracture: FractureFields) -> None:
         ("effective_normal_traction", "Pa"),
         ("aperture", "m"),  # with [permeability]
         ("transmissivity", "m^3"),
+        ("utilisation", "-"),  # None only in a result read from an older file
     )
     for name, units in optional:
         value = getattr(fracture, name, None)
@@ -298,11 +299,28 @@ def _write_properties(
     for index, prop in enumerate(properties):
         g = group[str(index)]
         n_points = g["s"].shape[0]
-        for name, units in (("shear_modulus", "Pa"), ("poisson_ratio", "-")):
-            value = _as_array(getattr(prop, name), np.float64, (n_points,), name)
-            _dataset(g, name, value, units)
+        for name, units in PROPERTY_DATASETS:
+            value = getattr(prop, name)
+            if value is not None:
+                value = _as_array(value, np.float64, (n_points,), name)
+                _dataset(g, name, value, units)
         g.attrs["ends"] = _as_array(prop.ends, np.float64, (2,), "ends")
+        if prop.breaks is not None:
+            g.attrs["breaks"] = _as_array(prop.breaks, np.float64, (None,), "breaks")
+            g.attrs["units_plus"] = np.array(prop.units_plus, dtype=h5py.string_dtype())
+            g.attrs["units_minus"] = np.array(
+                prop.units_minus, dtype=h5py.string_dtype()
+            )
 
+
+# (name, units) of the datasets of FractureProperties, K rows each, root only
+PROPERTY_DATASETS = (
+    ("shear_modulus", "Pa"),
+    ("poisson_ratio", "-"),
+    ("in_situ_normal_traction", "Pa"),
+    ("in_situ_shear_traction", "Pa"),
+    ("in_situ_utilisation", "-"),
+)
 
 # (name, units) of the event datasets, each (S, F)
 EVENT_DATASETS = (

@@ -40,6 +40,7 @@ OPTIONAL_FRACTURE_ARRAYS = (
     "effective_normal_traction",
     "aperture",
     "transmissivity",
+    "utilisation",
 )
 BULK_ARRAYS = ("stress", "stress_zz", "principal_stress")
 OPTIONAL_BULK_ARRAYS = ("effective_stress", "pore_pressure")
@@ -96,6 +97,11 @@ def _fractures(group: h5py.Group | None) -> list[FractureFields]:
     return out
 
 
+def _text(value) -> str:
+    """An HDF5 string attribute item as str."""
+    return value.decode("utf-8") if isinstance(value, bytes) else str(value)
+
+
 def _properties(h5: h5py.File) -> list[FractureProperties] | None:
     """``/fractures/<i>`` shear_modulus, poisson_ratio and attribute ends of
     every fracture; None when a fracture lacks one (a result written before
@@ -109,11 +115,25 @@ def _properties(h5: h5py.File) -> list[FractureProperties] | None:
         if not {"shear_modulus", "poisson_ratio"} <= set(g) or "ends" not in g.attrs:
             return None
         lo, hi = (float(v) for v in g.attrs["ends"])
+        optional = {
+            key: g[key][()]
+            for key in (
+                "in_situ_normal_traction",
+                "in_situ_shear_traction",
+                "in_situ_utilisation",
+            )
+            if key in g
+        }
+        if "breaks" in g.attrs:
+            optional["breaks"] = np.asarray(g.attrs["breaks"], float)
+            for key in ("units_plus", "units_minus"):
+                optional[key] = tuple(_text(v) for v in g.attrs.get(key, ()))
         out.append(
             FractureProperties(
                 ends=(lo, hi),
                 shear_modulus=g["shear_modulus"][()],
                 poisson_ratio=g["poisson_ratio"][()],
+                **optional,
             )
         )
     return out

@@ -6,6 +6,9 @@ swapped in whole, :mod:`xfemslip.io.folder`); ``write_results`` writes a
 :class:`~xfemslip.post.result.Result` into its staging folder:
 
 - ``result.h5`` (:mod:`xfemslip.io.hdf5`), always;
+- with ``"csv"`` in ``output.formats``: ``profile.csv``, the profiles of
+  the fractures at every step (:mod:`xfemslip.post.profile`), when the
+  case has a fracture;
 - with ``"vtu"`` in the case's ``output.formats`` (the ParaView files) and
   at least one converged step: ``result.xdmf`` (and ``result_steps.xdmf``
   with more than one load step) describing ``result.h5``
@@ -27,8 +30,10 @@ from pathlib import Path
 
 from xfemslip import interrupt
 from xfemslip.io import hdf5
+from xfemslip.io.csv import write_rows
 from xfemslip.io.folder import RUN_FILES, output_folder
 from xfemslip.post.fields import VisMesh, stress_for_paraview
+from xfemslip.post.profile import PROFILE_COLUMNS, profile_rows
 from xfemslip.post.result import Result
 
 __all__ = ["OUTPUT_FILES", "run_folder", "write_results"]
@@ -72,6 +77,8 @@ def write_results(
         permeability=result.permeability,
         properties=result.fracture_properties,
     )
+    if "csv" in formats and result.steps and result.steps[0].fractures:
+        write_rows(folder / "profile.csv", PROFILE_COLUMNS, profile_rows(result))
     if "vtu" in formats and result.steps:
         # the ParaView files: those of the split mesh, and the description
         # of result.h5 that lets ParaView read it

@@ -39,7 +39,14 @@ from xfemslip.post.fields import FractureFields, VisMesh
 logger = logging.getLogger(__name__)
 
 FRACTURE_POINT_DATA = ("slip", "opening", "normal_traction", "shear_traction")
-OPTIONAL_FRACTURE_POINT_DATA = ("plastic_slip", "aperture", "transmissivity")
+OPTIONAL_FRACTURE_POINT_DATA = (
+    "plastic_slip",
+    "fluid_pressure",
+    "effective_normal_traction",
+    "utilisation",
+    "aperture",
+    "transmissivity",
+)
 
 
 def write_bulk(
@@ -144,8 +151,10 @@ def write_fractures(
     Point data: ``slip``, ``plastic_slip`` (the slip that slid), ``opening``
     [m], ``normal_traction``,
     ``shear_traction``, ``contact_pressure`` = max(0, -normal_traction) [Pa],
-    ``state`` (int32: 0 open, 1 stick, 2 slip), ``s`` [m] and ``fracture``
-    (the index), with ``faces`` the two displacements above, and with
+    ``state`` (int32: 0 open, 1 stick, 2 slip), ``utilisation`` (the Coulomb
+    utilisation, 1 where it slips), ``s`` [m] and ``fracture`` (the index),
+    with ``faces`` the two displacements above, with pore pressure
+    ``fluid_pressure`` and ``effective_normal_traction`` [Pa], and with
     ``[permeability]`` also ``aperture`` [m] and ``transmissivity`` [m^3].
     Points are 3D with z = 0.
 
@@ -262,8 +271,10 @@ def _fracture_part(
     part["state"] = np.asarray(fields.state, dtype=np.int32).reshape(n_points)
     part["s"] = s
     part["fracture"] = np.full(n_points, index, dtype=np.int32)
-    # plastic_slip [m] (None only when read from an older result.h5);
-    # [permeability]: aperture [m], transmissivity a^3 / 12 [m^3]
+    # plastic_slip [m] and utilisation [-] (None only when read from an older
+    # result.h5); with pore pressure fluid_pressure and
+    # effective_normal_traction [Pa]; [permeability]: aperture [m],
+    # transmissivity a^3 / 12 [m^3]
     for name in OPTIONAL_FRACTURE_POINT_DATA:
         value = getattr(fields, name, None)
         if value is not None:

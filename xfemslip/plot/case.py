@@ -1,6 +1,6 @@
 """The picture of a case before it runs (the seed paper's Fig. 5): the
 domain and its mesh, the fractures numbered as in the case file, the
-reservoir, the boundary conditions of each edge and the loads.
+rock units, the boundary conditions of each edge and the loads.
 
 ``figure_case(spec)`` draws a validated :class:`~xfemslip.case.specs.CaseSpec`
 (nothing is solved); ``plot_case`` writes it (``xfemslip plot --case``).
@@ -27,7 +27,10 @@ import matplotlib
 import numpy as np
 from matplotlib.collections import LineCollection
 from matplotlib.figure import Figure
-from matplotlib.patches import Polygon, Rectangle
+from matplotlib.patches import Rectangle
+
+from xfemslip.fem.zones import build_zones
+from xfemslip.geometry.regions import edges
 
 __all__ = ["figure_case", "plot_case"]
 
@@ -72,26 +75,46 @@ def _mesh_lines(ax, spec) -> str:
     return cells if step == 1 else f"{cells} (every {step}th line drawn)"
 
 
+# raster of the zone picture (cells per side) in the case figure
+ZONE_RASTER = 400
+
+
 def _regions(ax, spec) -> list[str]:
-    """The reservoir (and where the pore pressure changes); legend notes."""
+    """The rock units (filled by zone, edges drawn) and where the pore
+    pressure changes; legend notes."""
     notes = []
-    res, pore = spec.reservoir, spec.pore_pressure
-    if res is not None:
-        style = {"fc": "tab:orange", "alpha": 0.18, "ec": "tab:orange", "lw": 1.0}
-        label = f"reservoir: E = {res.E / 1e9:g} GPa, \u03bd = {res.nu:g}"
-        if pore is not None and pore.region == "reservoir":
-            label += f"; \u0394p = {pore.change / 1e6:g} MPa"
-        shapes = [
-            Rectangle((b[0], b[1]), b[2] - b[0], b[3] - b[1], **style)
-            for b in np.asarray(res.boxes).reshape(-1, 4)
-        ]
-        if res.polygon is not None:
-            shapes.append(Polygon(np.asarray(res.polygon), closed=True, **style))
-        for k, shape in enumerate(shapes):
-            shape.set_label(label if k == 0 else None)
-            ax.add_patch(shape)
+    pore = spec.pore_pressure
+    if spec.units:
+        zones = build_zones(spec)
+        (x0, y0), (w, h) = spec.origin, spec.size
+        gx = np.linspace(x0, x0 + w, ZONE_RASTER)
+        gy = np.linspace(y0, y0 + h, ZONE_RASTER)
+        X, Y = np.meshgrid(gx, gy)
+        Z = zones.at(np.column_stack([X.ravel(), Y.ravel()])).reshape(X.shape)
+        colours = matplotlib.colormaps["Pastel1"](np.arange(zones.n) % 9)
+        colours[0] = (1.0, 1.0, 1.0, 0.0)  # the host: not filled
+        ax.imshow(
+            colours[Z],
+            origin="lower",
+            extent=(x0, x0 + w, y0, y0 + h),
+            interpolation="nearest",
+            aspect="auto",
+            zorder=0,
+        )
+        box = (x0, x0 + w, y0, y0 + h)
+        for k in range(1, zones.n):
+            label = (
+                f"{zones.names[k]}: E = {zones.E[k] / 1e9:g} GPa, "
+                f"\u03bd = {zones.nu[k]:g}"
+            )
+            if pore is not None and zones.change[k] != 0.0:
+                label += f"; \u0394p = {zones.change[k] / 1e6:g} MPa"
+            ax.add_patch(Rectangle((0, 0), 0, 0, fc=colours[k], label=label))
+        for unit in spec.units:
+            for _, p, q in edges(unit.region, box):
+                ax.plot([p[0], q[0]], [p[1], q[1]], color="0.35", lw=0.8)
     if pore is not None:
-        where = "in the reservoir" if pore.region == "reservoir" else "everywhere"
+        where = "everywhere" if pore.region == "all" else f"in {pore.region}"
         notes.append(
             f"pore pressure p0 = {pore.initial / 1e6:g} MPa, change "
             f"\u0394p = {pore.change / 1e6:g} MPa {where} (Biot {pore.biot:g})"

@@ -10,6 +10,7 @@ from pathlib import Path
 import numpy as np
 
 from xfemslip.conventions import SLIP
+from xfemslip.fem.poro import domain_box
 from xfemslip.geometry.regions import edges
 
 
@@ -57,15 +58,19 @@ def plot_slip_vs_depletion(
 def plot_field(model, result, out_dir: Path, dpi: float = 110.0) -> Path:
     """Shear stress change and effective horizontal stress at the last step,
     reservoir outline, fractures coloured stick / slip."""
-    from xfemslip.post.fields import step_fields
+    from xfemslip.post.fields import cell_in_situ, step_fields
 
     plt = _pyplot()
     f = step_fields(model, result)
     mesh = model.mesh
-    s0 = model.spec.loading.initial_stress or (0.0, 0.0, 0.0)
+    s0 = cell_in_situ(model)
+    s0 = np.zeros(3) if s0 is None else np.atleast_2d(np.asarray(s0, float))
     shape = (mesh.ny, mesh.nx)
     panels = [
-        ("shear stress change $\\Delta\\sigma_{xy}$ [MPa]", f.stress[:, 2] - s0[2]),
+        (
+            "shear stress change $\\Delta\\sigma_{xy}$ [MPa]",
+            f.stress[:, 2] - np.broadcast_to(s0, f.stress.shape)[:, 2],
+        ),
         (
             "effective stress $\\sigma'_{xx}$ [MPa]",
             f.effective_stress[:, 0]
@@ -82,8 +87,8 @@ def plot_field(model, result, out_dir: Path, dpi: float = 110.0) -> Path:
             mesh.x, mesh.y, v, cmap="RdBu_r", vmin=mid - lim, vmax=mid + lim
         )
         fig.colorbar(im, ax=ax, shrink=0.85)
-        if model.spec.reservoir is not None:
-            for _, p, q in edges(model.spec.reservoir):
+        for unit in model.spec.units:
+            for _, p, q in edges(unit.region, domain_box(mesh)):
                 ax.plot([p[0], q[0]], [p[1], q[1]], "k--", lw=0.8)
         for fr in f.fractures:
             slip = fr.state == SLIP

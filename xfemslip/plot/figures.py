@@ -42,10 +42,18 @@ from xfemslip.errors import UsageError
 from xfemslip.plot.data import ResultData, distinct_labels, figure_data
 from xfemslip.plot.mohr import NUMBERED_FROM, add_legend, draw_mohr, mohr_figsize
 from xfemslip.plot.permeability import figure_permeability
+from xfemslip.plot.profile import figure_profile
 
 logger = logging.getLogger(__name__)
 
-KINDS = ("displacement", "principal_stress", "deformed_mesh", "slip", "mohr")
+KINDS = (
+    "displacement",
+    "principal_stress",
+    "deformed_mesh",
+    "slip",
+    "mohr",
+    "profile",
+)
 FORMATS = ("png", "pdf")
 PANEL = 3.6  # inches per panel
 DPI = 110
@@ -556,12 +564,19 @@ def plot_results(
         # not in KINDS (asked for by name): one figure per result
         "network": lambda: figure_network(results[0], scale),
     }
+    if "profile" in kinds:  # of one result: the first
+        makers["profile"] = lambda: figure_profile(paths[0], results[0].label)
     if "permeability" in kinds:  # drawn now: a result without one is refused
         figure = figure_permeability(paths[0], results[0].label)
         makers["permeability"] = lambda: figure
     drawn = {}
     for kind in kinds:
-        if kind in ("slip", "mohr") and not any(r.fractures for r in results):
+        if kind == "profile" and len(results) > 1:
+            logger.info("profile figure: drawn for one result at a time")
+            continue
+        if kind in ("slip", "mohr", "profile") and not any(
+            r.fractures for r in results
+        ):
             logger.info("no fracture: %s figure skipped", kind)
             continue
         drawn[kind] = makers[kind]

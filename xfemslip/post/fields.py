@@ -21,9 +21,11 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from xfemslip.contact.interface import JUMP_PROBE
+from xfemslip.conventions import STICK
 from xfemslip.fem.enrichment import HEAVISIDE, find_candidates, group_values
 from xfemslip.fem.material import shear_modulus
-from xfemslip.fem.poro import FACE_OFFSET, face_materials, fluid_pressure
+from xfemslip.fem.poro import FACE_OFFSET, cell_centres, domain_box, face_zones
+from xfemslip.fem.zones import build_zones, in_situ_stress, loading_breaks
 from xfemslip.geometry.fracture import GEOMETRY_TOL
 
 
@@ -48,6 +50,9 @@ class FractureFields:
     # with [permeability] only (xfemslip.post.hydraulics)
     aperture: np.ndarray | None = None  # (K,) hydraulic aperture a [m]
     transmissivity: np.ndarray | None = None  # (K,) a^3 / 12 [m^3]
+    # |p_T| / (c + f max(0, -p_N')) of a stuck point, 1 where it slips or is
+    # open (coulomb_utilisation); None in a result written without it
+    utilisation: np.ndarray | None = None  # (K,) [-]
 
     @property
     def slid(self) -> np.ndarray:
@@ -66,6 +71,16 @@ class FractureProperties:
     ends: tuple[float, float]  # arc-length range of the fracture inside the domain [m]
     shear_modulus: np.ndarray  # (K,) mu at its contact points, sorted by s [Pa]
     poisson_ratio: np.ndarray  # (K,) nu there [-]
+    # the in-situ state at the contact points (effective normal and shear
+    # traction, utilisation), None in a result written without them
+    in_situ_normal_traction: np.ndarray | None = None  # (K,) p_N0' [Pa]
+    in_situ_shear_traction: np.ndarray | None = None  # (K,) p_T0 [Pa]
+    in_situ_utilisation: np.ndarray | None = None  # (K,) [-]
+    # where the rock on a face changes along it (arc lengths [m]) and the
+    # units on its + and - faces on each stretch between (len(breaks) + 1)
+    breaks: np.ndarray | None = None
+    units_plus: tuple[str, ...] = ()
+    units_minus: tuple[str, ...] = ()
 
 
 @dataclass
@@ -133,8 +148,9 @@ def bulk_fields(
     """stress (M, 3), stress_zz (M,), principal_stress (M, 2) [Pa] (total).
 
     With several materials (xfemslip.fem.poro): D (k, 3, 3), nu (k,) and
-    ``cell_material`` (M,).  With pore pressure, ``biot_p`` = (alpha p0,
-    alpha p (M,)) [Pa] at this step: sigma = sigma0 + D eps - alpha (p - p0) m
+    ``cell_material`` (M,).  ``initial_stress``: (3,), or (M, 3) varying with
+    depth.  With pore pressure, ``biot_p`` = (alpha p0, alpha p) [Pa] (each
+    (M,) or a number) at this step: sigma = sigma0 + D eps - alpha (p - p0) m
     and, in plane strain, sigma_zz = nu (sigma'_xx + sigma'_yy) - alpha p with
     sigma' = sigma0 + alpha p0 m + D eps (see xfemslip.fem.poro).
     """
@@ -145,8 +161,8 @@ def bulk_fields(
     else:
         stress = np.einsum("mij,mj->mi", np.asarray(D)[cell_material], eps)
         nu_c = np.asarray(nu, float)[cell_material]
-    if initial_stress is not None:
-        stress = stress + np.asarray(initial_stress, float)[None, :]
+    if initial_stress is not None:  # (3,) uniform or (M, 3) per cell
+        stress = stress + np.atleast_2d(np.asarray(initial_stress, float))
     a0, a = (0.0, np.zeros(mesh.n_cells)) if biot_p is None else biot_p
     # stress is sigma0 + D eps here, i.e. sigma' - alpha p0 m
     szz = (
@@ -161,6 +177,19 @@ def bulk_fields(
     return stress, szz, principal
 
 
+def coulomb_utilisation(pn, pt, state, friction, cohesion) -> np.ndarray:
+    """|p_T| / (c + f max(0, -p_N')) [-] of each contact point or patch: how
+    much of its Coulomb strength a stuck point uses; 1 where it slips (on the
+    bound) or is open (no strength left); 0 for a stuck point without shear
+    or strength.  p_N' is the effective normal traction the contact law acts
+    on (tension positive)."""
+    strength = cohesion + friction * np.maximum(0.0, -np.asarray(pn, float))
+    ratio = np.divide(
+        np.abs(pt), strength, out=np.zeros(np.shape(strength)), where=strength > 0.0
+    )
+    return np.where(np.asarray(state) == STICK, np.minimum(ratio, 1.0), 1.0)
+
+
 def fracture_fields(ip, res, n_fractures, fluid=None) -> list[FractureFields]:
     """Contact fields per fracture, ordered by arc length.
 
@@ -169,6 +198,12 @@ def fracture_fields(ip, res, n_fractures, fluid=None) -> list[FractureFields]:
     ``normal_traction`` is the total sigma_n' - p_f and the effective one and
     p_f are reported too (xfemslip.fem.poro).
     """
+    c = getattr(res, "contact", None)
+    use = (
+        coulomb_utilisation(res.pn, res.pt, res.state, c.friction, c.cohesion)[c.patch]
+        if c is not None
+        else None
+    )
     out = []
     for fi in range(n_fractures):
         m = np.nonzero(ip.fracture == fi)[0]
@@ -189,6 +224,7 @@ def fracture_fields(ip, res, n_fractures, fluid=None) -> list[FractureFields]:
                 shear_traction=res.point_pt[m].copy(),
                 state=res.point_state[m].astype(np.int8),
                 plastic_slip=res.point_plastic_slip[m].copy(),
+                utilisation=None if use is None else use[m].copy(),
                 **extra,
             )
         )
@@ -319,22 +355,33 @@ def vis_mesh_with_faces(model, u) -> VisMesh:
     return vis
 
 
+def cell_in_situ(model):
+    """The in-situ stress of every cell: ``initial_stress`` (3,) when uniform
+    (or None), else (M, 3) [Pa] at the cell centres in their zones."""
+    spec = model.spec
+    if spec.loading.in_situ is None:
+        return spec.loading.initial_stress
+    mats = model.materials
+    p0 = None if model.pore is None else model.pore.cell_p0
+    return in_situ_stress(spec, mats.zones, cell_centres(model.mesh), mats.cell, p0)
+
+
 def step_fields(model, r) -> StepFields:
     """The fields of the converged step ``r`` (a ``StepResult``) of ``model``
     (a :class:`xfemslip.simulation.Model`)."""
     spec = model.spec
     mats, pore = model.materials, model.pore
-    hetero = spec.reservoir is not None
+    hetero = bool(spec.units)
     biot_p = None
     if pore is not None:
         p = pore.cell_pressure(r.load_factor)
-        biot_p = (pore.biot * pore.initial, pore.biot * p)
+        biot_p = (pore.cell_biot * pore.cell_p0, pore.cell_biot * p)
     stress, szz, principal = bulk_fields(
         model.mesh,
         model.bulk,
         mats.D if hetero else model.D,
         r.u,
-        spec.loading.initial_stress,
+        cell_in_situ(model),
         mats.nu if hetero else spec.material.nu,
         spec.material.model,
         cell_material=mats.cell if hetero else None,
@@ -347,7 +394,7 @@ def step_fields(model, r) -> StepFields:
             "effective_stress": stress + biot_p[1][:, None] * [1.0, 1.0, 0.0],
             "pore_pressure": p,
         }
-        fluid = fluid_pressure(model.ip, pore, r.load_factor)
+        fluid = pore.fluid(r.load_factor)
     n_std = 2 * model.mesh.n_nodes
     return StepFields(
         step=r.step,
@@ -370,33 +417,47 @@ def fracture_properties(model) -> list[FractureProperties]:
     :func:`fracture_fields`.
 
     The elastic constants at a contact point are the mean of those of the
-    materials on its two faces (:func:`xfemslip.fem.poro.face_materials`,
-    sampled FACE_OFFSET h_min off the fracture as the fluid pressure is): a
-    fracture inside one material has that material's, a fault bounding the
-    reservoir the mean of the reservoir's and the host's.
+    zones on its two faces (:func:`xfemslip.fem.poro.face_zones`, sampled
+    FACE_OFFSET h_min off the fracture as the fluid pressure is): a fracture
+    inside one unit has that unit's, a fault bounding the reservoir the mean
+    of the reservoir's and the host's.
     """
     spec, ip = model.spec, model.ip
-    E = np.array([spec.material.E], float)
-    nu = np.array([spec.material.nu], float)
-    if model.materials is not None:
-        E, nu = (
-            np.asarray(model.materials.E, float),
-            np.asarray(model.materials.nu, float),
-        )
-    plus, minus = face_materials(spec, ip, FACE_OFFSET * model.mesh.h_min)
+    zones = model.materials.zones if model.materials else build_zones(spec)
+    E, nu = np.asarray(zones.E, float), np.asarray(zones.nu, float)
+    eps = FACE_OFFSET * model.mesh.h_min
+    plus, minus = face_zones(zones, ip, eps)
     mu = shear_modulus(E, nu)
     point_mu = 0.5 * (mu[plus] + mu[minus])
     point_nu = 0.5 * (nu[plus] + nu[minus])
+    c = model.contact
+    pn0 = c.pn0  # effective where there is pore pressure (make_contact_effective)
+    pt0 = -c.kt * c.slip_reference
+    state0 = np.full(c.n, STICK, np.int8)
+    use0 = coulomb_utilisation(pn0, pt0, state0, c.friction, c.cohesion)
+    use0 = np.where(pn0 > 0.0, 1.0, use0)  # in tension in situ: it opens
+    breaks = model.breaks
+    if breaks is None:
+        breaks = loading_breaks(zones, model.fractures, domain_box(model.mesh), eps)
     out = []
     for fi, fr in enumerate(model.fractures):
         m = np.nonzero(ip.fracture == fi)[0]
         m = m[np.argsort(ip.s[m], kind="stable")]
         ends = (float(fr.s_start[0]), float(fr.s_start[-1] + fr.length[-1]))
+        cuts = np.asarray(breaks[fi], float)
+        mids = np.concatenate([[ends[0]], cuts, [ends[1]]])
+        xy, normal = fr.point_at(0.5 * (mids[1:] + mids[:-1]))
         out.append(
             FractureProperties(
                 ends=ends,
                 shear_modulus=point_mu[m].copy(),
                 poisson_ratio=point_nu[m].copy(),
+                in_situ_normal_traction=pn0[c.patch[m]].copy(),
+                in_situ_shear_traction=pt0[c.patch[m]].copy(),
+                in_situ_utilisation=use0[c.patch[m]].copy(),
+                breaks=cuts,
+                units_plus=tuple(zones.names[z] for z in zones.at(xy + eps * normal)),
+                units_minus=tuple(zones.names[z] for z in zones.at(xy - eps * normal)),
             )
         )
     return out

@@ -33,6 +33,8 @@ from __future__ import annotations
 import numpy as np
 
 from xfemslip.conventions import OPEN
+from xfemslip.fem.poro import FACE_OFFSET
+from xfemslip.fem.zones import build_zones, in_situ_stress, initial_pressure
 from xfemslip.post.metrics import arc_extent, fracture_ends, point_stretches
 from xfemslip.post.permeability import ApertureLaw, oda_tensor, transmissivity
 from xfemslip.post.result import PermeabilityHistory, Result
@@ -70,11 +72,29 @@ def polyline_tangents(points, s) -> np.ndarray:
     return d[k] / length[k, None]
 
 
-def in_situ_normal(spec, tangents) -> np.ndarray:
+def in_situ_normal(spec, tangents, points=None) -> np.ndarray:
     """sigma_n0' = n . sigma0 . n + p0 [Pa] at points of the given unit
-    tangents (K, 2): the effective normal traction of the in-situ state."""
+    tangents (K, 2): the effective normal traction of the in-situ state;
+    ``points`` (K, 2) [m] where it varies with depth (the mean of the two
+    faces' in-situ stress and initial pore pressure)."""
     t = np.asarray(tangents, float)
     n = np.column_stack([-t[:, 1], t[:, 0]])
+    if spec.loading.in_situ is not None and points is not None:
+        zones = build_zones(spec)
+        xy = np.asarray(points, float)
+        eps = FACE_OFFSET * float(
+            min(np.diff(spec.mesh.x).min(), np.diff(spec.mesh.y).min())
+        )
+        S = np.zeros((xy.shape[0], 3))
+        p0 = np.zeros(xy.shape[0])
+        for sign in (0.5, -0.5):
+            face = xy + 2.0 * sign * eps * n
+            zone = zones.at(face)
+            p = initial_pressure(spec, zones, xy, zone)
+            S += 0.5 * in_situ_stress(spec, zones, face, zone, p)
+            p0 += 0.5 * p
+        sn = S[:, 0] * n[:, 0] ** 2 + S[:, 1] * n[:, 1] ** 2
+        return sn + 2.0 * S[:, 2] * n[:, 0] * n[:, 1] + p0
     sigma0 = spec.loading.initial_stress or (0.0, 0.0, 0.0)
     sxx, syy, sxy = sigma0
     sn = sxx * n[:, 0] ** 2 + syy * n[:, 1] ** 2 + 2.0 * sxy * n[:, 0] * n[:, 1]
@@ -118,7 +138,7 @@ def add_permeability(result: Result, spec) -> None:
         fracture = spec.fractures[k]
         t = polyline_tangents(fracture.points, ff.s)
         weights = block_stretches(ff.s, ends[k], arc_extent(fracture.points, block))
-        geometry.append((t, in_situ_normal(spec, t), weights))
+        geometry.append((t, in_situ_normal(spec, t, ff.points), weights))
     in_situ = oda_tensor(
         [
             (wk, t, np.full(wk.shape, law.initial_aperture))

@@ -38,12 +38,14 @@ point values ("interp") give K_I = 11-19 % of K_II.  The default "mean" uses
 the weighted mean traction of the points inside the domain (a few cells), which
 filters the oscillation and keeps any variation on the scale of the crack.
 
-With an initial stress s0 the interaction integral of the uniform s0 (with
-its own face tractions) is zero, so the integral uses D eps(u) and p - p0.
+With an initial stress s0 the integral uses D eps(u), p - p0 and the face
+tractions less s0 . n: the in-situ state is smooth (the faces carry s0 . n
+as the intact rock did), so its stress intensity is zero, uniform or
+growing with depth.
 
-Material.  E, nu (and D) are those of the material at the tip: the
-reservoir's when the tip lies in the ``[reservoir]`` region (xfemslip.fem.poro),
-the host's otherwise.  The integral assumes a homogeneous domain (it has no
+Material.  E, nu (and D) are those of the zone at the tip
+(xfemslip.fem.zones: a rock unit's, or the host's).  The integral assumes a
+homogeneous domain (it has no
 term for a material interface); a domain holding cells or quadrature points
 of the other material is computed with the tip's and logged as a warning.
 
@@ -59,8 +61,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from xfemslip.fem.poro import HOST, RESERVOIR
-from xfemslip.geometry.regions import in_region
+from xfemslip.fem.zones import in_situ_stress
 from xfemslip.post.fields import fracture_fields
 from xfemslip.reference.closed_form import kolosov
 
@@ -319,6 +320,11 @@ def _face_term(model, contact, fi, tip, q_nodes, r_out, r_in, mu, kappa, tractio
         S0 = _tensor(np.asarray(s0, float)[None, :])[0]
         pn = pn - np.einsum("ni,ij,nj->n", ip.normal[m], S0, ip.normal[m])
         pt = pt - np.einsum("ni,ij,nj->n", ip.tangent[m], S0, ip.normal[m])
+    elif model.spec.loading.in_situ is not None:
+        z = model.materials.zones
+        S0 = _tensor(in_situ_stress(model.spec, z, ip.xy[m], z.at(ip.xy[m])))
+        pn = pn - np.einsum("ni,nij,nj->n", ip.normal[m], S0, ip.normal[m])
+        pt = pt - np.einsum("ni,nij,nj->n", ip.tangent[m], S0, ip.normal[m])
     if tip.end == 0:
         s_tip = float(fr.s_start[0])
         seg = 0
@@ -365,11 +371,11 @@ def _face_term(model, contact, fi, tip, q_nodes, r_out, r_in, mu, kappa, tractio
 def _tip_material(model, tip, q_nodes):
     """E [Pa], nu [-] and D (3, 3) [Pa] of the material at the tip; warns when
     the domain (cells with q > 0) holds the other material."""
-    r = model.spec.reservoir
-    if r is None:
+    if not model.spec.units:
         return model.spec.material.E, model.spec.material.nu, model.D
     mats = model.materials
-    k = RESERVOIR if in_region(np.asarray(tip.point)[None], r)[0] else HOST
+    zones = mats.zones
+    k = int(zones.at(np.asarray(tip.point)[None])[0])
     cells = np.nonzero(q_nodes[model.mesh.cells].max(axis=1) > 0.0)[0]
     ec = model.ec
     is_enr = np.isin(cells, ec.cells)
@@ -384,10 +390,11 @@ def _tip_material(model, tip, q_nodes):
         found |= set(mats.cell[cells[is_enr]].tolist())
     if found != {k}:
         logger.warning(
-            "J-integral domain around the tip at %s holds both materials; K uses "
-            "the %s's E, nu (the interaction integral assumes one material)",
+            "J-integral domain around the tip at %s holds several materials; "
+            "K uses the E, nu of %s (the interaction integral assumes one "
+            "material)",
             np.asarray(tip.point).tolist(),
-            "reservoir" if k == RESERVOIR else "host",
+            "the host" if k == 0 else f"unit {zones.names[k]!r}",
         )
     return float(mats.E[k]), float(mats.nu[k]), mats.D[k]
 

@@ -99,6 +99,16 @@ def stress_path(spec) -> tuple[StressPath | None, str]:
     pore = spec.pore_pressure
     if pore is None or pore.change == 0.0:
         return None, "the case has no [pore_pressure] change to follow"
+    if spec.loading.in_situ is not None or pore.gradient != 0.0:
+        return None, (
+            "the in-situ state varies with depth: the closed form follows one "
+            "uniform state"
+        )
+    if spec.units and spec.reservoir is None:
+        return None, (
+            "the case has [[units]]: the closed form follows at most one "
+            "reservoir layer ([reservoir])"
+        )
     b = spec.boundary
     edges = {"left": b.left, "right": b.right, "bottom": b.bottom, "top": b.top}
     bad = [

@@ -183,7 +183,7 @@ def test_defaults_of_optional_keys(tmp_path):
     assert spec.loading.stress is None and spec.loading.steps == 1
     assert spec.solver == SolverSpec()
     assert str(spec.output.directory) == "out/my-case"
-    assert spec.output.formats == ("h5", "vtu")
+    assert spec.output.formats == ("h5", "vtu", "csv")
     for edge in ("top", "left", "right"):
         assert getattr(spec.boundary, edge).kind == "free"
         assert getattr(spec.boundary, edge).source == "default"
@@ -316,7 +316,7 @@ def test_describe_summarises_the_resolved_case(tmp_path):
         "tangent = secant",
         "max_iterations = 30",
         "tolerance = 1e-08",
-        "output: out/desc (h5, vtu)",
+        "output: out/desc (h5, vtu, csv)",
     ):
         assert part in text, part
 

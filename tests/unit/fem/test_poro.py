@@ -540,7 +540,7 @@ def test_polygon_equals_the_same_region_as_boxes():
     np.testing.assert_array_equal(a.materials.qp, b.materials.qp)
     assert abs(a.bulk.K - b.bulk.K).max() == 0.0
     np.testing.assert_array_equal(a.problem.F_unit, b.problem.F_unit)
-    np.testing.assert_array_equal(a.pore.point_changes, b.pore.point_changes)
+    np.testing.assert_array_equal(a.pore.point_ratio, b.pore.point_ratio)
 
 
 def _clipped_area(bounds, p, n):
@@ -577,7 +577,7 @@ def test_polygon_edge_along_an_inclined_fault(caplog):
     want = np.array([_clipped_area(b[c], p, n) for c in cut]) / area
     assert np.all((want > 0.0) & (want < 1.0))
     np.testing.assert_allclose(model.pore.cell_fraction[cut], want, rtol=1e-10)
-    np.testing.assert_allclose(model.pore.point_changes, 0.5, rtol=0)
+    np.testing.assert_allclose(model.pore.point_ratio, 0.5, rtol=0)
     caplog.clear()
     build_model(loads_case(_trapezoid_case(False), "tri.toml"))
     assert "polygon edge 0 is not on a mesh line" in caplog.text
