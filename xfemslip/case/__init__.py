@@ -11,7 +11,9 @@ Modules: ``load`` (entry points; ``name``, ``[material]``, ``[loading]``,
 ``[solver]``, ``[output]``), ``options`` (key tables, ``SOLVER_OPTIONS``),
 ``specs`` (the frozen spec dataclasses), ``tables`` (typed TOML-table reader,
 value checks, messages), ``files`` (capped reading of input files, TOML
-nesting cap, path checks), ``grid`` (``[domain]``, ``[mesh]``), ``fractures``
+nesting cap, path checks), ``grid`` (``[domain]``, ``[mesh]``), ``grading``
+(the graded mesh of ``mesh.size``, built around the fractures and region
+edges), ``fractures``
 (``[[fractures]]`` and polyline checks), ``boundary`` (``[boundary]`` and its
 CSV files), ``network``, ``segments`` and ``generate`` (``[network]``: a CSV
 file of segments, random networks), ``pore`` (``[pore_pressure]``,

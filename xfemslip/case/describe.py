@@ -267,6 +267,19 @@ def _network_count(spec: CaseSpec) -> str:
     return " (" + ", ".join(f"{s} {n}" for s, n in counts.items()) + ")"
 
 
+def _describe_grading(g) -> str:
+    """``; graded from size 6.25 m, growth 1.2, max_size 100 m`` or ""."""
+    if g is None:
+        return ""
+    largest = (
+        "no max_size" if g.max_size == float("inf") else f"max_size {fmt(g.max_size)} m"
+    )
+    refine = f", {len(g.refine)} refine boxes" if len(g.refine) else ""
+    return (
+        f"; graded from size {fmt(g.size)} m, growth {fmt(g.growth)}, {largest}{refine}"
+    )
+
+
 def describe(spec: CaseSpec) -> str:
     """Human-readable summary of a resolved case (SI units, tension positive).
 
@@ -283,7 +296,8 @@ def describe(spec: CaseSpec) -> str:
         f"domain: [{fmt(x0)}, {fmt(x0 + w)}] x [{fmt(y0)}, {fmt(y0 + h)}] m "
         f"(size {fmt(w)} x {fmt(h)} m)",
         f"mesh: {nx} x {ny} Q4 elements, {(nx + 1) * (ny + 1)} nodes; "
-        f"{_describe_axis(spec.mesh.x, 'x')}; {_describe_axis(spec.mesh.y, 'y')}",
+        f"{_describe_axis(spec.mesh.x, 'x')}; {_describe_axis(spec.mesh.y, 'y')}"
+        f"{_describe_grading(spec.mesh.grading)}",
         f"material: E = {_with_unit(m.E, MaterialSpec.UNITS['E'])}, nu = {fmt(m.nu)}, "
         f"{m.model}",
         f"fractures: {len(spec.fractures)}{_network_count(spec)}",

@@ -31,6 +31,7 @@ from xfemslip.case.boundary import read_boundary
 from xfemslip.case.events import read_events
 from xfemslip.case.files import MAX_NAME_BYTES, parse_toml, path_problem, read_text
 from xfemslip.case.fractures import read_fractures
+from xfemslip.case.grading import case_refinement, graded_grid
 from xfemslip.case.grid import read_grid
 from xfemslip.case.hydraulics import read_permeability
 from xfemslip.case.network import read_network
@@ -42,7 +43,11 @@ from xfemslip.case.options import (
     STRESS_KEYS,
     TOP_KEYS,
 )
-from xfemslip.case.pore import read_pore_pressure, read_reservoir
+from xfemslip.case.pore import (
+    check_reservoir_cells,
+    read_pore_pressure,
+    read_reservoir,
+)
 from xfemslip.case.specs import (
     CaseSpec,
     LoadingSpec,
@@ -199,6 +204,19 @@ def _with_network(root: Table, grid, folder: Path, fractures):
     return fractures + network
 
 
+def _graded(root: Table, grid, fractures, reservoir):
+    """(grid, reservoir): a graded mesh built around the fractures and the
+    reservoir once they are read (xfemslip.case.grading), and the reservoir's
+    element-centre check on it; anything else unchanged."""
+    if grid is None or grid.mesh is not None:
+        return grid, reservoir
+    if fractures is None or (reservoir is None and root.has("reservoir")):
+        return None, reservoir  # their problems are recorded; nothing to refine
+    features = case_refinement(grid, fractures, reservoir)
+    grid = graded_grid(grid, features, root.problems, root.key("mesh.size"))
+    return grid, check_reservoir_cells(root, reservoir, grid)
+
+
 def _read_output(root: Table, name: str | None) -> OutputSpec | None:
     """[output]: directory (default out/<name>, relative to the cwd) and formats."""
     table = root.table("output", ("directory", "formats"))
@@ -256,12 +274,13 @@ def loads_case(text: str, path: str | Path = "<string>") -> CaseSpec:
     material = _read_material(root)
     fractures = read_fractures(root, grid)
     fractures = _with_network(root, grid, path.parent, fractures)
+    reservoir = read_reservoir(root, grid)
+    grid, reservoir = _graded(root, grid, fractures, reservoir)
     boundary, needs_stress = read_boundary(root, grid, path.parent)
     loading = _read_loading(root, needs_stress)
     solver = _read_solver(root)
     output = _read_output(root, name)
     pore_pressure = read_pore_pressure(root)
-    reservoir = read_reservoir(root, grid)
     events = read_events(root)
     permeability = read_permeability(root, grid, fractures)
     if problems:

@@ -136,8 +136,44 @@ def _read_boxes(table: Table) -> list | None:
     return None if any(b is None for b in boxes) else boxes
 
 
+NO_CENTRE = (
+    "contains no element centre of the mesh (a cell belongs to the reservoir "
+    "when its centre lies inside)"
+)
+
+
+def _holds_a_centre(grid, boxes, polygon) -> bool:
+    """Whether an element centre of the grid's mesh lies in the region."""
+    x, y = grid.mesh.x, grid.mesh.y
+    cx, cy = np.meshgrid(0.5 * (x[1:] + x[:-1]), 0.5 * (y[1:] + y[:-1]))
+    centres = np.column_stack([cx.ravel(), cy.ravel()])
+    if polygon is not None:
+        return bool(np.any(in_polygon(centres, np.array(polygon))))
+    return bool(np.any(in_boxes(centres, np.array(boxes).reshape(-1, 4))))
+
+
+def _region_key(data: dict) -> str:
+    """The key that gives the region: polygon, box or boxes."""
+    return "polygon" if "polygon" in data else "box" if "box" in data else "boxes"
+
+
+def check_reservoir_cells(root: Table, reservoir, grid) -> ReservoirSpec | None:
+    """The element-centre check of ``read_reservoir`` for a mesh built after
+    it (a graded mesh, refined around the reservoir): the reservoir, or None
+    after recording the problem."""
+    if reservoir is None or grid is None or grid.mesh is None:
+        return reservoir
+    polygon = reservoir.polygon
+    if _holds_a_centre(grid, reservoir.boxes, polygon):
+        return reservoir
+    root.error(f"reservoir.{_region_key(root.data['reservoir'])}", NO_CENTRE)
+    return None
+
+
 def read_reservoir(root: Table, grid) -> ReservoirSpec | None:
-    """[reservoir]: boxes or a polygon, and the reservoir's E [Pa] and nu [-]."""
+    """[reservoir]: boxes or a polygon, and the reservoir's E [Pa] and nu [-]
+    (whether the region holds an element centre is checked once the mesh is
+    known: here, or by ``check_reservoir_cells`` for a graded mesh)."""
     table = root.table("reservoir", RESERVOIR_KEYS)
     if table is None or not table.present:
         return None
@@ -157,27 +193,9 @@ def read_reservoir(root: Table, grid) -> ReservoirSpec | None:
         boxes = _read_boxes(table)
     E = table.number("E", rule=POSITIVE)
     nu = table.number("nu", rule=Range(0.0, 0.5, hi_open=True))
-    if boxes is not None and grid is not None:
-        x, y = grid.mesh.x, grid.mesh.y
-        cx, cy = np.meshgrid(0.5 * (x[1:] + x[:-1]), 0.5 * (y[1:] + y[:-1]))
-        centres = np.column_stack([cx.ravel(), cy.ravel()])
-        if polygon is not None:
-            inside = in_polygon(centres, np.array(polygon))
-        else:
-            inside = in_boxes(centres, np.array(boxes).reshape(-1, 4))
-        if not np.any(inside):
-            key = (
-                "polygon"
-                if polygon is not None
-                else "box"
-                if table.has("box")
-                else "boxes"
-            )
-            table.error(
-                key,
-                "contains no element centre of the mesh (a cell belongs to the "
-                "reservoir when its centre lies inside)",
-            )
+    if boxes is not None and grid is not None and grid.mesh is not None:
+        if not _holds_a_centre(grid, boxes, polygon):
+            table.error(_region_key(table.data), NO_CENTRE)
     if len(table.problems) > start:
         return None
     return ReservoirSpec(

@@ -12,11 +12,30 @@ EDGES = ("bottom", "top", "left", "right")
 
 
 @dataclass(frozen=True, kw_only=True)
+class GradingSpec:
+    """``[mesh]`` size, growth, max_size, refine: a graded mesh
+    (xfemslip.geometry.grading) refined to ``size`` around the fractures, the
+    region edges and the ``refine`` boxes."""
+
+    size: float  # h, the largest cell near a refinement feature [m]
+    growth: float  # g, largest ratio of neighbouring cell sizes, 1 < g <= 2 [-]
+    max_size: float  # H >= h, the largest cell [m]; inf: no cap
+    refine: np.ndarray  # (k, 4) float64 boxes [x0, y0, x1, y1] [m]
+    UNITS: ClassVar[dict[str, str]] = {
+        "size": "m",
+        "growth": "-",
+        "max_size": "m",
+        "refine": "m",
+    }
+
+
+@dataclass(frozen=True, kw_only=True)
 class MeshSpec:
     """Rectilinear structured Q4 mesh: node coordinates along x and y."""
 
     x: np.ndarray  # (nx+1,) float64, strictly increasing [m]
     y: np.ndarray  # (ny+1,) float64, strictly increasing [m]
+    grading: GradingSpec | None = None  # the keys x and y were built from
     UNITS: ClassVar[dict[str, str]] = {"x": "m", "y": "m"}
 
 
