@@ -17,7 +17,8 @@ edges), ``fractures``
 (``[[fractures]]`` and polyline checks), ``boundary`` (``[boundary]`` and its
 CSV files), ``network``, ``segments`` and ``generate`` (``[network]``: a CSV
 file of segments, random networks), ``pore`` (``[pore_pressure]``,
-``[reservoir]``), ``events`` (``[events]``), ``hydraulics``
+``[reservoir]``), ``pressure_field`` (``[pore_pressure.field]``: pressure
+changes from a CSV or VTK file), ``events`` (``[events]``), ``hydraulics``
 (``[permeability]``, a fracture's ``hydraulic`` table), ``describe`` (the ``xfemslip
 check`` printout) and ``build`` (case text from Python values, for tests and
 benchmarks).

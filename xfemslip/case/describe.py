@@ -178,8 +178,13 @@ def _describe_pore(spec: CaseSpec) -> list[str]:
     p = spec.pore_pressure
     if p is not None:
         where = "the reservoir" if p.region == "reservoir" else "the whole model"
+        change = (
+            f"change {fmt(p.change)} Pa"
+            if p.field is None
+            else f"change from {_describe_field(p.field)}"
+        )
         lines.append(
-            f"pore pressure: initial {fmt(p.initial)} Pa, change {fmt(p.change)} Pa "
+            f"pore pressure: initial {fmt(p.initial)} Pa, {change} "
             f"over the load steps (< 0 = depletion), Biot coefficient "
             f"{fmt(p.biot)}, acting in {where}; "
             "effective stress in the bulk (Biot) and on the fractures (Terzaghi)"
@@ -265,6 +270,15 @@ def _network_count(spec: CaseSpec) -> str:
         return ""
     counts = {s: sources.count(s) for s in dict.fromkeys(sources)}
     return " (" + ", ".join(f"{s} {n}" for s, n in counts.items()) + ")"
+
+
+def _describe_field(f) -> str:
+    """``dp.csv (columns dp1, dp2: a regular grid of ...; outside: error)``."""
+    outside = f.outside if isinstance(f.outside, str) else f"{fmt(f.outside)} Pa"
+    return (
+        f"{f.file} (columns {', '.join(f.columns)}: {f.field.description}; "
+        f"outside: {outside})"
+    )
 
 
 def _describe_grading(g) -> str:

@@ -280,7 +280,7 @@ def loads_case(text: str, path: str | Path = "<string>") -> CaseSpec:
     loading = _read_loading(root, needs_stress)
     solver = _read_solver(root)
     output = _read_output(root, name)
-    pore_pressure = read_pore_pressure(root)
+    pore_pressure = read_pore_pressure(root, path.parent)
     events = read_events(root)
     permeability = read_permeability(root, grid, fractures)
     if problems:

@@ -5,8 +5,11 @@ Both tables are optional; a case without them runs exactly as before.
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import numpy as np
 
+from xfemslip.case.pressure_field import read_field_table
 from xfemslip.case.specs import PorePressureSpec, ReservoirSpec
 from xfemslip.case.tables import (
     COORDINATE,
@@ -19,19 +22,35 @@ from xfemslip.case.tables import (
 )
 from xfemslip.geometry.regions import in_boxes, in_polygon, polygon_problem
 
-PORE_PRESSURE_KEYS = ("initial", "change", "biot", "region")
+PORE_PRESSURE_KEYS = ("initial", "change", "biot", "region", "field")
 PORE_PRESSURE_REGIONS = ("all", "reservoir")
 RESERVOIR_KEYS = ("box", "boxes", "polygon", "E", "nu")
 
 
-def read_pore_pressure(root: Table) -> PorePressureSpec | None:
-    """[pore_pressure]: initial, change [Pa], biot in (0, 1], region."""
+def read_pore_pressure(root: Table, folder: Path = Path()) -> PorePressureSpec | None:
+    """[pore_pressure]: initial, change [Pa] or a field from a file
+    (``[pore_pressure.field]``, its path relative to ``folder``), biot in
+    (0, 1], region."""
     table = root.table("pore_pressure", PORE_PRESSURE_KEYS)
     if table is None or not table.present:
         return None
     start = len(table.problems)
     initial = table.number("initial")
-    change = table.number("change")
+    field = None
+    if table.has("field") and table.has("change"):
+        table.error(
+            None,
+            "give either change (one value) or a field table (values from a "
+            "file), not both",
+        )
+        change = None
+    elif table.has("field"):
+        change = None
+        field = read_field_table(table, folder)
+    else:
+        change = table.number(
+            "change", hint=" (or a field table: [pore_pressure.field] file = ...)"
+        )
     biot = table.number("biot", 1.0, Range(0.0, 1.0, lo_open=True))
     region = table.choice("region", PORE_PRESSURE_REGIONS, "all")
     if region == "reservoir" and not root.has("reservoir"):
@@ -50,7 +69,9 @@ def read_pore_pressure(root: Table) -> PorePressureSpec | None:
         )
     if len(table.problems) > start:
         return None
-    return PorePressureSpec(initial=initial, change=change, biot=biot, region=region)
+    return PorePressureSpec(
+        initial=initial, change=change, biot=biot, region=region, field=field
+    )
 
 
 def _check_box(value, key: str, problems: list) -> tuple | None:

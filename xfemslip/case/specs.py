@@ -200,18 +200,38 @@ class OutputSpec:
 
 
 @dataclass(frozen=True, kw_only=True)
+class PressureFieldSpec:
+    """[pore_pressure.field]: pressure changes dp(x, y) read from a file,
+    one field per column (or VTK array), in order (xfemslip.case.pressure_field).
+
+    ``field.values(xy)`` (n, 2) [m] -> (n_fields, n) [Pa] interpolates them
+    (xfemslip.geometry.sampled: bilinear on a regular grid, linear on
+    triangles, constant per cell for cell data) with the ``outside`` rule.
+    """
+
+    file: Path  # resolved against the case file's folder
+    columns: tuple[str, ...]  # CSV columns or VTK array names, one per field
+    outside: str | float  # "error" | "nearest" | a value [Pa]
+    kind: str  # "grid" | "points" | "mesh points" | "mesh cells"
+    field: object  # GridField | TriangleField (xfemslip.geometry.sampled)
+    UNITS: ClassVar[dict[str, str]] = {"outside": "Pa"}
+
+
+@dataclass(frozen=True, kw_only=True)
 class PorePressureSpec:
     """[pore_pressure]: initial pore pressure and its change (depletion < 0).
 
     The change ``change`` [Pa] is applied proportionally over the load steps
     (``loading.steps``), in the whole model (``region = "all"``) or inside the
-    ``[reservoir]`` only (``region = "reservoir"``).
+    ``[reservoir]`` only (``region = "reservoir"``).  With ``field`` the
+    change is read from a file instead (``change`` is then None).
     """
 
     initial: float  # p0 [Pa]
-    change: float  # final dp [Pa]; < 0 = depletion
+    change: float | None  # final dp [Pa]; < 0 = depletion; None with field
     biot: float  # alpha, 0 < alpha <= 1 [-]
     region: str  # "all" | "reservoir"
+    field: PressureFieldSpec | None = None  # dp(x, y) from a file
     UNITS: ClassVar[dict[str, str]] = {
         "initial": "Pa",
         "change": "Pa",
