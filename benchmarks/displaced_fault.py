@@ -7,8 +7,9 @@ mu = 6.5 GPa, alpha = 0.9, dp = -25 MPa in both compartments, homogeneous
 rock, in a 4 km x 3 km section (rollers on the sides, fixed bottom, constant
 overburden on top; the compartments reach the rollers, so the reservoir is
 laterally infinite as in the closed form).  The fault runs from 700 m below
-to 700 m above the reservoir's centre and is held stuck (cohesion 1 GPa).  The mesh is the graded mesh of
-``[mesh] size = h, growth = 1.2, max_size = 100`` around the fault and the
+to 700 m above the reservoir's centre and is held stuck (cohesion 1 GPa).
+The mesh is the graded mesh of ``[mesh] size = h, growth = 1.2,
+max_size = 100`` around the fault and the
 reservoir's edges (xfemslip.geometry.grading), the reference
 ``xfemslip.reference.inclusion.fault_tractions``.
 
