@@ -71,11 +71,9 @@ def _refinement(fine_x=(), fine_y=(), lines_x=(), lines_y=()) -> Refinement:
 
 def combine(*parts: Refinement) -> Refinement:
     """All the features of ``parts`` together."""
-    return (
-        Refinement(*(np.concatenate([p[i] for p in parts]) for i in range(4)))
-        if parts
-        else _refinement()
-    )
+    if not parts:
+        return _refinement()
+    return Refinement(*(np.concatenate([p[i] for p in parts]) for i in range(4)))
 
 
 def _clip(a, b, lo, hi):

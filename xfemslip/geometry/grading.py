@@ -99,15 +99,9 @@ def _pl_min(f: _Field, g: _Field) -> _Field:
     return _Field(xs, np.minimum(a, b))
 
 
-def _line(x0: float, x1: float, v0: float, slope: float, floor: float) -> _Field:
-    """max(floor, v0 + slope (x - x0)) on [x0, x1] as a _Field."""
-    xs = [x0, x1]
-    if slope != 0.0:
-        xc = x0 + (floor - v0) / slope
-        if x0 < xc < x1:
-            xs = [x0, xc, x1]
-    xs = np.array(xs)
-    return _Field(xs, np.maximum(floor, v0 + slope * (xs - x0)))
+def _line(x0: float, x1: float, v0: float, slope: float) -> _Field:
+    """v0 + slope (x - x0) on [x0, x1] as a _Field."""
+    return _Field(np.array([x0, x1]), np.array([v0, v0 + slope * (x1 - x0)]))
 
 
 def _size_field(lo, hi, mu, cap, sources) -> _Field:
@@ -178,9 +172,9 @@ def _capped(seg: _Segment, mu: float, T: float) -> _Field:
     p, q = float(s.xs[0]), float(s.xs[-1])
     cap = _Field(np.array([p, q]), np.array([T, T]))
     if seg.left_line:
-        cap = _pl_max(cap, _line(p, q, float(s.vs[0]), -mu, -np.inf))
+        cap = _pl_max(cap, _line(p, q, float(s.vs[0]), -mu))
     if seg.right_line:
-        cap = _pl_max(cap, _line(p, q, float(s.vs[-1]) - mu * (q - p), mu, -np.inf))
+        cap = _pl_max(cap, _line(p, q, float(s.vs[-1]) - mu * (q - p), mu))
     return _pl_min(s, cap)
 
 
@@ -216,9 +210,9 @@ def _shrunk_end_size(seg: _Segment, mu: float) -> float:
     def reachable(sigma):
         new = s
         if seg.left_line:
-            new = _pl_min(new, _line(p, q, sigma, mu, -np.inf))
+            new = _pl_min(new, _line(p, q, sigma, mu))
         if seg.right_line:
-            new = _pl_min(new, _line(p, q, sigma + mu * (q - p), -mu, -np.inf))
+            new = _pl_min(new, _line(p, q, sigma + mu * (q - p), -mu))
         return not _unreachable(_Segment(new, seg.left_line, seg.right_line), mu)
 
     for _ in range(SHRINK_STEPS):
