@@ -11,11 +11,14 @@ Modules: ``load`` (entry points; ``name``, ``[material]``, ``[loading]``,
 ``[solver]``, ``[output]``), ``options`` (key tables, ``SOLVER_OPTIONS``),
 ``specs`` (the frozen spec dataclasses), ``tables`` (typed TOML-table reader,
 value checks, messages), ``files`` (capped reading of input files, TOML
-nesting cap, path checks), ``grid`` (``[domain]``, ``[mesh]``), ``fractures``
+nesting cap, path checks), ``grid`` (``[domain]``, ``[mesh]``), ``grading``
+(the graded mesh of ``mesh.size``, built around the fractures and region
+edges), ``fractures``
 (``[[fractures]]`` and polyline checks), ``boundary`` (``[boundary]`` and its
 CSV files), ``network``, ``segments`` and ``generate`` (``[network]``: a CSV
 file of segments, random networks), ``pore`` (``[pore_pressure]``,
-``[reservoir]``), ``events`` (``[events]``), ``hydraulics``
+``[reservoir]``), ``pressure_field`` (``[pore_pressure.field]``: pressure
+changes from a CSV or VTK file), ``events`` (``[events]``), ``hydraulics``
 (``[permeability]``, a fracture's ``hydraulic`` table), ``describe`` (the ``xfemslip
 check`` printout) and ``build`` (case text from Python values, for tests and
 benchmarks).

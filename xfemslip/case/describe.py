@@ -248,10 +248,15 @@ def _describe_pore(spec: CaseSpec) -> list[str]:
             if p.gradient
             else ""
         )
+        change = (
+            f"change {fmt(p.change)} Pa"
+            if p.field is None
+            else f"change from {_describe_field(p.field)}"
+        )
         lines.append(
-            f"pore pressure: initial {fmt(p.initial)} Pa{grad}, change "
-            f"{fmt(p.change)} Pa over the load steps (< 0 = depletion), Biot "
-            f"coefficient {fmt(p.biot)}, acting in {where}; "
+            f"pore pressure: initial {fmt(p.initial)} Pa{grad}, {change} over "
+            f"the load steps (< 0 = depletion), Biot coefficient "
+            f"{fmt(p.biot)}, acting in {where}; "
             "effective stress in the bulk (Biot) and on the fractures (Terzaghi)"
         )
     lines += _describe_units(spec)
@@ -338,6 +343,28 @@ def _network_count(spec: CaseSpec) -> str:
     return " (" + ", ".join(f"{s} {n}" for s, n in counts.items()) + ")"
 
 
+def _describe_field(f) -> str:
+    """``dp.csv (columns dp1, dp2: a regular grid of ...; outside: error)``."""
+    outside = f.outside if isinstance(f.outside, str) else f"{fmt(f.outside)} Pa"
+    return (
+        f"{f.file} (columns {', '.join(f.columns)}: {f.field.description}; "
+        f"outside: {outside})"
+    )
+
+
+def _describe_grading(g) -> str:
+    """``; graded from size 6.25 m, growth 1.2, max_size 100 m`` or ""."""
+    if g is None:
+        return ""
+    largest = (
+        "no max_size" if g.max_size == float("inf") else f"max_size {fmt(g.max_size)} m"
+    )
+    refine = f", {len(g.refine)} refine boxes" if len(g.refine) else ""
+    return (
+        f"; graded from size {fmt(g.size)} m, growth {fmt(g.growth)}, {largest}{refine}"
+    )
+
+
 def describe(spec: CaseSpec) -> str:
     """Human-readable summary of a resolved case (SI units, tension positive).
 
@@ -354,7 +381,8 @@ def describe(spec: CaseSpec) -> str:
         f"domain: [{fmt(x0)}, {fmt(x0 + w)}] x [{fmt(y0)}, {fmt(y0 + h)}] m "
         f"(size {fmt(w)} x {fmt(h)} m)",
         f"mesh: {nx} x {ny} Q4 elements, {(nx + 1) * (ny + 1)} nodes; "
-        f"{_describe_axis(spec.mesh.x, 'x')}; {_describe_axis(spec.mesh.y, 'y')}",
+        f"{_describe_axis(spec.mesh.x, 'x')}; {_describe_axis(spec.mesh.y, 'y')}"
+        f"{_describe_grading(spec.mesh.grading)}",
         f"material: E = {_with_unit(m.E, MaterialSpec.UNITS['E'])}, nu = {fmt(m.nu)}, "
         f"{m.model}",
         f"fractures: {len(spec.fractures)}{_network_count(spec)}",

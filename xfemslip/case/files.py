@@ -44,6 +44,10 @@ MAX_TOML_BYTES = 8 * 2**20
 # A CSV file of boundary values or fracture segments: 32 MB is ~600,000 rows
 # of four numbers, read in a few seconds.
 MAX_CSV_BYTES = 32 * 2**20
+# A VTK/VTU file of pressure fields (read whole by meshio, ~3 times its size
+# in memory while decoded): 128 MB is a 2D section of a few million cells
+# with several arrays.
+MAX_VTK_BYTES = 128 * 2**20
 READ_CHUNK = 2**20
 # Tables and arrays inside one another; the deepest key of the case format
 # (network.generate.sets[i].orientation.mean) is 5 levels down.
@@ -107,6 +111,28 @@ def read_input(path: Path, limit: int) -> str:
             f"not a UTF-8 text file: {exc.reason} at byte {exc.start}"
         ) from None
     return text.removeprefix("\ufeff")
+
+
+def input_size(path: Path, limit: int) -> int:
+    """The size of the regular file ``path`` [bytes], for a reader that opens
+    it itself (meshio); UnreadableInput as ``read_input`` (not a regular
+    file, larger than ``limit``, not readable)."""
+    try:
+        fd = os.open(path, os.O_RDONLY | os.O_NONBLOCK | os.O_NOCTTY | os.O_CLOEXEC)
+    except ValueError:  # a NUL byte in the path
+        raise UnreadableInput("the path contains a NUL byte") from None
+    except OSError as exc:
+        raise UnreadableInput(exc.strerror or str(exc)) from None
+    try:
+        size = _regular_size(fd)
+    finally:
+        os.close(fd)
+    if size > limit:
+        raise UnreadableInput(
+            f"the file is {_megabytes(size)}, more than the limit of "
+            f"{_megabytes(limit)}"
+        )
+    return size
 
 
 def _regular_size(fd: int) -> int:

@@ -1,4 +1,12 @@
-"""``[domain]`` and ``[mesh]`` -> origin, size and node coordinates (``Grid``)."""
+"""``[domain]`` and ``[mesh]`` -> origin, size and node coordinates (``Grid``).
+
+``[mesh]`` takes one of three forms: ``elements = [nx, ny]`` (uniform),
+``x`` and ``y`` (the node coordinates), or ``size`` with optional
+``growth``, ``max_size`` and ``refine`` (a graded mesh).  A graded mesh
+needs the fractures and the region edges it is refined around, so
+``read_grid`` leaves its ``mesh`` None and ``xfemslip.case.grading``
+builds it once those are read.
+"""
 
 from __future__ import annotations
 
@@ -6,8 +14,9 @@ from typing import NamedTuple
 
 import numpy as np
 
-from xfemslip.case.specs import MeshSpec
+from xfemslip.case.specs import GradingSpec, MeshSpec
 from xfemslip.case.tables import (
+    COORDINATE,
     MAX_COORDINATE,
     POSITIVE,
     REQUIRED,
@@ -28,14 +37,26 @@ MAX_ELEMENTS = 25_000_000
 BYTES_PER_ELEMENT = 2048
 # Relative agreement of [domain] with mesh.x / mesh.y (rounding of typed values).
 DOMAIN_RTOL = 1e-12
+MESH_KEYS = ("elements", "x", "y", "size", "growth", "max_size", "refine")
+GRADED_KEYS = ("size", "growth", "max_size", "refine")
+# Neighbouring cells of a graded mesh differ by at most this ratio unless
+# mesh.growth says otherwise (1.2: the usual choice of mesh generators; the
+# stress error of a smoothly graded mesh is that of its finest cells).
+DEFAULT_GROWTH = 1.2
+GROWTH_RANGE = Range(1.0, 2.0, lo_open=True)
 
 
 class Grid(NamedTuple):
-    """Resolved domain and mesh, shared by the checks that need geometry."""
+    """Resolved domain and mesh, shared by the checks that need geometry.
+
+    ``mesh`` is None while a graded mesh (``grading``) waits for its
+    refinement features (xfemslip.case.grading.graded_grid).
+    """
 
     origin: tuple[float, float]
     size: tuple[float, float]
-    mesh: MeshSpec
+    mesh: MeshSpec | None
+    grading: GradingSpec | None = None
 
 
 def _int_text(n: int) -> str:
@@ -47,7 +68,7 @@ def _int_text(n: int) -> str:
     return f"{digits[0]}.{digits[1:3]}e+{len(digits) - 1}"
 
 
-def _check_element_count(nx: int, ny: int, key: str, problems: list) -> bool:
+def check_element_count(nx: int, ny: int, key: str, problems: list) -> bool:
     """Memory guard on nx * ny (see MAX_ELEMENTS)."""
     count = nx * ny
     if count <= MAX_ELEMENTS:
@@ -93,7 +114,7 @@ def _read_axis(mesh: Table, name: str) -> np.ndarray | None:
 
 
 @np.errstate(over="ignore")
-def _axis_resolves(coords: np.ndarray, key: str, problems: list) -> bool:
+def axis_resolves(coords: np.ndarray, key: str, problems: list) -> bool:
     """Resolved node coordinates must stay finite, strictly increasing and
     within MAX_COORDINATE."""
     if (
@@ -140,10 +161,10 @@ def _mesh_from_axes(mesh: Table, domain: Table | None, size, origin) -> Grid | N
     x, y = _read_axis(mesh, "x"), _read_axis(mesh, "y")
     if x is None or y is None:
         return None
-    if not _check_element_count(x.size - 1, y.size - 1, mesh.key("x"), mesh.problems):
+    if not check_element_count(x.size - 1, y.size - 1, mesh.key("x"), mesh.problems):
         return None
-    x_ok = _axis_resolves(x, mesh.key("x"), mesh.problems)
-    y_ok = _axis_resolves(y, mesh.key("y"), mesh.problems)
+    x_ok = axis_resolves(x, mesh.key("x"), mesh.problems)
+    y_ok = axis_resolves(y, mesh.key("y"), mesh.problems)
     if not (x_ok and y_ok):
         return None
     mesh_origin = (float(x[0]), float(y[0]))
@@ -169,40 +190,102 @@ def _mesh_uniform(mesh: Table, domain: Table | None, size, origin) -> Grid | Non
         domain.error("size", "required key missing (mesh.elements needs domain.size)")
     if counts is None or size is None or origin is None:
         return None
-    if not _check_element_count(*counts, mesh.key("elements"), mesh.problems):
+    if not check_element_count(*counts, mesh.key("elements"), mesh.problems):
         return None
     with np.errstate(over="ignore"):
         x = origin[0] + size[0] * np.linspace(0.0, 1.0, counts[0] + 1)
         y = origin[1] + size[1] * np.linspace(0.0, 1.0, counts[1] + 1)
     key = domain.key("size") if domain is not None else "domain.size"
-    x_ok = _axis_resolves(x, key, mesh.problems)
-    y_ok = _axis_resolves(y, key, mesh.problems)
+    x_ok = axis_resolves(x, key, mesh.problems)
+    y_ok = axis_resolves(y, key, mesh.problems)
     if not (x_ok and y_ok):
         return None
     return Grid(origin, size, MeshSpec(x=frozen(x), y=frozen(y)))
 
 
+def _read_refine(mesh: Table) -> np.ndarray | None:
+    """``refine = [[x0, y0, x1, y1], ...]``: boxes with x0 < x1, y0 < y1 [m]."""
+    value = mesh.data.get("refine", [])
+    if not isinstance(value, list):
+        mesh.error(
+            "refine", f"expected an array of boxes [x0, y0, x1, y1], got {show(value)}"
+        )
+        return None
+    boxes = []
+    for i, box in enumerate(value):
+        key = f"{mesh.key('refine')}[{i}]"
+
+        def check(v, k):
+            return check_number(v, k, mesh.problems, COORDINATE)
+
+        items = check_vector(box, key, mesh.problems, 4, check)
+        if items is not None and not (items[0] < items[2] and items[1] < items[3]):
+            mesh.problems.append(
+                (key, f"must satisfy x0 < x1 and y0 < y1, got {list(items)}")
+            )
+            items = None
+        boxes.append(items)
+    if any(b is None for b in boxes):
+        return None
+    return frozen(np.array(boxes, dtype=np.float64).reshape(-1, 4))
+
+
+def _mesh_graded(mesh: Table, domain: Table | None, size, origin) -> Grid | None:
+    """``size`` (with growth, max_size, refine): the graded mesh's keys; its
+    node coordinates follow once the refinement features are read."""
+    start = len(mesh.problems)
+    cell = mesh.number("size", REQUIRED, POSITIVE, hint=GRADED_HINT)
+    growth = mesh.number("growth", DEFAULT_GROWTH, GROWTH_RANGE)
+    largest = mesh.number("max_size", np.inf, POSITIVE)
+    refine = _read_refine(mesh)
+    if cell is not None and largest is not None and largest < cell:
+        mesh.error(
+            "max_size", f"must be >= mesh.size = {exact(cell)}, got {exact(largest)}"
+        )
+    if domain is not None and not domain.has("size"):
+        domain.error("size", "required key missing (mesh.size needs domain.size)")
+    if len(mesh.problems) > start or size is None or origin is None:
+        return None
+    grading = GradingSpec(size=cell, growth=growth, max_size=largest, refine=refine)
+    return Grid(origin, size, None, grading)
+
+
+GRADED_HINT = " (growth, max_size and refine go with size: a graded mesh)"
+
+
 def read_grid(root: Table) -> Grid | None:
-    """[domain] and [mesh] -> origin, size and node coordinates."""
+    """[domain] and [mesh] -> origin, size and node coordinates (the mesh
+    None for a graded mesh, see the module docstring)."""
     domain = root.table("domain", ("size", "origin"))
     size = origin = None
     if domain is not None:
         size = domain.numbers("size", 2, None, POSITIVE)
         origin = domain.numbers("origin", 2, (0.0, 0.0))
-    mesh = root.table("mesh", ("elements", "x", "y"), required=True)
+    mesh = root.table("mesh", MESH_KEYS, required=True)
     if mesh is None:
         return None
     has_axes = mesh.has("x") or mesh.has("y")
+    graded = any(mesh.has(k) for k in GRADED_KEYS)
     if mesh.has("elements") and has_axes:
         mesh.error(None, "give either elements = [nx, ny] or x and y, not both")
+        return None
+    if graded and (mesh.has("elements") or has_axes):
+        other = "elements = [nx, ny]" if mesh.has("elements") else "x and y"
+        given = ", ".join(k for k in GRADED_KEYS if mesh.has(k))
+        mesh.error(
+            None,
+            f"give either {other} or size (a graded mesh), not both (got {given})",
+        )
         return None
     if has_axes:
         return _mesh_from_axes(mesh, domain, size, origin)
     if mesh.has("elements"):
         return _mesh_uniform(mesh, domain, size, origin)
+    if graded:
+        return _mesh_graded(mesh, domain, size, origin)
     mesh.error(
         None,
-        "required key missing: give elements = [nx, ny] (with "
-        "domain.size) or node coordinates x and y",
+        "required key missing: give elements = [nx, ny] (with domain.size), "
+        "node coordinates x and y, or size (a graded mesh, with domain.size)",
     )
     return None

@@ -31,6 +31,12 @@ from xfemslip.case.boundary import read_boundary
 from xfemslip.case.events import read_events
 from xfemslip.case.files import MAX_NAME_BYTES, parse_toml, path_problem, read_text
 from xfemslip.case.fractures import read_fractures
+from xfemslip.case.grading import (
+    case_refinement,
+    combine,
+    graded_grid,
+    unit_refinement,
+)
 from xfemslip.case.grid import read_grid
 from xfemslip.case.hydraulics import read_permeability
 from xfemslip.case.network import read_network
@@ -53,7 +59,12 @@ from xfemslip.case.specs import (
     SolverSpec,
 )
 from xfemslip.case.tables import POSITIVE, Range, Table, check_choice, show
-from xfemslip.case.units import read_reservoir, read_units, reservoir_unit
+from xfemslip.case.units import (
+    read_reservoir,
+    read_units,
+    reservoir_unit,
+    settle_units,
+)
 from xfemslip.errors import CaseError
 
 __all__ = ["load_case", "loads_case"]
@@ -312,6 +323,26 @@ def _with_network(root: Table, grid, folder: Path, fractures):
     return fractures + network
 
 
+def _graded(root: Table, grid, fractures, reservoir, units):
+    """The grid, with a graded mesh built around the fractures and the rock
+    units once they are read (xfemslip.case.grading: each fracture's extents,
+    the units' horizons on mesh rows, their edges); anything else unchanged."""
+    if grid is None or grid.mesh is not None:
+        return grid
+    failed = (reservoir is None and root.has("reservoir")) or (
+        units is None and root.has("units")
+    )
+    if fractures is None or failed:
+        return None  # their problems are recorded; nothing to refine
+    if reservoir is not None:
+        units = (reservoir_unit(reservoir),)
+    features = combine(
+        case_refinement(grid, fractures, None),
+        unit_refinement(units or (), grid.origin, grid.size),
+    )
+    return graded_grid(grid, features, root.problems, root.key("mesh.size"))
+
+
 def _read_output(root: Table, name: str | None) -> OutputSpec | None:
     """[output]: directory (default out/<name>, relative to the cwd) and formats."""
     table = root.table("output", ("directory", "formats"))
@@ -369,14 +400,16 @@ def loads_case(text: str, path: str | Path = "<string>") -> CaseSpec:
     material = _read_material(root)
     fractures = read_fractures(root, grid)
     fractures = _with_network(root, grid, path.parent, fractures)
+    reservoir = read_reservoir(root)
+    units = read_units(root, fractures, material)
+    grid = _graded(root, grid, fractures, reservoir, units)
+    units, reservoir = settle_units(root, units, reservoir, fractures, grid)
     boundary, needs_stress = read_boundary(root, grid, path.parent)
     loading = _read_loading(root, needs_stress)
     solver = _read_solver(root)
     output = _read_output(root, name)
     datum = loading.in_situ.datum if loading and loading.in_situ else None
-    pore_pressure = read_pore_pressure(root, datum)
-    reservoir = read_reservoir(root, grid, fractures)
-    units = read_units(root, grid, fractures, material)
+    pore_pressure = read_pore_pressure(root, datum, path.parent)
     if reservoir is not None:
         units = (reservoir_unit(reservoir),)
     check_region(root, pore_pressure, units)

@@ -6,23 +6,52 @@ units (``[[units]]``, ``[reservoir]``) are read in :mod:`xfemslip.case.units`.
 
 from __future__ import annotations
 
+from pathlib import Path
+
+from xfemslip.case.pressure_field import read_field_table
 from xfemslip.case.specs import PorePressureSpec
 from xfemslip.case.tables import Range, Table
 
-PORE_PRESSURE_KEYS = ("initial", "change", "biot", "region", "gradient", "datum")
+PORE_PRESSURE_KEYS = (
+    "initial",
+    "change",
+    "biot",
+    "region",
+    "gradient",
+    "datum",
+    "field",
+)
 PORE_PRESSURE_REGIONS = ("all", "reservoir")
 
 
-def read_pore_pressure(root: Table, in_situ_datum=None) -> PorePressureSpec | None:
+def read_pore_pressure(
+    root: Table, in_situ_datum=None, folder: Path = Path()
+) -> PorePressureSpec | None:
     """[pore_pressure]: initial [Pa] (at the datum), its ``gradient`` with
-    depth [Pa/m] and ``datum`` [m], change [Pa], biot in (0, 1], region
-    ("all", "reservoir" or the name of a unit: checked with the units)."""
+    depth [Pa/m] and ``datum`` [m], change [Pa] or a field from a file
+    (``[pore_pressure.field]``, its path relative to ``folder``), biot in
+    (0, 1], region ("all", "reservoir" or the name of a unit: checked with
+    the units)."""
     table = root.table("pore_pressure", PORE_PRESSURE_KEYS)
     if table is None or not table.present:
         return None
     start = len(table.problems)
     initial = table.number("initial")
-    change = table.number("change")
+    field = None
+    if table.has("field") and table.has("change"):
+        table.error(
+            None,
+            "give either change (one value) or a field table (values from a "
+            "file), not both",
+        )
+        change = None
+    elif table.has("field"):
+        change = None
+        field = read_field_table(table, folder)
+    else:
+        change = table.number(
+            "change", hint=" (or a field table: [pore_pressure.field] file = ...)"
+        )
     biot = table.number("biot", 1.0, Range(0.0, 1.0, lo_open=True))
     region = table.string("region", "all")
     gradient = table.number("gradient", 0.0)
@@ -53,6 +82,7 @@ def read_pore_pressure(root: Table, in_situ_datum=None) -> PorePressureSpec | No
         region=region,
         gradient=gradient,
         datum=0.0 if datum is None else datum,
+        field=field,
     )
 
 

@@ -12,11 +12,30 @@ EDGES = ("bottom", "top", "left", "right")
 
 
 @dataclass(frozen=True, kw_only=True)
+class GradingSpec:
+    """``[mesh]`` size, growth, max_size, refine: a graded mesh
+    (xfemslip.geometry.grading) refined to ``size`` around the fractures, the
+    region edges and the ``refine`` boxes."""
+
+    size: float  # h, the largest cell near a refinement feature [m]
+    growth: float  # g, largest ratio of neighbouring cell sizes, 1 < g <= 2 [-]
+    max_size: float  # H >= h, the largest cell [m]; inf: no cap
+    refine: np.ndarray  # (k, 4) float64 boxes [x0, y0, x1, y1] [m]
+    UNITS: ClassVar[dict[str, str]] = {
+        "size": "m",
+        "growth": "-",
+        "max_size": "m",
+        "refine": "m",
+    }
+
+
+@dataclass(frozen=True, kw_only=True)
 class MeshSpec:
     """Rectilinear structured Q4 mesh: node coordinates along x and y."""
 
     x: np.ndarray  # (nx+1,) float64, strictly increasing [m]
     y: np.ndarray  # (ny+1,) float64, strictly increasing [m]
+    grading: GradingSpec | None = None  # the keys x and y were built from
     UNITS: ClassVar[dict[str, str]] = {"x": "m", "y": "m"}
 
 
@@ -230,20 +249,40 @@ class OutputSpec:
 
 
 @dataclass(frozen=True, kw_only=True)
+class PressureFieldSpec:
+    """[pore_pressure.field]: pressure changes dp(x, y) read from a file,
+    one field per column (or VTK array), in order (xfemslip.case.pressure_field).
+
+    ``field.values(xy)`` (n, 2) [m] -> (n_fields, n) [Pa] interpolates them
+    (xfemslip.geometry.sampled: bilinear on a regular grid, linear on
+    triangles, constant per cell for cell data) with the ``outside`` rule.
+    """
+
+    file: Path  # resolved against the case file's folder
+    columns: tuple[str, ...]  # CSV columns or VTK array names, one per field
+    outside: str | float  # "error" | "nearest" | a value [Pa]
+    kind: str  # "grid" | "points" | "mesh points" | "mesh cells"
+    field: object  # GridField | TriangleField (xfemslip.geometry.sampled)
+    UNITS: ClassVar[dict[str, str]] = {"outside": "Pa"}
+
+
+@dataclass(frozen=True, kw_only=True)
 class PorePressureSpec:
     """[pore_pressure]: initial pore pressure and its change (depletion < 0).
 
     The change ``change`` [Pa] is applied proportionally over the load steps
     (``loading.steps``), in the whole model (``region = "all"``) or inside the
-    ``[reservoir]`` only (``region = "reservoir"``).
+    ``[reservoir]`` only (``region = "reservoir"``).  With ``field`` the
+    change is read from a file instead (``change`` is then None).
     """
 
     initial: float  # p0 [Pa] (at the datum with a gradient)
-    change: float  # final dp [Pa]; < 0 = depletion
+    change: float | None  # final dp [Pa]; < 0 = depletion; None with field
     biot: float  # alpha, 0 < alpha <= 1 [-]
     region: str  # "all" | "reservoir" | the name of a unit
     gradient: float = 0.0  # d p0 / d depth [Pa/m] (hydrostatic: about 1e4)
     datum: float = 0.0  # y of zero depth [m] (with a gradient)
+    field: PressureFieldSpec | None = None  # dp(x, y) from a file
     UNITS: ClassVar[dict[str, str]] = {
         "initial": "Pa",
         "change": "Pa",

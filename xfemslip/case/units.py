@@ -19,6 +19,8 @@ loading jumps at the wrong place along the fault).
 
 from __future__ import annotations
 
+from dataclasses import replace
+
 import numpy as np
 
 from xfemslip.case.specs import RegionSpec, ReservoirSpec, UnitSpec
@@ -174,16 +176,14 @@ def _cell_centres(grid) -> np.ndarray:
     return np.column_stack([cx.ravel(), cy.ravel()])
 
 
-def _check_holds_a_cell(table: Table, region, grid, key: str) -> None:
-    """A region that holds no cell centre is an error (a cell belongs to the
-    unit of its centre)."""
-    if grid is None or in_region(_cell_centres(grid), region).any():
-        return
-    table.error(
-        key,
-        "contains no element centre of the mesh (a cell belongs to the unit "
-        "its centre lies in)",
-    )
+UNIT_NO_CENTRE = (
+    "contains no element centre of the mesh (a cell belongs to the unit its "
+    "centre lies in)"
+)
+RESERVOIR_NO_CENTRE = (
+    "contains no element centre of the mesh (a cell belongs to the reservoir "
+    "when its centre lies inside)"
+)
 
 
 # --------------------------------------------------------------------------- #
@@ -377,10 +377,10 @@ def _change(table: Table, region: RegionSpec | None):
     return None, (left, right)
 
 
-def _shape_key(table: Table) -> str:
-    """The key that gave a unit its region, for messages."""
+def _shape_key_of(data) -> str:
+    """The key that gave a unit (a TOML table) its region, for messages."""
     for key in ("top", "polygon", "box", "boxes"):
-        if table.has(key):
+        if isinstance(data, dict) and key in data:
             return key
     return "top"
 
@@ -413,10 +413,6 @@ def _read_unit(table: Table, index: int, ctx: dict) -> UnitSpec | None:
     density = table.number("density", None, POSITIVE)
     change, sides = _change(table, region)
     overpressure = table.number("overpressure", 0.0)
-    snapped: tuple = ()
-    if region is not None:
-        region, snapped = snap_to_fractures(region, ctx["fractures"], ctx["grid"])
-        _check_holds_a_cell(table, region, ctx["grid"], _shape_key(table))
     if len(table.problems) > start or region is None or E is None or nu is None:
         return None
     return UnitSpec(
@@ -429,11 +425,10 @@ def _read_unit(table: Table, index: int, ctx: dict) -> UnitSpec | None:
         change=change,
         change_sides=sides,
         overpressure=overpressure,
-        snapped=snapped,
     )
 
 
-def read_units(root: Table, grid, fractures, material) -> tuple[UnitSpec, ...] | None:
+def read_units(root: Table, fractures, material) -> tuple[UnitSpec, ...] | None:
     """``[[units]]`` (after ``[material]`` and ``[[fractures]]``: a unit
     takes the host's constants it leaves out, and a displaced layer its
     fault).  Names are unique."""
@@ -455,7 +450,7 @@ def read_units(root: Table, grid, fractures, material) -> tuple[UnitSpec, ...] |
             '"reservoir" replaces [reservoir]), not both',
         )
         return None
-    ctx = {"grid": grid, "fractures": fractures or (), "material": material}
+    ctx = {"fractures": fractures or (), "material": material}
     specs = []
     for i, item in enumerate(value):
         if not isinstance(item, dict):
@@ -479,8 +474,10 @@ def read_units(root: Table, grid, fractures, material) -> tuple[UnitSpec, ...] |
 # --------------------------------------------------------------------------- #
 
 
-def read_reservoir(root: Table, grid, fractures=()) -> ReservoirSpec | None:
-    """[reservoir]: boxes or a polygon, and the reservoir's E [Pa] and nu [-]."""
+def read_reservoir(root: Table) -> ReservoirSpec | None:
+    """[reservoir]: boxes or a polygon, and the reservoir's E [Pa] and nu [-]
+    (its edges are snapped and its cells checked by :func:`settle_units`
+    once the mesh is known)."""
     value = root.data.get("reservoir")
     if isinstance(value, list):
         root.error(
@@ -496,12 +493,12 @@ def read_reservoir(root: Table, grid, fractures=()) -> ReservoirSpec | None:
     region = _shape(table)
     E = table.number("E", rule=POSITIVE)
     nu = table.number("nu", rule=NU_RANGE)
-    snapped: tuple = ()
-    if region is not None:
-        region, snapped = snap_to_fractures(region, fractures or (), grid)
-        _check_holds_a_cell(table, region, grid, _shape_key(table))
     if len(table.problems) > start or region is None:
         return None
+    return _reservoir_spec(region, E, nu)
+
+
+def _reservoir_spec(region: RegionSpec, E, nu, snapped=()) -> ReservoirSpec:
     return ReservoirSpec(
         boxes=region.boxes if region.kind == "boxes" else frozen(np.zeros((0, 4))),
         E=E,
@@ -509,6 +506,36 @@ def read_reservoir(root: Table, grid, fractures=()) -> ReservoirSpec | None:
         polygon=region.polygon if region.kind == "polygon" else None,
         snapped=snapped,
     )
+
+
+def settle_units(root: Table, units, reservoir, fractures, grid):
+    """(units, reservoir) once the mesh is known: every polygon or box edge
+    within SNAP_CELLS of a fracture snapped onto it, and a region that holds
+    no element centre an error (recorded; the units or reservoir are then
+    None)."""
+    if grid is None or grid.mesh is None:
+        return units, reservoir
+    fractures = fractures or ()
+    if reservoir is not None:
+        region, snapped = snap_to_fractures(
+            reservoir_unit(reservoir).region, fractures, grid
+        )
+        if not in_region(_cell_centres(grid), region).any():
+            key = _shape_key_of(root.data.get("reservoir", {}))
+            root.error(f"reservoir.{key}", RESERVOIR_NO_CENTRE)
+            return units, None
+        reservoir = _reservoir_spec(region, reservoir.E, reservoir.nu, snapped)
+    if not units:
+        return units, reservoir
+    out = []
+    items = root.data.get("units", [])
+    for i, unit in enumerate(units):
+        region, snapped = snap_to_fractures(unit.region, fractures, grid)
+        if not in_region(_cell_centres(grid), region).any():
+            root.error(f"units[{i}].{_shape_key_of(items[i])}", UNIT_NO_CENTRE)
+            return None, reservoir
+        out.append(replace(unit, region=region, snapped=snapped))
+    return tuple(out), reservoir
 
 
 def reservoir_unit(reservoir: ReservoirSpec) -> UnitSpec:

@@ -8,6 +8,9 @@ Modules:
 - ``closed_form``: the frictional straight crack and the slip window;
 - ``closed_form_depletion``: uniaxial strain and the offset-reservoir fault
   under depletion;
+- ``inclusion``: the stress of a pressure change in polygons of an infinite
+  plane (Goodier's potential in closed form) and the displaced fault of
+  Jansen, Singhal & Vossepoel (2019);
 - ``screen``: closed-form screening of fracture orientations (Coulomb margin
   of each plane);
 - ``peer``: the OpenGeoSys peer problem as an xfemslip case.
@@ -18,4 +21,4 @@ import the module you need (``from xfemslip.reference.closed_form import
 ...``).
 """
 
-__all__ = ["closed_form", "closed_form_depletion", "peer", "screen"]
+__all__ = ["closed_form", "closed_form_depletion", "inclusion", "peer", "screen"]

@@ -20,7 +20,8 @@ plane strain, homogeneous isotropic elasticity (shear modulus mu, Poisson nu).
    displacement potential u = grad psi with (lambda + 2 mu) lap psi =
    alpha dp chi_reservoir solves the Navier equations with the Biot body
    force, so psi = alpha dp / (lambda + 2 mu) * (1 / 2 pi) int_A ln r dA and
-   sigma_xy = 2 mu d2psi/dxdy.  For a rectangle, d2/dxdy int int ln r dA is a
+   sigma_xy = 2 mu d2psi/dxdy (xfemslip.reference.inclusion: the whole stress
+   of any polygon).  For a rectangle, d2/dxdy int int ln r dA is a
    signed sum of ln r over its four corners; on x = 0 the corners at
    infinity drop out and
 
@@ -64,6 +65,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from xfemslip.reference.inclusion import polygon_stress
+
 
 def uniaxial_strain_change(dp: float, nu: float, biot: float = 1.0) -> dict:
     """Stress changes [Pa] of the uniaxial-strain path for a pressure change dp."""
@@ -78,24 +81,20 @@ def uniaxial_strain_change(dp: float, nu: float, biot: float = 1.0) -> dict:
 def rectangles_shear(x, y, rects, dp, nu, biot=1.0) -> np.ndarray:
     """sigma_xy(x, y) [Pa] of a pressure change dp in rectangles, no fault.
 
-    rects : (k, 4) [x0, y0, x1, y1] [m].  The corner sum behind (J1):
-    sigma_xy = 2 pi C sum_rect [g(x - x0, y - y0) - g(x - x0, y - y1)
-    - g(x - x1, y - y0) + g(x - x1, y - y1)] / (2 pi), g = ln r, valid at any
-    point off the corners (inside or outside the rectangles).
+    rects : (k, 4) [x0, y0, x1, y1] [m].  Each rectangle is a polygon of
+    ``inclusion.polygon_stress``, whose sigma_xy is here the corner sum
+    behind (J1): sigma_xy = C [g(x - x0, y - y0) - g(x - x0, y - y1)
+    - g(x - x1, y - y0) + g(x - x1, y - y1)], g = ln r, summed over the
+    rectangles; valid at any point off the corners (inside, outside or on
+    an edge of the rectangles), NaN at a corner.
     """
     x, y = np.broadcast_arrays(np.asarray(x, float), np.asarray(y, float))
-    C = biot * dp * (1.0 - 2.0 * nu) / (2.0 * np.pi * (1.0 - nu))
-    out = np.zeros(x.shape)
-    with np.errstate(divide="ignore"):
-        for x0, y0, x1, y1 in np.asarray(rects, float):
-            for cx, cy, sign in (
-                (x0, y0, 1.0),
-                (x0, y1, -1.0),
-                (x1, y0, -1.0),
-                (x1, y1, 1.0),
-            ):
-                out += sign * 0.5 * np.log((x - cx) ** 2 + (y - cy) ** 2)
-    return C * out
+    xy = np.column_stack([x.ravel(), y.ravel()])
+    out = np.zeros(x.size)
+    for x0, y0, x1, y1 in np.asarray(rects, float).reshape(-1, 4):
+        box = [[x0, y0], [x1, y0], [x1, y1], [x0, y1]]
+        out += polygon_stress(xy, box, dp, nu, biot)[:, 2]
+    return out.reshape(x.shape)
 
 
 def offset_fault_shear(y, a, b, c, d, dp, nu, biot=1.0) -> np.ndarray:
