@@ -8,6 +8,8 @@ Modules:
 - ``closed_form``: the frictional straight crack and the slip window;
 - ``closed_form_depletion``: uniaxial strain and the offset-reservoir fault
   under depletion;
+- ``onset``: the pore-pressure change at which a plane first slips or opens
+  along a linear stress path (the one law of the screens and closed forms);
 - ``screen``: closed-form screening of fracture orientations (Coulomb margin
   of each plane);
 - ``peer``: the OpenGeoSys peer problem as an xfemslip case.
@@ -18,4 +20,4 @@ import the module you need (``from xfemslip.reference.closed_form import
 ...``).
 """
 
-__all__ = ["closed_form", "closed_form_depletion", "peer", "screen"]
+__all__ = ["closed_form", "closed_form_depletion", "onset", "peer", "screen"]
