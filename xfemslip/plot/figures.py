@@ -422,19 +422,18 @@ def _mohr_state(data: ResultData) -> tuple[tuple, float]:
 
 
 def _slipped_text(results: Sequence[ResultData]) -> str:
-    """Which fractures have contact points in slip at the final step."""
-    parts = []
-    for data in results:
-        slipped = [f.index for f in data.fractures if np.any(f.state == SLIP)]
-        who = (
-            "fractures " + ", ".join(str(i) for i in slipped) + " slip"
-            if len(slipped) > 1
-            else f"fracture {slipped[0]} slips"
-            if slipped
-            else "no fracture slips"
-        )
-        parts.append(f"{data.label}: {who}" if len(results) > 1 else who)
-    return "; ".join(parts)
+    """Which fractures (of one result) or results (of several) have contact
+    points in slip at the final step."""
+    slipped = [
+        [f.index for f in data.fractures if np.any(f.state == SLIP)] for data in results
+    ]
+    if len(results) > 1:
+        who = [data.label for data, s in zip(results, slipped, strict=True) if s]
+        return "slip in: " + ", ".join(who) if who else "no result slips"
+    (mine,) = slipped
+    if len(mine) > 1:
+        return "fractures " + ", ".join(str(i) for i in mine) + " slip"
+    return f"fracture {mine[0]} slips" if mine else "no fracture slips"
 
 
 def figure_mohr(results: Sequence[ResultData]) -> Figure:
