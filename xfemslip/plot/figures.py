@@ -456,7 +456,8 @@ def figure_mohr(results: Sequence[ResultData]) -> Figure:
     )
     fig = Figure(figsize=mohr_figsize(limits), layout="constrained")
     ax = fig.subplots()
-    circles, criteria = set(), set()
+    circles: set[tuple] = set()
+    criteria: set[tuple] = set()
     labels = _point_labels(results)
     for k, data in enumerate(results):
         stress, pore = _mohr_state(data)

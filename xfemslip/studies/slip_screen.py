@@ -455,7 +455,11 @@ def screen_plan(spec, planes, stress=None, pore_pressure=None) -> ScreenPlan:
             if pore_pressure is not None
             else (pore.initial if pore else 0.0)
         )
-        S = tuple(stress if stress is not None else spec.loading.stress)
+        S = tuple(
+            stress
+            if stress is not None
+            else spec.loading.stress or spec.loading.initial_stress
+        )
         return ScreenPlan(
             S, p, _total(S, p, planes, INJECTION), _constant_total_text(1.0), ""
         )
@@ -470,10 +474,10 @@ def screen_plan(spec, planes, stress=None, pore_pressure=None) -> ScreenPlan:
         S = tuple(stress or spec.loading.initial_stress or spec.loading.stress)
         onsets = _total(S, p, planes, start.direction)
         return ScreenPlan(S, p, onsets, _constant_total_text(start.direction), why)
-    onsets = [
-        segment_onset(path, start, *_plane_ends(path, theta, ends), f, c)
-        for _, theta, f, c, ends in planes
-    ]
+    onsets = []
+    for _, theta, f, c, ends in planes:
+        P0, P1 = _plane_ends(path, theta, ends)
+        onsets.append(segment_onset(path, start, P0, P1, f, c))
     S = tuple(float(v) for v in start.stress[0])
     way = "depletion (dp < 0)" if start.direction < 0 else "injection (dp > 0)"
     return ScreenPlan(
@@ -483,7 +487,6 @@ def screen_plan(spec, planes, stress=None, pore_pressure=None) -> ScreenPlan:
 
 def _total(stress, p, planes, direction) -> list:
     """Onsets of the planes at constant total stress."""
-
     eff = effective_stress(stress, p)
     out = []
     for _, theta, f, c, _ in planes:

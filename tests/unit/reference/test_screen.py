@@ -223,8 +223,13 @@ def test_cli_screen_follows_the_depleting_reservoir_path(runner):
     # -p replaces the in-situ pore pressure on the same path: with 2 MPa
     # less, sigma_n' starts 2 MPa more compressive and the onset moves
     lower = runner.invoke(cli, ["screen", case, "-p", "28e6", "--step", "90"])
-    hand = (b0 + 0.5 * (a0 - 2e6)) / (b1 - 0.5 * a1)
-    assert _dp_line(lower.stdout, "fractures[0]") == pytest.approx(hand, rel=1e-5)
+    hand_lower = (b0 + 0.5 * (a0 - 2e6)) / (b1 - 0.5 * a1)
+    assert _dp_line(lower.stdout, "fractures[0]") == pytest.approx(hand_lower, rel=1e-5)
+    # a plane given by its angle is screened inside the layer
+    angle = runner.invoke(
+        cli, ["screen", case, "--angle", "60", "--friction", "0.5", "--step", "90"]
+    )
+    assert _dp_line(angle.stdout, "angle 60") == pytest.approx(hand, rel=1e-5)
 
 
 def test_cli_screen_warns_when_the_case_path_needs_the_full_solve(runner, tmp_path):
