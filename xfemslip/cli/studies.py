@@ -303,8 +303,9 @@ def plot_run(out_dir: Path) -> None:
     type=FiniteFloat(),
     default=None,
     metavar="XX YY XY",
-    help="Total far-field stress [Pa], tension positive "
-    "[default: loading.stress of CASE].",
+    help="Total far-field stress [Pa], tension positive [default: CASE's "
+    "in-situ stress: loading.initial_stress with a [pore_pressure] change, "
+    "else loading.stress].",
 )
 @click.option(
     "-p",
@@ -312,8 +313,7 @@ def plot_run(out_dir: Path) -> None:
     type=FiniteFloat(),
     default=None,
     help="Pore pressure p [Pa]; effective stress = stress + p I "
-    "[default: the final far-field pore pressure of CASE's [pore_pressure], "
-    "else 0].",
+    "[default: pore_pressure.initial of CASE, else 0].",
 )
 @click.option(
     "--friction",
@@ -379,44 +379,48 @@ def screen(
 ) -> None:
     """Closed-form slip screening of every orientation (and of the fractures of
     CASE): slip tendency, Coulomb margin, the band that slips and the
-    pore-pressure change at which each fracture slips.  Stresses in Pa,
-    tension positive."""
+    pore-pressure change at which each fracture slips or opens, along CASE's
+    own stress path when it changes the pore pressure (else at constant
+    total stress, the pressure rising).  Stresses in Pa, tension positive."""
     with reported_errors(debug):
         from xfemslip.reference import screen as scr
+        from xfemslip.studies.slip_screen import screen_plan
 
         configure_logging(False, True)  # the warnings; the report is printed
         spec = load_case_file(case) if case is not None else None
-        stress, fractures = _screen_inputs(spec, stress, friction, cohesion, angles)
-        if pore_pressure is None:
-            pore_pressure = _case_pore_pressure(spec)
-        _warn_depletion_path(spec, case)
-        f0 = friction if friction is not None else fractures[0][2]
-        c0 = cohesion if cohesion is not None else fractures[0][3]
+        fractures = _screen_planes(spec, stress, friction, cohesion, angles)
+        plan = screen_plan(spec, fractures, stress, pore_pressure)
+        if plan.refused:
+            _warn_path_refused(case, plan.refused)
+        f0, c0 = fractures[0][2], fractures[0][3]
         screened = [
             scr.screen_fracture(
-                label,
-                theta,
-                stress,
-                pore_pressure,
-                f if friction is None else friction,
-                c if cohesion is None else cohesion,
+                label, theta, plan.stress, plan.pore_pressure, f, c, found
             )
-            for label, theta, f, c in fractures
+            for (label, theta, f, c, _), found in zip(
+                fractures, plan.onsets, strict=True
+            )
             if label
         ]
-        click.echo(scr.format_report(stress, pore_pressure, f0, c0, step, screened))
+        click.echo(
+            scr.format_report(
+                plan.stress, plan.pore_pressure, f0, c0, step, screened, plan.text
+            )
+        )
         if csv_path is not None:
             _write_screen_csv(
                 csv_path,
-                scr.orientation_table(stress, pore_pressure, f0, c0, _angles(step)),
+                scr.orientation_table(
+                    plan.stress, plan.pore_pressure, f0, c0, _angles(step)
+                ),
             )
         if plot_dir is not None:
             from xfemslip.plot.figures import plot_screen
 
             for path in plot_screen(
                 plot_dir,
-                stress,
-                pore_pressure,
+                plan.stress,
+                plan.pore_pressure,
                 f0,
                 c0,
                 [(s.label, s.theta, s.friction, s.cohesion) for s in screened],
@@ -431,59 +435,49 @@ def _angles(step: float):
     return np.arange(0.0, 180.0, step)
 
 
-def _case_pore_pressure(spec) -> float:
-    """Final far-field pore pressure of CASE's [pore_pressure] (initial, plus
-    the change when it acts in the whole model), else 0 [Pa]."""
-    pp = None if spec is None else spec.pore_pressure
-    if pp is None:
-        return 0.0
-    return pp.initial + (pp.change if pp.region == "all" else 0.0)
-
-
-def _warn_depletion_path(spec, case) -> None:
-    """A case that depletes a region has a stress path the closed-form screen
-    does not follow (the region's contraction loads the fractures around
-    it): say so, and what answers it."""
-    pp = None if spec is None else spec.pore_pressure
-    if pp is None or pp.region == "all" or pp.change == 0.0:
-        return
+def _warn_path_refused(case, why: str) -> None:
+    """The case changes the pore pressure along a path the closed form cannot
+    follow: say why, what the screen did instead, and what answers it."""
     logging.getLogger("xfemslip.reference.screen").warning(
-        "%s: the case changes the pore pressure by %g Pa in its reservoir only; "
-        "this screen keeps the total stress fixed and uses the far-field pore "
-        "pressure, so its dp to slip is not the case's (xfemslip deplete %s "
-        "solves the poroelastic path)",
+        "%s: the closed form cannot follow this case's stress path (%s); this "
+        "screen keeps the total stress fixed instead, so its dp to slip is not "
+        "the case's (xfemslip deplete %s solves the poroelastic path)",
         case,
-        pp.change,
+        why,
         case,
     )
 
 
-def _screen_inputs(spec, stress, friction, cohesion, angles):
-    """(stress, [(label, theta, f, c)]) from the case's spec (or None) and the
+def _screen_planes(spec, stress, friction, cohesion, angles):
+    """[(label, theta, f, c, ends)] from the case's spec (or None) and the
     options; a fracture-less entry (label "") carries the defaults of f and c."""
-    if stress is None:
-        if spec is None or spec.loading.stress is None:
-            raise UsageError(
-                "screen needs --stress XX YY XY or a CASE with loading.stress"
-            )
-        stress = spec.loading.stress
+    loading = None if spec is None else spec.loading
+    if stress is None and (
+        loading is None or (loading.stress is None and loading.initial_stress is None)
+    ):
+        raise UsageError("screen needs --stress XX YY XY or a CASE with loading.stress")
     if angles:
-        fractures = [(f"angle {a:g}", a, friction, cohesion) for a in angles]
+        fractures = [(f"angle {a:g}", a, friction, cohesion, None) for a in angles]
     elif spec is not None and spec.fractures:
         from xfemslip.reference.screen import case_fractures
 
         fractures = case_fractures(spec)
     else:
-        fractures = [("", 0.0, friction, cohesion)]
+        fractures = [("", 0.0, friction, cohesion, None)]
     f0 = friction if friction is not None else fractures[0][2]
     if f0 is None:
         raise UsageError("screen needs --friction (or a CASE with a fracture)")
     c0 = cohesion if cohesion is not None else (fractures[0][3] or 0.0)
-    fractures = [
-        (lab, th, f0 if f is None else f, c0 if c is None else c)
-        for lab, th, f, c in fractures
+    return [  # --friction and --cohesion replace every fracture's
+        (
+            lab,
+            th,
+            f0 if friction is not None or f is None else f,
+            c0 if cohesion is not None or c is None else c,
+            ends,
+        )
+        for lab, th, f, c, ends in fractures
     ]
-    return tuple(float(v) for v in stress), fractures
 
 
 def _write_screen_csv(path: Path, table: dict) -> None:

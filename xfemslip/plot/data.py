@@ -61,6 +61,13 @@ class ResultData:
     # far-field pore pressure of the final step [Pa] ([pore_pressure]: initial,
     # plus the change when it acts in the whole model); 0 without one
     pore_pressure: float = 0.0
+    # with a [pore_pressure] change: the state the fractures' Coulomb law
+    # sees where the pressure changed, at the final step (changed_stress:
+    # sigma + p I, its median over changed_cells cells), and the in-situ
+    # effective stress (loading.initial_stress, else loading.stress, + p0 I)
+    changed_stress: tuple[float, float, float] | None = None
+    changed_cells: int = 0
+    in_situ_stress: tuple[float, float, float] | None = None
     vis_points: np.ndarray | None = None  # (P, 2) split mesh from result.vtu
     vis_displacement: np.ndarray | None = None  # (P, 2)
     vis_triangles: np.ndarray | None = None  # (T, 3): quads split in two + cut
@@ -160,6 +167,37 @@ def _far_pore_pressure(case: dict) -> float:
         return 0.0
     change = pp.get("change", 0.0) if pp.get("region", "all") == "all" else 0.0
     return float(pp.get("initial", 0.0)) + float(change)
+
+
+def _changed_state(case: dict, step) -> tuple[tuple | None, int, tuple | None]:
+    """(sigma + p I where the pore pressure changed, at ``step``: the median
+    of each component over those cells; their number; the in-situ
+    effective stress), or (None, 0, None) without a pressure change.
+
+    A cell counts as changed when its pore pressure moved by at least half
+    the largest change (cut cells store their area mean, so a cell mostly
+    outside the region does not count).  The median is the undisturbed
+    value of the region's uniform part: the fractures disturb a few cells
+    around them, which the mean would mix in.  sigma + p I and not
+    sigma + alpha p I: the fractures see their full fluid pressure
+    (Terzaghi, ``effective_normal_traction``)."""
+    pp = case.get("pore_pressure")
+    if not isinstance(pp, dict) or step.pore_pressure is None or step.stress is None:
+        return None, 0, None
+    p0 = float(pp.get("initial", 0.0))
+    moved = np.abs(step.pore_pressure - p0)
+    if not moved.max() > 0.0:
+        return None, 0, None
+    cells = moved >= 0.5 * moved.max()
+    eff = step.stress[cells] + step.pore_pressure[cells, None] * np.array([1, 1, 0])
+    loading = case.get("loading", {})
+    start = loading.get("initial_stress") or loading.get("stress") or {}
+    in_situ = tuple(
+        float(start.get(k, 0.0)) + (p0 if k != "xy" else 0.0)
+        for k in ("xx", "yy", "xy")
+    )
+    median = tuple(float(v) for v in np.median(eff, axis=0))
+    return median, int(cells.sum()), in_situ
 
 
 def _fracture_laws(result, case: dict, path: Path) -> list[tuple[float, float, float]]:
@@ -341,6 +379,9 @@ def figure_data(path: str | Path, label: str | None = None) -> ResultData:
         stress_source=source,
         pore_pressure=_far_pore_pressure(case),
         fractures=_fracture_data(result, case, path.with_name("case.toml")),
+    )
+    data.changed_stress, data.changed_cells, data.in_situ_stress = _changed_state(
+        case, result.final
     )
     vtu = path.with_name("result.vtu")
     if vtu.is_file():

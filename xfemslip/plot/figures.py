@@ -12,7 +12,9 @@ side (one column per result):
   point, every result overlaid (Fig. 12);
 - ``mohr``: the Mohr-Coulomb diagram of the far-field stress with each
   fracture's point, the failure line and the band of orientations that slip
-  (Fig. 13); the contact points of the run are drawn too;
+  (Fig. 13); the contact points of the run are drawn too, red where they
+  slip; with a pore-pressure change, the effective stress where it changed
+  at the final step, beside the in-situ circle;
 - ``network`` (only when asked for, first result only): |slip| along every
   fracture of a network over the deformed split mesh, and the contact state.
 - ``permeability`` (only when asked for, first result only, a case with
@@ -26,6 +28,7 @@ Every figure is saved as PNG and PDF.  Only the object-oriented API
 from __future__ import annotations
 
 import logging
+import math
 from collections.abc import Sequence
 from pathlib import Path
 
@@ -40,7 +43,14 @@ from matplotlib.tri import Triangulation
 from xfemslip.conventions import SLIP
 from xfemslip.errors import UsageError
 from xfemslip.plot.data import ResultData, distinct_labels, figure_data
-from xfemslip.plot.mohr import NUMBERED_FROM, add_legend, draw_mohr, mohr_figsize
+from xfemslip.plot.mohr import (
+    NUMBERED_FROM,
+    add_legend,
+    draw_circle,
+    draw_mohr,
+    mohr_figsize,
+    mohr_limits,
+)
 from xfemslip.plot.permeability import figure_permeability
 from xfemslip.plot.profile import figure_profile
 
@@ -412,49 +422,134 @@ def _point_labels(results: Sequence[ResultData]) -> dict:
     return labels
 
 
+def _mohr_state(data: ResultData) -> tuple[tuple, float]:
+    """(stress, pore pressure) of a result's circle: with a pore-pressure
+    change the effective stress where it changed at the final step (the
+    state its fractures' Coulomb law sees), else the far field."""
+    if data.changed_stress is not None:
+        return data.changed_stress, 0.0
+    return data.stress_state, data.pore_pressure
+
+
+def _slipped_text(results: Sequence[ResultData]) -> str:
+    """Which fractures (of one result) or results (of several) have contact
+    points in slip at the final step."""
+    slipped = [
+        [f.index for f in data.fractures if np.any(f.state == SLIP)] for data in results
+    ]
+    if len(results) > 1:
+        who = [data.label for data, s in zip(results, slipped, strict=True) if s]
+        return "slip in: " + ", ".join(who) if who else "no result slips"
+    (mine,) = slipped
+    if len(mine) > 1:
+        return "fractures " + ", ".join(str(i) for i in mine) + " slip"
+    return f"fracture {mine[0]} slips" if mine else "no fracture slips"
+
+
 def figure_mohr(results: Sequence[ResultData]) -> Figure:
     """The Mohr-Coulomb diagram of every result's stress and fractures; a
-    circle per distinct stress state, a failure line per distinct (f, c)."""
-    fig = Figure(
-        figsize=mohr_figsize(results[0].stress_state, results[0].pore_pressure),
-        layout="constrained",
+    circle per distinct stress state, a failure line per distinct (f, c),
+    every contact point of the final step (red where it slips).
+
+    A result with a pore-pressure change is drawn at the end: its circle is
+    sigma + p I where the pressure changed (:func:`_mohr_state`), the
+    in-situ circle beside it in grey, and its fractures are their contact
+    points (a plane on the circle is not where a fracture outside that
+    region is)."""
+    contact = [
+        [(f.normal_traction, f.shear_traction, f.state) for f in data.fractures]
+        for data in results
+    ]
+    limits = mohr_limits(
+        *_mohr_state(results[0]),
+        points=[(pn, pt) for each in contact for pn, pt, _ in each],
     )
+    fig = Figure(figsize=mohr_figsize(limits), layout="constrained")
     ax = fig.subplots()
-    circles, criteria = set(), set()
+    circles: set[tuple] = set()
+    criteria: set[tuple] = set()
     labels = _point_labels(results)
     for k, data in enumerate(results):
+        stress, pore = _mohr_state(data)
+        changed = data.changed_stress is not None
         fractures = [
             (labels[k, f.index], f.theta, f.friction, f.cohesion)
             for f in data.fractures
         ]
-        keys = {(data.stress_state, f, c) for _, _, f, c in fractures}
+        keys = {(stress, f, c) for _, _, f, c in fractures}
+        if changed and data.in_situ_stress not in circles:
+            draw_circle(ax, data.in_situ_stress, "0.6", "in situ", lw=0.9, ls=":")
+            circles.add(data.in_situ_stress)
         draw_mohr(
             ax,
-            data.stress_state,
-            data.pore_pressure,
+            stress,
+            pore,
             fractures=fractures,
-            contact=[(f.normal_traction, f.shear_traction) for f in data.fractures],
+            contact=contact[k],
             color=f"C{k % 10}",
             first=k == 0,
-            circle=data.stress_state not in circles,
+            circle=stress not in circles,
             criterion=not keys <= criteria,
             inset_lines=[
                 (f.theta, f"C{j % 10}")
                 for j, other in enumerate(results)
                 for f in other.fractures
             ],
+            markers=not changed,
+            circle_label=(
+                f"where the pore pressure changed, final step (median of "
+                f"{data.changed_cells} cells)"
+                if changed
+                else "Mohr circle"
+            ),
+            limits=limits,
         )
-        circles.add(data.stress_state)
+        if changed and len(results) == 1 and len(fractures) < NUMBERED_FROM:
+            _cloud_labels(ax, data)
+        circles.add(stress)
         criteria |= keys
-    source = results[0].stress_source
     names = ", ".join(dict.fromkeys(data.name for data in results if data.name))
+    if results[0].changed_stress is not None:
+        what = "final step, effective stresses sigma + p I"
+    else:
+        what = (
+            f"far field: {results[0].stress_source}; pore pressure "
+            f"{results[0].pore_pressure / 1e6:g} MPa"
+        )
     ax.set_title(
-        f"{names}\nMohr-Coulomb diagram (far field: {source}; pore pressure "
-        f"{results[0].pore_pressure / 1e6:g} MPa; tension positive)",
+        f"{names}\nMohr-Coulomb diagram ({what}; tension positive)\n"
+        f"{_slipped_text(results)}",
         fontsize=9,
     )
     add_legend(fig)
     return fig
+
+
+def _cloud_labels(ax, data: ResultData) -> None:
+    """Each fracture's name at its contact point of largest |p_T|; fractures
+    whose points are that close (within 3 % of the axes' width) share one."""
+    width = float(np.subtract(*ax.get_xlim()[::-1]))
+    groups: list[tuple[tuple[float, float], list[int]]] = []
+    for f in data.fractures:
+        if not f.shear_traction.size:
+            continue
+        k = int(np.argmax(np.abs(f.shear_traction)))
+        at = (float(f.normal_traction[k]), float(abs(f.shear_traction[k])))
+        for place, members in groups:
+            if math.dist(place, at) < 0.03 * width:
+                members.append(f.index)
+                break
+        else:
+            groups.append((at, [f.index]))
+    for at, members in groups:
+        ax.annotate(
+            ("fractures " if len(members) > 1 else "fracture ")
+            + ", ".join(str(i) for i in members),
+            at,
+            textcoords="offset points",
+            xytext=(4, 4),
+            fontsize=7,
+        )
 
 
 # --------------------------------------------------------------------------- #
@@ -512,7 +607,9 @@ def plot_screen(
 
 def _screen_figure(stress, pore_pressure, friction, cohesion, fractures) -> Figure:
     """The Mohr diagram of :func:`plot_screen`."""
-    fig = Figure(figsize=mohr_figsize(stress, pore_pressure), layout="constrained")
+    fig = Figure(
+        figsize=mohr_figsize(mohr_limits(stress, pore_pressure)), layout="constrained"
+    )
     ax = fig.subplots()
     if not fractures:
         fractures = [("", 0.0, friction, cohesion)]

@@ -7,7 +7,9 @@ C = -(sigma1' + sigma3') / 2 and R = (sigma1' - sigma3') / 2 (sigma1' >=
 sigma3' compressive magnitudes).  The failure line is |tau| = c - f sigma_n';
 the arc above it is the band of orientations that slip
 (:func:`xfemslip.reference.screen.slip_band`).  An inset shows those orientations in
-the x-y plane.
+the x-y plane.  A run's contact points are drawn at their (p_N, |p_T|), red
+where they slip; the band's text never says that no orientation slips
+without saying how many of those points do.
 """
 
 from __future__ import annotations
@@ -17,6 +19,7 @@ import math
 import numpy as np
 from matplotlib.ticker import FuncFormatter
 
+from xfemslip.conventions import SLIP
 from xfemslip.reference.closed_form import angle_to_sigma1
 from xfemslip.reference.screen import effective_stress, slip_band
 
@@ -38,6 +41,27 @@ def _circle_point(centre: float, radius: float, beta_deg):
     return centre + radius * np.cos(two_beta), radius * np.sin(two_beta)
 
 
+def draw_circle(ax, stress_eff, color, label: str, **style) -> tuple[float, float]:
+    """The upper half of the Mohr circle of the effective stress
+    ``stress_eff`` (xx, yy, xy) [Pa], its principal stresses marked;
+    returns (centre, radius) [Pa]."""
+    band = slip_band(stress_eff, 0.0)
+    s1, s3 = band.sigma1, band.sigma3
+    centre, radius = -(s1 + s3) / 2.0, (s1 - s3) / 2.0
+    xs, ys = _circle_point(centre, radius, np.linspace(0.0, 90.0, 181))
+    ax.plot(
+        xs,
+        ys,
+        color=color,
+        lw=style.pop("lw", 1.2),
+        label=f"{label}: $\\sigma_1'$ = {_mpa(s1)}, $\\sigma_3'$ = {_mpa(s3)} "
+        "(compressive)",
+        **style,
+    )
+    ax.plot([-s1, -s3], [0, 0], "o", color=color, ms=3)
+    return centre, radius
+
+
 def draw_mohr(
     ax,
     stress,
@@ -50,65 +74,119 @@ def draw_mohr(
     circle: bool = True,
     criterion: bool = True,
     inset_lines=None,
+    markers: bool = True,
+    circle_label: str = "Mohr circle",
+    limits=None,
 ) -> None:
     """Draw the circle of ``stress`` (+ p), the failure line of each distinct
     (f, c) of ``fractures`` = [(label, theta [deg], f, c)], the slip band, the
-    fractures' points and the ``contact`` tractions [(p_N (K,), p_T (K,))].
+    fractures' points on the circle (``markers``) and the ``contact``
+    tractions [(p_N (K,), p_T (K,), state (K,))] (red where they slip).
 
-    ``first``: also label the axes and draw the inset, with the fracture
+    ``first``: also label the axes (within ``limits``, default
+    :func:`mohr_limits`) and draw the inset, with the fracture
     lines ``inset_lines`` = [(theta [deg], colour)] (default: ``fractures``
     in ``color``); ``circle`` and
     ``criterion`` switch off parts already drawn for an earlier result.  The
     caller adds the legend (:func:`add_legend`) once everything is drawn.
     """
     eff = effective_stress(stress, pore_pressure)
-    band0 = slip_band(eff, 0.0)
-    s1, s3, dir1 = band0.sigma1, band0.sigma3, band0.dir1
-    centre, radius = -(s1 + s3) / 2.0, (s1 - s3) / 2.0
-    x_left = mohr_limits(stress, pore_pressure)[0]
+    dir1 = slip_band(eff, 0.0).dir1
     if circle:
-        xs, ys = _circle_point(centre, radius, np.linspace(0.0, 90.0, 181))
-        ax.plot(
-            xs,
-            ys,
-            color=color,
-            lw=1.2,
-            label=f"Mohr circle: $\\sigma_1'$ = {_mpa(s1)}, "
-            f"$\\sigma_3'$ = {_mpa(s3)} (compressive)",
+        centre, radius = draw_circle(ax, eff, color, circle_label)
+    else:
+        band0 = slip_band(eff, 0.0)
+        centre, radius = (
+            -(band0.sigma1 + band0.sigma3) / 2.0,
+            (band0.sigma1 - band0.sigma3) / 2.0,
         )
-        ax.plot([-s1, -s3], [0, 0], "o", color=color, ms=3)
+    if limits is None:
+        limits = mohr_limits(stress, pore_pressure)
+    slipping = sum(
+        int(np.count_nonzero(np.asarray(st) == SLIP)) for _, _, st in contact
+    )
     seen = set()
     for _, _, f, c in fractures:
         if (f, c) in seen or not criterion:
             continue
         seen.add((f, c))
-        phi = math.degrees(math.atan(f))
-        xs = np.array([x_left, 0.0])
-        ax.plot(
-            xs,
-            c - f * xs,
-            linestyle=CRITERION_STYLES[(len(seen) - 1) % len(CRITERION_STYLES)],
-            color=color,
-            lw=1.0,
-            label=f"failure line $|\\tau| = c - f\\,\\sigma_n'$ "
-            f"(f = {f:g}, c = {c / 1e6:g} MPa)",
+        _criterion(
+            ax, eff, f, c, color, len(seen) - 1, limits[0], (centre, radius), slipping
         )
-        band = slip_band(eff, f, c)
-        if band.beta is not None:
-            bx, by = _circle_point(centre, radius, np.linspace(*band.beta, 100))
-            ax.fill_between(bx, c - f * bx, by, color=color, alpha=0.18, lw=0)
+    if markers:
+        _markers(ax, fractures, dir1, centre, radius, color)
+    for k, (pn, pt, state) in enumerate(contact):
+        slip = np.asarray(state) == SLIP
+        for mask, c, what in (
+            (~slip, "0.35", "stuck or open"),
+            (slip, "C3", "in slip"),
+        ):
             ax.plot(
-                bx,
-                by,
-                color="C3",
-                lw=3,
-                alpha=0.7,
-                label=f"slips: $\\beta$ = {band.beta[0]:.1f}..{band.beta[1]:.1f} deg "
-                f"from $\\sigma_1'$ (f = {f:g}; most critical "
-                f"$45 - \\phi/2$ = {45 - phi / 2:.1f} deg)",
+                np.asarray(pn)[mask],
+                np.abs(np.asarray(pt))[mask],
+                ".",
+                color=c,
+                ms=2.5 if c != "C3" else 3.5,
+                label=f"contact points {what} $(p_N, |p_T|)$"
+                if first and k == 0
+                else None,
             )
-        else:
-            ax.plot([], [], " ", label=f"f = {f:g}: no orientation slips")
+    if first:
+        ax.set_xlabel("effective normal stress $\\sigma_n'$ [MPa] (tension positive)")
+        ax.set_ylabel("shear stress $|\\tau|$ [MPa]")
+        ax.axhline(0.0, color="k", lw=0.5)
+        ax.axvline(0.0, color="k", lw=0.5)
+        ax.set_aspect("equal")
+        ax.set_xlim(*limits[:2])
+        ax.set_ylim(*limits[2:])
+        in_mpa = FuncFormatter(lambda value, _: f"{value / 1e6:g}")
+        ax.xaxis.set_major_formatter(in_mpa)
+        ax.yaxis.set_major_formatter(in_mpa)
+        f0, c0 = (fractures[0][2], fractures[0][3]) if fractures else (0.0, 0.0)
+        if inset_lines is None:
+            inset_lines = [(theta, color) for _, theta, _, _ in fractures]
+        _inset(ax, slip_band(eff, f0, c0), inset_lines)
+
+
+def _criterion(ax, eff, f, c, color, k, x_left, circle, slipping) -> None:
+    """The failure line of (f, c), the band of the circle that slips, and the
+    legend's words on it (with the run's ``slipping`` contact points)."""
+    phi = math.degrees(math.atan(f))
+    xs = np.array([x_left, 0.0])
+    ax.plot(
+        xs,
+        c - f * xs,
+        linestyle=CRITERION_STYLES[k % len(CRITERION_STYLES)],
+        color=color,
+        lw=1.0,
+        label=f"failure line $|\\tau| = c - f\\,\\sigma_n'$ "
+        f"(f = {f:g}, c = {c / 1e6:g} MPa)",
+    )
+    band = slip_band(eff, f, c)
+    if band.beta is None:
+        text = f"f = {f:g}: no orientation slips under this circle's stress"
+        if slipping:
+            text += f"; {slipping} contact points of the run slip (red)"
+        ax.plot([], [], " ", label=text)
+        return
+    centre, radius = circle
+    bx, by = _circle_point(centre, radius, np.linspace(*band.beta, 100))
+    ax.fill_between(bx, c - f * bx, by, color=color, alpha=0.18, lw=0)
+    ax.plot(
+        bx,
+        by,
+        color="C3",
+        lw=3,
+        alpha=0.7,
+        label=f"slips: $\\beta$ = {band.beta[0]:.1f}..{band.beta[1]:.1f} deg "
+        f"from $\\sigma_1'$ (f = {f:g}; most critical "
+        f"$45 - \\phi/2$ = {45 - phi / 2:.1f} deg)",
+    )
+
+
+def _markers(ax, fractures, dir1, centre, radius, color) -> None:
+    """Each fracture's plane on the circle, labelled (numbered from
+    NUMBERED_FROM on)."""
     labelled = []
     for label, theta, _, _ in fractures:
         beta = angle_to_sigma1(theta, dir1)
@@ -119,56 +197,38 @@ def draw_mohr(
             labelled.append((label, theta, beta))
     if len(labelled) >= NUMBERED_FROM:
         _numbered_labels(ax, centre, radius, labelled, color)
-    else:
-        for label, _, beta in labelled:
-            ax.annotate(
-                f"{label} ($\\beta$ = {beta:.1f} deg)",
-                _circle_point(centre, radius, beta),
-                textcoords="offset points",
-                xytext=(5, 4),
-                fontsize=7,
-            )
-    for k, (pn, pt) in enumerate(contact):
-        ax.plot(
-            pn,
-            np.abs(pt),
-            ".",
-            color="0.35",
-            ms=2.5,
-            label="contact points of the run $(p_N, |p_T|)$"
-            if first and k == 0
-            else None,
+        return
+    for label, _, beta in labelled:
+        ax.annotate(
+            f"{label} ($\\beta$ = {beta:.1f} deg)",
+            _circle_point(centre, radius, beta),
+            textcoords="offset points",
+            xytext=(5, 4),
+            fontsize=7,
         )
-    if first:
-        ax.set_xlabel("effective normal stress $\\sigma_n'$ [MPa] (tension positive)")
-        ax.set_ylabel("shear stress $|\\tau|$ [MPa]")
-        ax.axhline(0.0, color="k", lw=0.5)
-        ax.axvline(0.0, color="k", lw=0.5)
-        ax.set_aspect("equal")
-        ax.set_xlim(*mohr_limits(stress, pore_pressure)[:2])
-        ax.set_ylim(*mohr_limits(stress, pore_pressure)[2:])
-        in_mpa = FuncFormatter(lambda value, _: f"{value / 1e6:g}")
-        ax.xaxis.set_major_formatter(in_mpa)
-        ax.yaxis.set_major_formatter(in_mpa)
-        f0, c0 = (fractures[0][2], fractures[0][3]) if fractures else (0.0, 0.0)
-        if inset_lines is None:
-            inset_lines = [(theta, color) for _, theta, _, _ in fractures]
-        _inset(ax, slip_band(eff, f0, c0), inset_lines)
 
 
-def mohr_limits(stress, pore_pressure: float = 0.0) -> tuple[float, ...]:
-    """(x0, x1, y0, y1) of the diagram [Pa]: the circle, zero and room above."""
+def mohr_limits(stress, pore_pressure: float = 0.0, points=()) -> tuple[float, ...]:
+    """(x0, x1, y0, y1) of the diagram [Pa]: the circle, zero and room above,
+    and the (p_N, p_T) arrays of ``points``."""
     band = slip_band(effective_stress(stress, pore_pressure), 0.0)
     s1, radius = max(band.sigma1, 1.0), (band.sigma1 - band.sigma3) / 2.0
     centre = -(band.sigma1 + band.sigma3) / 2.0
     # room for the ring of numbered labels (1.25 R) left of the circle
     x0 = min(-1.08 * s1, centre - 1.35 * radius)
-    return x0, 0.25 * s1, 0.0, max(1.5 * radius, 0.3 * s1)
+    x1, y1 = 0.25 * s1, max(1.5 * radius, 0.3 * s1)
+    for pn, pt in points:
+        if np.size(pn):
+            x0 = min(x0, 1.05 * float(np.min(pn)))
+            x1 = max(x1, 1.05 * float(np.max(pn)))
+            y1 = max(y1, 1.1 * float(np.max(np.abs(pt))))
+    return x0, x1, 0.0, y1
 
 
-def mohr_figsize(stress, pore_pressure: float = 0.0, width: float = 8.0):
-    """Figure size that fits the equal-aspect diagram, its title and legend."""
-    x0, x1, y0, y1 = mohr_limits(stress, pore_pressure)
+def mohr_figsize(limits, width: float = 8.0):
+    """Figure size that fits the equal-aspect diagram of ``limits``
+    (:func:`mohr_limits`), its title and legend."""
+    x0, x1, y0, y1 = limits
     return width, (width - 0.8) * (y1 - y0) / (x1 - x0) + 2.0
 
 

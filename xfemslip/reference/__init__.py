@@ -11,6 +11,8 @@ Modules:
 - ``inclusion``: the stress of a pressure change in polygons of an infinite
   plane (Goodier's potential in closed form) and the displaced fault of
   Jansen, Singhal & Vossepoel (2019);
+- ``onset``: the pore-pressure change at which a plane first slips or opens
+  along a linear stress path (the one law of the screens and closed forms);
 - ``screen``: closed-form screening of fracture orientations (Coulomb margin
   of each plane);
 - ``peer``: the OpenGeoSys peer problem as an xfemslip case.
@@ -21,4 +23,11 @@ import the module you need (``from xfemslip.reference.closed_form import
 ...``).
 """
 
-__all__ = ["closed_form", "closed_form_depletion", "inclusion", "peer", "screen"]
+__all__ = [
+    "closed_form",
+    "closed_form_depletion",
+    "inclusion",
+    "onset",
+    "peer",
+    "screen",
+]

@@ -66,6 +66,7 @@ from __future__ import annotations
 import numpy as np
 
 from xfemslip.reference.inclusion import polygon_stress
+from xfemslip.reference.onset import critical_change, plane_directions, plane_tractions
 
 
 def uniaxial_strain_change(dp: float, nu: float, biot: float = 1.0) -> dict:
@@ -150,29 +151,21 @@ def dislocation_shear(y, s, slip, nu, shear_modulus) -> np.ndarray:
 def critical_change_uniaxial(
     initial_stress, p0, nu, angle_deg, friction, cohesion=0.0, biot=1.0, sign=-1.0
 ) -> float:
-    """Pore-pressure change [Pa] at which a plane first slips on the
-    uniaxial-strain path (Coulomb on the rotated effective stress).
+    """Pore-pressure change [Pa] at which a plane first slips or opens on the
+    uniaxial-strain path (:func:`xfemslip.reference.onset.onset`).
 
     initial_stress : (xx, yy, xy) total [Pa]; p0 [Pa]; the plane's tangent at
     ``angle_deg`` from +x, normal n = (-sin, cos).  Along the path
     sigma_xx = sigma0_xx - alpha (1 - 2 nu) / (1 - nu) dp, sigma_yy, sigma_xy
     constant (Biot in the bulk), and the fracture sees sigma_n' = sigma_n + p
-    (Terzaghi): sigma_n' = A0 + A1 dp, tau = B0 + B1 dp, and |tau| = c -
-    f sigma_n' is solved on both branches.  ``sign`` = -1 looks for the first
-    crossing under depletion (dp < 0), +1 under injection.  NaN if never.
+    (Terzaghi): sigma_n' = A0 + A1 dp, tau = B0 + B1 dp.  ``sign`` = -1
+    looks for the first limit under depletion (dp >= -p0), +1 under
+    injection; 0 at or beyond the limit in situ, NaN if never.
     """
-    th = np.radians(angle_deg)
-    t = np.array([np.cos(th), np.sin(th)])
-    n = np.array([-np.sin(th), np.cos(th)])
-    sxx, syy, sxy = initial_stress
-    S0 = np.array([[sxx, sxy], [sxy, syy]])
-    S1 = np.diag([-biot * (1.0 - 2.0 * nu) / (1.0 - nu), 0.0])
-    A0, A1 = n @ S0 @ n + p0, n @ S1 @ n + 1.0
-    B0, B1 = t @ S0 @ n, t @ S1 @ n
-    roots = []
-    for s in (1.0, -1.0):  # s tau = c - f sigma_n'
-        den = s * B1 + friction * A1
-        if den != 0.0:
-            roots.append((cohesion - friction * A0 - s * B0) / den)
-    roots = [r for r in roots if r * sign > 0.0]
-    return float(min(roots, key=abs)) if roots else float("nan")
+    c, s = plane_directions(angle_deg)
+    rate = (-biot * (1.0 - 2.0 * nu) / (1.0 - nu), 0.0, 0.0)
+    A0, B0 = plane_tractions(initial_stress, c, s)
+    A1, B1 = plane_tractions(rate, c, s)
+    return float(
+        critical_change((A0 + p0, A1 + 1.0), (B0, B1), friction, cohesion, sign, p0)
+    )

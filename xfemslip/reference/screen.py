@@ -19,10 +19,13 @@ sigma_n = n.sigma.n, tau = t.sigma.n.
 - Coulomb failure margin m = c + f max(0, -sigma_n') - |tau| [Pa]
   (the contact law of xfemslip: positive = stable, <= 0 = slips; Jaeger, Cook
   & Zimmerman 2007, section 4.7);
-- pore-pressure change to slip dp_slip = m / f [Pa] (from m(p + dp) = 0:
-  dm/dp = -f while the plane is in compression); the plane opens at
-  dp_open = -sigma_n', and an open plane carries no shear, so it slips at
-  min(dp_slip, dp_open);
+- pore-pressure change to slip: the first dp at which the plane slips or
+  opens along a stress path (:func:`xfemslip.reference.onset.onset`, the
+  one law of the screen, the closed forms and the uncertainty screen).
+  With the total stress kept (:func:`pressure_to_slip`) sigma_n' grows by dp
+  and tau stays, so only a rise of p can reach the limit; ``xfemslip
+  screen`` on a case with ``[pore_pressure]`` follows the case's own path
+  (:mod:`xfemslip.studies.slip_screen`);
 - the band of angles beta to sigma_1 that slip: :func:`closed_form.slip_window`
   on the effective principal stresses.
 """
@@ -35,6 +38,13 @@ from dataclasses import dataclass
 import numpy as np
 
 from xfemslip.reference.closed_form import angle_to_sigma1, principal, slip_window
+from xfemslip.reference.onset import (
+    INJECTION,
+    Onset,
+    onset,
+    plane_directions,
+    plane_tractions,
+)
 
 
 def effective_stress(stress, pore_pressure: float) -> tuple[float, float, float]:
@@ -45,14 +55,7 @@ def effective_stress(stress, pore_pressure: float) -> tuple[float, float, float]
 
 def plane_stresses(stress, theta_deg) -> tuple[np.ndarray, np.ndarray]:
     """(sigma_n, tau) [Pa] on planes at theta [deg] (arrays; see module doc)."""
-    xx, yy, xy = (float(v) for v in stress)
-    theta = np.asarray(theta_deg, dtype=float)
-    c, s = np.cos(np.radians(theta)), np.sin(np.radians(theta))
-    quarter = np.mod(theta, 90.0) == 0.0  # cos(pi/2) is 6e-17, not 0
-    c, s = np.where(quarter, np.round(c), c), np.where(quarter, np.round(s), s)
-    sigma_n = xx * s * s + yy * c * c - 2.0 * xy * s * c
-    tau = (yy - xx) * s * c + xy * (c * c - s * s)
-    return sigma_n + 0.0, tau + 0.0  # + 0.0: no -0.0 in the printout
+    return plane_tractions(stress, *plane_directions(theta_deg))
 
 
 def slip_tendency(sigma_n_eff, tau) -> np.ndarray:
@@ -70,22 +73,16 @@ def coulomb_margin(sigma_n_eff, tau, friction: float, cohesion: float = 0.0):
     return cohesion + friction * np.maximum(0.0, -sn) - np.abs(np.asarray(tau, float))
 
 
-def pressure_to_slip(sigma_n_eff, tau, friction, cohesion=0.0):
-    """(dp_slip, dp_open, dp_critical) [Pa]: the pore-pressure changes at which
-    the Coulomb margin reaches zero, the plane opens, and the first of the two.
-
-    With f = 0 the margin does not depend on p: dp_slip is +inf (stable) or
-    -inf (already slipping).  A negative dp means the plane slips already; a
-    drop of |dp| would stop it.
-    """
-    sn = float(sigma_n_eff)
-    margin = float(coulomb_margin(sn, tau, friction, cohesion))
-    if friction > 0.0:
-        dp_slip = margin / friction
-    else:
-        dp_slip = math.inf if margin > 0.0 else -math.inf
-    dp_open = -sn
-    return dp_slip, dp_open, min(dp_slip, dp_open) if margin > 0.0 else dp_slip
+def pressure_to_slip(
+    sigma_n_eff, tau, friction, cohesion=0.0, direction=INJECTION, pore_pressure=None
+) -> Onset:
+    """The first pore-pressure change [Pa] at which planes slip or open while
+    the total stress stays: sigma_n' = sigma_n_eff + dp, tau constant
+    (:func:`xfemslip.reference.onset.onset`; ``pore_pressure`` p0 bounds a
+    depletion at dp = -p0)."""
+    return onset(
+        (sigma_n_eff, 1.0), (tau, 0.0), friction, cohesion, direction, pore_pressure
+    )
 
 
 @dataclass(frozen=True)
@@ -152,16 +149,20 @@ class FractureScreen:
     tau: float  # [Pa]
     slip_tendency: float
     margin: float  # [Pa]
-    dp_slip: float  # [Pa]
-    dp_open: float  # [Pa]
-    dp_critical: float  # [Pa]
+    dp_critical: float  # [Pa]: 0 at or beyond the limit, NaN never
+    opens: bool  # the limit reached first is opening, not Coulomb
 
 
-def screen_fracture(label, theta, stress, pore_pressure, friction, cohesion=0.0):
-    """Screen one plane at ``theta`` [deg]."""
+def screen_fracture(
+    label, theta, stress, pore_pressure, friction, cohesion=0.0, found=None
+):
+    """Screen one plane at ``theta`` [deg]: its in-situ numbers, and the
+    pore-pressure change ``found`` (an :class:`Onset` of one plane) or, by
+    default, the rise of p that reaches its limit at constant total stress."""
     eff = effective_stress(stress, pore_pressure)
     sn, tau = (float(v) for v in plane_stresses(eff, theta))
-    dp_slip, dp_open, dp_crit = pressure_to_slip(sn, tau, friction, cohesion)
+    if found is None:
+        found = pressure_to_slip(sn, tau, friction, cohesion)
     return FractureScreen(
         label=label,
         theta=float(theta),
@@ -172,15 +173,14 @@ def screen_fracture(label, theta, stress, pore_pressure, friction, cohesion=0.0)
         tau=tau,
         slip_tendency=float(slip_tendency(sn, tau)),
         margin=float(coulomb_margin(sn, tau, friction, cohesion)),
-        dp_slip=dp_slip,
-        dp_open=dp_open,
-        dp_critical=dp_crit,
+        dp_critical=float(np.asarray(found.change).reshape(-1)[0]),
+        opens=bool(np.asarray(found.opens).reshape(-1)[0]),
     )
 
 
 def case_fractures(spec):
-    """(label, theta [deg], friction, cohesion) of every straight segment of
-    every fracture of a case."""
+    """(label, theta [deg], friction, cohesion, (P0, P1) [m]) of every
+    straight segment of every fracture of a case."""
     out = []
     for fracture in spec.fractures:
         pts = np.asarray(fracture.points, dtype=float)
@@ -190,12 +190,22 @@ def case_fractures(spec):
             if len(d) > 1:
                 label += f" segment {k}"
             theta = math.degrees(math.atan2(dy, dx)) % 180.0
-            out.append((label, theta, fracture.friction, fracture.cohesion))
+            ends = (pts[k], pts[k + 1])
+            out.append((label, theta, fracture.friction, fracture.cohesion, ends))
     return out
 
 
-def format_report(stress, pore_pressure, friction, cohesion, step, fractures) -> str:
-    """The text report of ``xfemslip screen``: state, band, table, fractures."""
+def format_report(
+    stress,
+    pore_pressure,
+    friction,
+    cohesion,
+    step,
+    fractures,
+    path_text,
+) -> str:
+    """The text report of ``xfemslip screen``: state, band, table, fractures;
+    ``path_text`` the sentence naming the stress path of the dp to slip."""
     eff = effective_stress(stress, pore_pressure)
     band = slip_band(eff, friction, cohesion)
     phi = math.degrees(math.atan(friction))
@@ -206,9 +216,7 @@ def format_report(stress, pore_pressure, friction, cohesion, step, fractures) ->
         f"effective principal stresses (compression): sigma1' = {band.sigma1:.6g} "
         f"at {band.dir1:.2f} deg from +x, sigma3' = {band.sigma3:.6g}",
         f"friction f = {friction:g} (phi = {phi:.2f} deg), cohesion c = {cohesion:g}",
-        "stress path: the total stress stays as given while the pore pressure "
-        "changes (the dp to slip below); the stress a depleting reservoir "
-        "transfers is not included (xfemslip deplete solves it)",
+        path_text,
     ]
     if band.beta is None:
         lines.append("slip band: no orientation slips")
@@ -247,18 +255,14 @@ def _fracture_text(fractures: list[FractureScreen]) -> str:
     """The per-fracture lines, with the pore-pressure change to slip."""
     lines = []
     for fs in fractures:
-        if fs.margin <= 0.0:
-            change = (
-                f"SLIPS already; a pore-pressure drop of {-fs.dp_slip:.6g} Pa "
-                "would stop it"
-                if math.isfinite(fs.dp_slip)
-                else "SLIPS at any pore pressure (f = 0)"
-            )
+        limit = "opens" if fs.opens else "slips"
+        if fs.dp_critical == 0.0:
+            change = f"{limit.upper()} already"
+        elif math.isnan(fs.dp_critical):
+            change = "stable; neither slips nor opens along the path"
         else:
-            change = (
-                f"stable; slips at a pore-pressure change dp = "
-                f"{fs.dp_critical:.6g} Pa (Coulomb {fs.dp_slip:.6g}, opening "
-                f"{fs.dp_open:.6g})"
+            change = f"stable; {limit} at a pore-pressure change dp = " + (
+                f"{fs.dp_critical:.6g} Pa"
             )
         lines.append(
             f"{fs.label}: theta = {fs.theta:.2f} deg (beta = {fs.beta:.2f} deg), "

@@ -13,7 +13,7 @@ import math
 import numpy as np
 
 from xfemslip.case.tables import Range, Table, show
-from xfemslip.studies.sampling import KINDS, Distribution
+from xfemslip.studies.sampling import KINDS, Distribution, score_correlation
 from xfemslip.studies.vary import MAX_CASES, parse_key_path
 
 MAX_INPUTS = 100
@@ -210,11 +210,13 @@ def read_correlation(table: Table, keys: list[str]) -> np.ndarray | None:
             item.error("keys", f"the pair {pair} is correlated twice")
             continue
         matrix[a, b] = matrix[b, a] = rho
-    if np.any(np.linalg.eigvalsh(matrix) <= 1e-10):
+    scores = score_correlation(matrix)  # what the reordering imposes
+    if min(np.linalg.eigvalsh(matrix).min(), np.linalg.eigvalsh(scores).min()) <= 1e-10:
         table.error(
             "correlation",
             "the correlations together are not a valid correlation matrix "
-            "(not positive definite)",
+            "(not positive definite, as rank correlations or as the normal-score "
+            "correlations 2 sin(pi rho / 6) that induce them)",
         )
         return None
     return None if np.allclose(matrix, np.eye(len(keys))) else matrix

@@ -15,8 +15,14 @@ strata in every marginal.
 - **Correlation** between inputs (Iman & Conover 1982, "A distribution-free
   approach to inducing rank correlation among input variables", Commun.
   Statist. B11): the samples of each input are *reordered* so that their
-  ranks follow normal scores with the requested correlation; the marginals,
-  and so the Latin hypercube strata, are kept exactly.
+  ranks follow normal scores; the marginals, and so the Latin hypercube
+  strata, are kept exactly.  The target is Spearman's rank correlation
+  rho_s: the scores get the Pearson correlation r = 2 sin(pi rho_s / 6),
+  the one whose bivariate normal has rank correlation rho_s (Pearson 1907;
+  Kruskal 1958, "Ordinal measures of association", JASA 53), since ranks
+  of normal scores correlated by rho_s itself come out weaker (0.479 for
+  0.5).  The achieved rank correlation then scatters about the target with
+  less than the sampling error of n independent pairs.
 
 The generator is ``numpy.random.default_rng(seed)``: the same seed gives the
 same samples on every platform NumPy supports.
@@ -85,7 +91,9 @@ class Distribution:
         return float(lo), float(hi)
 
     def ppf(self, u: np.ndarray) -> np.ndarray:
-        """Values at the quantiles u in [0, 1) of the (truncated) distribution."""
+        """Values at the quantiles u in [0, 1) of the (truncated) distribution,
+        increasing with u (so that the ranks of u are the ranks of the values,
+        which the rank correlation reorders)."""
         u = np.asarray(u, dtype=float)
         if self.kind == "choice":
             values = np.asarray(self.params)
@@ -94,12 +102,15 @@ class Distribution:
                 if self.weights is None
                 else np.asarray(self.weights, float)
             )
+            order = np.argsort(values, kind="stable")
+            values, w = values[order], w[order]
             edges = np.cumsum(w) / w.sum()
             index = np.minimum(np.searchsorted(edges, u, side="right"), values.size - 1)
             return values[index]
         lo, hi = self._cdf_bounds()
-        q = lo + (hi - lo) * u
-        return self._sign() * self._frozen().ppf(q)
+        if self._sign() < 0:  # a negative lognormal grows as its magnitude falls
+            return -self._frozen().isf((1.0 - hi) + (hi - lo) * u)
+        return self._frozen().ppf(lo + (hi - lo) * u)
 
     def mean(self) -> float:
         """Mean of the (truncated) distribution, by quadrature over quantiles."""
@@ -132,31 +143,57 @@ def normal_scores(n: int) -> np.ndarray:
     return special.ndtri(np.arange(1, n + 1) / (n + 1.0))
 
 
+def score_correlation(rank_target: np.ndarray) -> np.ndarray:
+    """(d, d) Pearson correlation of normal scores whose rank correlation
+    (Spearman) is ``rank_target``: r = 2 sin(pi rho_s / 6), ones on the
+    diagonal.  It may fail to be positive definite where ``rank_target``
+    is nearly singular (the loader refuses that)."""
+    r = 2.0 * np.sin(np.pi * np.asarray(rank_target, float) / 6.0)
+    np.fill_diagonal(r, 1.0)
+    return r
+
+
+# Fresh permutations of the scores tried when their sample correlation is
+# singular (two columns in the same or reversed order, likely only when the
+# samples barely outnumber the inputs: 1 in 3 for 3 samples of 2 inputs).
+SCORE_DRAWS = 100
+
+
 def induce_correlation(
     u: np.ndarray, target: np.ndarray, rng: np.random.Generator
 ) -> np.ndarray:
     """Reorder the columns of u (n, d) so that their rank correlation follows
-    ``target`` (d, d), Iman & Conover (1982); every column keeps its values.
+    ``target`` (d, d, Spearman), Iman & Conover (1982); every column keeps
+    its values.  Needs n > d.
 
     Scores S (n, d): normal scores, each column randomly permuted; their
-    sample correlation E = Q Q^T and the target C = P P^T (Cholesky) give
-    T = S (P Q^-1)^T, whose correlation is C; each column of u is then
-    sorted into the rank order of the same column of T.
+    sample correlation E = Q Q^T and the score target C = P P^T
+    (:func:`score_correlation`, Cholesky) give T = S (P Q^-1)^T, whose
+    Pearson correlation is C; each column of u is then sorted into the rank
+    order of the same column of T.
     """
     n, d = u.shape
     target = np.asarray(target, float)
     if np.allclose(target, np.eye(d)):
         return u
-    scores = np.column_stack([rng.permutation(normal_scores(n)) for _ in range(d)])
-    E = np.corrcoef(scores, rowvar=False)
-    P = np.linalg.cholesky(target)
-    Q = np.linalg.cholesky(E)
-    T = scores @ (P @ np.linalg.inv(Q)).T
-    out = np.empty_like(u)
-    for j in range(d):
-        ranks = np.argsort(np.argsort(T[:, j]))
-        out[:, j] = np.sort(u[:, j])[ranks]
-    return out
+    if n <= d:
+        raise ValueError(
+            f"inducing a correlation needs more samples than inputs ({n} <= {d})"
+        )
+    P = np.linalg.cholesky(score_correlation(target))
+    for _ in range(SCORE_DRAWS):
+        scores = np.column_stack([rng.permutation(normal_scores(n)) for _ in range(d)])
+        try:
+            Q = np.linalg.cholesky(np.corrcoef(scores, rowvar=False))
+        except np.linalg.LinAlgError:
+            continue
+        T = scores @ (P @ np.linalg.inv(Q)).T
+        out = np.empty_like(u)
+        for j in range(d):
+            ranks = np.argsort(np.argsort(T[:, j]))
+            out[:, j] = np.sort(u[:, j])[ranks]
+        return out
+    raise ValueError(f"no {SCORE_DRAWS} permutations of {n} scores were independent")
 
 
 def draw(
@@ -169,8 +206,9 @@ def draw(
 ) -> np.ndarray:
     """(n, len(distributions)) samples of the inputs.
 
-    correlation : (d, d) target rank correlation (symmetric, positive definite,
-    ones on the diagonal), or None for independent inputs.
+    correlation : (d, d) target rank correlation (Spearman; symmetric, ones
+    on the diagonal, it and its :func:`score_correlation` positive
+    definite), or None for independent inputs; then n > d.
     """
     rng = np.random.default_rng(seed)
     d = len(distributions)

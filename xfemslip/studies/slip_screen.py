@@ -30,12 +30,14 @@ its stress path needs the full solve (``evaluate = "xfem"``).
 
 Along the path each segment part sees sigma_n' = A0 + A1 dp and
 tau = B0 + B1 dp (sigma_n' = sigma_n + p, Terzaghi on the fracture; tension
-positive); it slips when |tau| = c - f sigma_n' (the contact law of
-xfemslip), which is solved on both branches s tau = c - f sigma_n', keeping
-the smallest root in the direction of the change at which the bound is not
-negative (a genuine crossing).  A part already beyond the bound slips at
-dp = 0 (as ``deplete`` reports a fracture slipping in situ).  A fracture's
-critical change is the smallest of its parts'.  The closed form is exact for
+positive); its critical change is the first dp, in the direction of the
+case's change, at which it slips (|tau| = c - f sigma_n', the contact law of
+xfemslip) or opens (sigma_n' = 0), within the pore pressures that can be
+reached (p >= 0 under depletion): :func:`xfemslip.reference.onset.onset`,
+the one law of the screen, the closed forms and this module.  A part
+already at or beyond its limit slips at dp = 0 (as ``deplete`` reports a
+fracture slipping in situ).  A fracture's critical change is the first of
+its parts'.  The closed form is exact for
 a fracture that does not disturb the stress before it slips (isolated, or
 stuck fractures far apart); interaction and stress transfer around a
 reservoir that is not a full-width layer are what the xfem path adds.
@@ -44,9 +46,22 @@ reservoir that is not a full-width layer are what the xfem path adds.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
+
+from xfemslip.reference.onset import (
+    INJECTION,
+    Onset,
+    onset,
+    plane_directions,
+    plane_tractions,
+)
+from xfemslip.reference.screen import (
+    effective_stress,
+    plane_stresses,
+    pressure_to_slip,
+)
 
 UNIAXIAL = "uniaxial_strain"
 CONSTANT_TOTAL = "constant_total_stress"
@@ -250,32 +265,73 @@ def _vector(base: tuple | None, values: dict, prefix: str, n: int) -> np.ndarray
     return out
 
 
-def _plane(S: np.ndarray, c: np.ndarray, s: np.ndarray):
-    """(n . S . n, t . S . n) for t = (c, s), n = (-s, c); S (n, 3)."""
-    xx, yy, xy = S[:, 0], S[:, 1], S[:, 2]
-    return xx * s * s + yy * c * c - 2.0 * xy * s * c, (yy - xx) * s * c + xy * (
-        c * c - s * s
+@dataclass(frozen=True)
+class PathStart:
+    """Where a stress path starts and how its load grows, per sample (n,)."""
+
+    stress: np.ndarray  # (n, 3) in-situ total stress (xx, yy, xy) [Pa]
+    load_rate: np.ndarray  # (n, 3) boundary load change per unit dp [-]
+    pressure: np.ndarray  # (n,) initial pore pressure p0 [Pa]
+    biot: np.ndarray  # (n,) [-]
+    nu_layer: np.ndarray  # (n,) Poisson ratio where the pressure changes
+    nu_host: np.ndarray  # (n,)
+    direction: float  # DEPLETION (-1) or INJECTION (+1): the sign of the change
+
+
+def path_start(spec, values: dict | None = None, n: int = 1) -> PathStart:
+    """The start of ``spec``'s stress path, with the sampled ``values``
+    ({key path: (n,) array}) in place of the case's own."""
+    v = values or {}
+    pore = spec.pore_pressure
+    initial = spec.loading.initial_stress
+    S0 = _vector(initial, v, "loading.initial_stress", n)  # None: from zero
+    S1 = _vector(spec.loading.stress or initial, v, "loading.stress", n)
+    nu_host = v.get("material.nu", spec.material.nu)
+    nu_layer = (
+        v.get("reservoir.nu", spec.reservoir.nu)
+        if spec.reservoir is not None
+        else nu_host
+    )
+    return PathStart(
+        stress=S0,
+        load_rate=(S1 - S0) / pore.change,
+        pressure=np.broadcast_to(v.get("pore_pressure.initial", pore.initial), (n,)),
+        biot=np.broadcast_to(v.get("pore_pressure.biot", pore.biot), (n,)),
+        nu_layer=np.broadcast_to(nu_layer, (n,)),
+        nu_host=np.broadcast_to(nu_host, (n,)),
+        direction=math.copysign(1.0, pore.change),
     )
 
 
-def coulomb_onset(A0, A1, B0, B1, friction, cohesion, sign: float) -> np.ndarray:
-    """First dp (sign(dp) = sign) with |B0 + B1 dp| = c - f (A0 + A1 dp) [Pa].
-
-    0 where the initial state is already at or beyond the bound, NaN where the
-    path never reaches it.  All arguments broadcast to one shape.
-    """
-    f, c = friction, cohesion
-    with np.errstate(divide="ignore", invalid="ignore"):
-        roots = []
-        for s in (1.0, -1.0):
-            r = (c - f * A0 - s * B0) / (s * B1 + f * A1)
-            bound = c - f * (A0 + A1 * r)
-            ok = np.isfinite(r) & (r * sign > 0.0) & (bound >= 0.0)
-            roots.append(np.where(ok, np.abs(r), np.inf))
-    first = np.minimum(roots[0], roots[1])
-    margin0 = c + f * np.maximum(0.0, -A0) - np.abs(B0)
-    out = np.where(np.isfinite(first), sign * first, np.nan)
-    return np.where(margin0 <= 0.0, 0.0, out)
+def segment_onset(path: StressPath, start: PathStart, P0, P1, friction, cohesion):
+    """:func:`xfemslip.reference.onset.onset` of a straight segment P0 -> P1
+    ((n, 2) [m]) along the path: the first of its parts (in the reservoir
+    layer, outside it) to reach its limit.  Its plane tractions are
+    sigma_n' = n.S.n + p, tau = t.S.n (Terzaghi on the fracture), with S and
+    p linear in dp along the path (:func:`_parts`)."""
+    d = np.asarray(P1, float) - np.asarray(P0, float)
+    norm = np.hypot(d[:, 0], d[:, 1])
+    ct, st = d[:, 0] / norm, d[:, 1] / norm
+    A0, B0 = plane_tractions(start.stress, ct, st)
+    inside, outside = _layer_parts(path, P0, P1)
+    change = np.full(d.shape[0], np.nan)
+    opens = np.zeros(d.shape[0], bool)
+    for present, rate, fluid in _parts(path, start):
+        A1, B1 = plane_tractions(rate, ct, st)
+        part = onset(
+            (A0 + start.pressure, A1 + fluid),
+            (B0, B1),
+            friction,
+            cohesion,
+            start.direction,
+            start.pressure,
+        )
+        mask = inside if present else outside
+        better = mask & ~np.isnan(part.change)
+        better &= np.isnan(change) | (np.abs(part.change) < np.abs(change))
+        change = np.where(better, part.change, change)
+        opens = np.where(better, part.opens, opens)
+    return Onset(change, opens)
 
 
 def _segments(spec, document: dict, values: dict, n: int) -> list:
@@ -291,10 +347,10 @@ def _segments(spec, document: dict, values: dict, n: int) -> list:
             item = items[pos]
             angle = values.get(f"fractures[{pos}].angle", float(item["angle"]))
             length = values.get(f"fractures[{pos}].length", float(item["length"]))
-            th = np.radians(np.broadcast_to(angle, (n,)))
+            c, s = plane_directions(np.broadcast_to(angle, (n,)))
             half = 0.5 * np.broadcast_to(length, (n,))
             centre = np.asarray(item["center"], float)
-            d = np.column_stack([np.cos(th), np.sin(th)]) * half[:, None]
+            d = np.column_stack([c, s]) * half[:, None]
             out.append((pos, centre - d, centre + d))
             continue
         pts = np.asarray(fracture.points, float)
@@ -322,67 +378,143 @@ def _layer_parts(path: StressPath, P0, P1):
 
 
 def critical_changes(spec, document, path: StressPath, keys, values) -> np.ndarray:
-    """(n, n_fractures) critical pore-pressure change [Pa] of every sample.
+    """(n, n_fractures) critical pore-pressure change [Pa] of every sample:
+    the first of a fracture's segments to reach its limit
+    (:func:`segment_onset`).
 
     spec : the base CaseSpec; document : the base case's TOML tables;
     keys : input key paths; values : (n, len(keys)) sampled values.
     """
     n = values.shape[0]
     v = {k: values[:, j] for j, k in enumerate(keys)}
-    pore = spec.pore_pressure
-    change = pore.change
-    sign = math.copysign(1.0, change)
-    S0 = _vector(spec.loading.initial_stress, v, "loading.initial_stress", n)
-    S1 = _vector(
-        spec.loading.stress or spec.loading.initial_stress, v, "loading.stress", n
-    )
-    dS = (S1 - S0) / change  # boundary load per unit dp
-    p0 = v.get("pore_pressure.initial", pore.initial)
-    biot = v.get("pore_pressure.biot", pore.biot)
-    nu_host = v.get("material.nu", spec.material.nu)
-    nu_layer = (
-        v.get("reservoir.nu", spec.reservoir.nu)
-        if spec.reservoir is not None
-        else nu_host
-    )
+    start = path_start(spec, v, n)
     out = np.full((n, len(spec.fractures)), np.nan)
     for pos, P0, P1 in _segments(spec, document, v, n):
         fr = spec.fractures[pos]
         f = v.get(f"fractures[{pos}].friction", fr.friction)
         c = v.get(f"fractures[{pos}].cohesion", fr.cohesion)
-        d = P1 - P0
-        norm = np.hypot(d[:, 0], d[:, 1])
-        ct, st = d[:, 0] / norm, d[:, 1] / norm
-        inside, outside = _layer_parts(path, P0, P1)
-        for present, rate, fluid in _parts(path, dS, biot, nu_layer, nu_host):
-            mask = inside if present else outside
-            A0, B0 = _plane(S0, ct, st)
-            A1, B1 = _plane(rate, ct, st)
-            dp = coulomb_onset(A0 + p0, A1 + fluid, B0, B1, f, c, sign)
-            dp = np.where(mask, dp, np.nan)
-            better = np.isnan(out[:, pos]) | (np.abs(dp) < np.abs(out[:, pos]))
-            out[:, pos] = np.where(np.isfinite(dp) & better, dp, out[:, pos])
+        dp = segment_onset(path, start, P0, P1, f, c).change
+        better = np.isnan(out[:, pos]) | (np.abs(dp) < np.abs(out[:, pos]))
+        out[:, pos] = np.where(~np.isnan(dp) & better, dp, out[:, pos])
     return out
 
 
-def _parts(path: StressPath, dS, biot, nu_layer, nu_host):
+def _parts(path: StressPath, start: PathStart):
     """(in the layer?, d sigma / d dp (n, 3), d p_fracture / d dp) of each part."""
+    dS, biot = start.load_rate, start.biot
     n = dS.shape[0]
     if path.kind == CONSTANT_TOTAL:
         return [(True, dS, 1.0)]
-    one = np.ones(n)
 
     def uniaxial(nu, pressure: bool):
-        k = nu / (1.0 - nu) * one
+        k = nu / (1.0 - nu)
         xx = k * dS[:, 1] - (biot * (1.0 - 2.0 * nu) / (1.0 - nu) if pressure else 0.0)
         return np.column_stack([xx, dS[:, 1], np.zeros(n)])
 
-    layer_rate = uniaxial(nu_layer, True)
+    layer_rate = uniaxial(start.nu_layer, True)
     host_pressure = not path.pressure_in_layer_only
     parts = [(True, layer_rate, 1.0)]
     if path.layer is not None:
-        parts.append((False, uniaxial(nu_host, host_pressure), float(host_pressure)))
+        parts.append(
+            (False, uniaxial(start.nu_host, host_pressure), float(host_pressure))
+        )
     return parts
+
+
+# --------------------------------------------------------------------------- #
+# xfemslip screen on a case
+# --------------------------------------------------------------------------- #
+
+
+@dataclass(frozen=True)
+class ScreenPlan:
+    """What ``xfemslip screen`` screens: the in-situ state, the path and the
+    pore-pressure change at which each plane reaches its limit."""
+
+    stress: tuple[float, float, float]  # in-situ total stress [Pa]
+    pore_pressure: float  # in-situ pore pressure [Pa]
+    onsets: list  # one Onset (of one plane) per plane
+    text: str  # the sentence naming the stress path, printed with the report
+    refused: str  # why the case's own path is not followed ("": it is, or none)
+
+
+def _constant_total_text(direction: float) -> str:
+    way = "drops" if direction < 0 else "rises"
+    return (
+        "stress path: constant total stress (the total stress stays as given "
+        f"while the pore pressure {way}: the dp to slip below)"
+    )
+
+
+def screen_plan(spec, planes, stress=None, pore_pressure=None) -> ScreenPlan:
+    """The plan of ``xfemslip screen`` for ``spec`` (a CaseSpec or None).
+
+    planes : [(label, theta [deg], f, c, ends)] with ends = (P0, P1) [m] of a
+    case's segment, or None for a plane given by its angle (screened inside
+    the layer whose pressure changes).  ``stress`` (xx, yy, xy) and
+    ``pore_pressure`` replace the case's in-situ values.  A case with a
+    ``[pore_pressure]`` change is followed along its own stress path
+    (:func:`stress_path`) in the direction of the change; one whose path
+    needs the full solve, and a stress without a case, keep the total stress
+    (:func:`xfemslip.reference.screen.pressure_to_slip`).
+    """
+    pore = None if spec is None else spec.pore_pressure
+    if pore is None or pore.change == 0.0:
+        p = (
+            pore_pressure
+            if pore_pressure is not None
+            else (pore.initial if pore else 0.0)
+        )
+        S = tuple(
+            stress
+            if stress is not None
+            else spec.loading.stress or spec.loading.initial_stress
+        )
+        return ScreenPlan(
+            S, p, _total(S, p, planes, INJECTION), _constant_total_text(1.0), ""
+        )
+    path, why = stress_path(spec)
+    start = path_start(spec)
+    if stress is not None:
+        start = replace(start, stress=np.asarray([stress], float))
+    if pore_pressure is not None:
+        start = replace(start, pressure=np.asarray([pore_pressure], float))
+    p = float(start.pressure[0])
+    if path is None:
+        S = tuple(stress or spec.loading.initial_stress or spec.loading.stress)
+        onsets = _total(S, p, planes, start.direction)
+        return ScreenPlan(S, p, onsets, _constant_total_text(start.direction), why)
+    onsets = []
+    for _, theta, f, c, ends in planes:
+        P0, P1 = _plane_ends(path, theta, ends)
+        onsets.append(segment_onset(path, start, P0, P1, f, c))
+    S = tuple(float(v) for v in start.stress[0])
+    way = "depletion (dp < 0)" if start.direction < 0 else "injection (dp > 0)"
+    return ScreenPlan(
+        S, p, onsets, f"{path.description}; the dp to slip below: {way}", ""
+    )
+
+
+def _total(stress, p, planes, direction) -> list:
+    """Onsets of the planes at constant total stress."""
+    eff = effective_stress(stress, p)
+    out = []
+    for _, theta, f, c, _ in planes:
+        sn, tau = plane_stresses(eff, theta)
+        out.append(pressure_to_slip(sn, tau, f, c, direction, p))
+    return out
+
+
+def _plane_ends(path: StressPath, theta: float, ends):
+    """(P0, P1) (1, 2) of a case's segment, or of a short segment at theta
+    in the middle of the layer whose pressure changes."""
+    if ends is not None:
+        return np.asarray([ends[0]], float), np.asarray([ends[1]], float)
+    y0, y1 = path.layer if path.layer is not None else (0.0, 1.0)
+    c, s = plane_directions(theta)
+    half = 0.25 * (y1 - y0) * np.array([c, s])
+    mid = np.array([0.0, 0.5 * (y0 + y1)])
+    return (mid - half)[None, :], (mid + half)[None, :]
 
 
 def sample_problems(keys, values) -> np.ndarray:

@@ -231,6 +231,14 @@ def loads_uncertainty(text: str, path: str | Path = "<string>") -> UncertaintySp
     levels = _read_levels(table)
     keys, dists = read_inputs(table)
     correlation = read_correlation(table, keys) if keys else None
+    if correlation is not None and samples is not None and samples <= len(keys):
+        # the normal scores of n samples span n - 1 dimensions: their
+        # correlation matrix over the inputs is singular
+        table.error(
+            "samples",
+            f"[[uncertainty.correlation]] needs more samples than inputs "
+            f"({len(keys)}), got {samples}",
+        )
     _check_keys(table, keys, base)
     if problems:
         raise CaseError(path, problems)

@@ -241,7 +241,7 @@ def test_deplete_writes_tables_and_fields(runner, tmp_path):
 
 def test_plots_and_screen_use_the_effective_stress(runner, tmp_path):
     """The Mohr figure reads the effective normal traction, and ``screen``
-    defaults to the case's far-field pore pressure (region "all": p0 + dp)."""
+    starts from the case's in-situ pore pressure p0 and follows its path."""
     from xfemslip.plot.data import figure_data
 
     case = tmp_path / "all.toml"
@@ -254,9 +254,9 @@ def test_plots_and_screen_use_the_effective_stress(runner, tmp_path):
         eff = f["fractures/0/effective_normal_traction"][()]
     np.testing.assert_array_equal(data.fractures[0].normal_traction, eff)
     default = runner.invoke(cli, ["screen", str(case)])
-    given = runner.invoke(cli, ["screen", str(case), "-p", "10.0e6"])
+    given = runner.invoke(cli, ["screen", str(case), "-p", "30.0e6"])
     assert default.exit_code == 0, default.output
-    assert "pore pressure p = 1e+07" in default.output
+    assert "pore pressure p = 3e+07" in default.output
     assert default.output == given.output
 
 

@@ -328,3 +328,97 @@ def test_permeability_figure_draws_the_apertures_and_the_ratio(tmp_path, runner)
     refused = runner.invoke(cli, ["plot", str(plain), "--figure", "permeability"])
     assert refused.exit_code == 2
     assert "no permeability in this result" in refused.output
+
+
+@pytest.fixture(scope="module")
+def depleted(tmp_path_factory):
+    """cases/depleting_reservoir.toml on 20 m cells in two steps (20 MPa of
+    depletion): fractures 0 and 1 slip in the reservoir layer, 2 stays."""
+    import tomllib
+
+    root = tmp_path_factory.mktemp("depleted")
+    case = tomllib.loads((ROOT / "cases" / "depleting_reservoir.toml").read_text())
+    keys = {"mesh.elements": [40, 25], "loading.steps": 2, "output.formats": ["h5"]}
+    (root / "case.toml").write_text(build.case_text(build.with_keys(case, **keys)))
+    result = CliRunner().invoke(
+        cli, ["run", str(root / "case.toml"), "-o", str(root / "out"), "-q"]
+    )
+    assert result.exit_code == 0, result.output
+    return root / "out" / "result.h5"
+
+
+def test_mohr_of_a_depletion_run_is_the_state_at_the_end(depleted):
+    """The circle is the effective stress sigma + p I of the reservoir layer
+    at the final step: the uniaxial-strain closed form (docs/depletion.md),
+    sigma'_xx = -44 + 0.75 * 20 + 10 = -19 MPa, sigma'_yy = -62 + 10 = -52
+    MPa, to the mesh's accuracy; the in-situ circle (-14, -32) MPa is drawn
+    beside it; the points drawn are the fractures' stored effective
+    tractions, red exactly where their state is slip; the text says which
+    fractures slipped and never that no orientation slips."""
+    from xfemslip.conventions import SLIP
+    from xfemslip.plot.figures import figure_mohr
+
+    data = figure_data(depleted)
+    assert data.changed_cells == 40 * 5  # the layer's cells
+    np.testing.assert_allclose(data.changed_stress, (-19e6, -52e6, 0.0), atol=0.05e6)
+    assert data.in_situ_stress == (-14e6, -32e6, 0.0)
+    fig = figure_mohr([data])
+    ax = fig.axes[0]
+    circles = {
+        ln.get_label().split(":")[0]: ln
+        for ln in ax.lines
+        if ln.get_label().endswith("(compressive)")
+    }
+    assert set(circles) == {
+        "in situ",
+        "where the pore pressure changed, final step (median of 200 cells)",
+    }
+    end = circles["where the pore pressure changed, final step (median of 200 cells)"]
+    assert end.get_xdata().min() == pytest.approx(-52e6, abs=0.05e6)
+    assert end.get_xdata().max() == pytest.approx(-19e6, abs=0.05e6)
+    assert circles["in situ"].get_xdata().min() == pytest.approx(-32e6)
+    red = [ln for ln in ax.lines if ln.get_color() == "C3" and ln.get_marker() == "."]
+    assert red[0].get_label() == "contact points in slip $(p_N, |p_T|)$"
+    xs = np.concatenate([ln.get_xdata() for ln in red])
+    ys = np.concatenate([ln.get_ydata() for ln in red])
+    with h5py.File(depleted) as f:
+        slip = [f[f"fractures/{i}/state"][()] == SLIP for i in range(3)]
+        pn = [f[f"fractures/{i}/effective_normal_traction"][()] for i in range(3)]
+        pt = [f[f"fractures/{i}/shear_traction"][()] for i in range(3)]
+    assert [int(s.sum()) for s in slip][2] == 0 and all(s.any() for s in slip[:2])
+    np.testing.assert_array_equal(
+        xs, np.concatenate([p[s] for p, s in zip(pn, slip, strict=True)])
+    )
+    np.testing.assert_array_equal(
+        ys, np.abs(np.concatenate([p[s] for p, s in zip(pt, slip, strict=True)]))
+    )
+    # the slipping points lie on the failure line |tau| = -0.5 sigma_n'
+    np.testing.assert_allclose(ys, -0.5 * xs, rtol=1e-6)
+    texts = [t.get_text() for t in fig.legends[0].get_texts()]
+    assert not any("no orientation slips" in t for t in texts)
+    assert any(t.startswith("slips: $\\beta$") for t in texts)
+    assert ax.get_title().endswith("fractures 0, 1 slip")
+
+
+def test_mohr_never_says_no_orientation_slips_without_the_slipping_points():
+    """A circle below the failure line whose run has slipping points (stress
+    transferred around a reservoir, say): the legend counts them."""
+    from matplotlib.figure import Figure
+
+    from xfemslip.plot.mohr import add_legend, draw_mohr
+
+    for states, words in (
+        ([1, 2, 2, 0], "; 2 contact points of the run slip (red)"),
+        ([1, 1, 1, 0], ""),
+    ):
+        fig = Figure()
+        ax = fig.subplots()
+        contact = [(np.full(4, -20e6), np.full(4, 12e6), np.array(states))]
+        fracture = [("f", 45.0, 0.6, 0.0)]
+        draw_mohr(ax, (-20e6, -40e6, 0.0), fractures=fracture, contact=contact)
+        add_legend(fig)
+        texts = [t.get_text() for t in fig.legends[0].get_texts()]
+        line = [t for t in texts if "no orientation slips" in t]
+        assert line == [
+            f"f = 0.6: no orientation slips under this circle's stress{words}"
+        ]

@@ -9,6 +9,7 @@ tau = t.sigma.n = (20 - 40)/2 = -10 MPa.
 from __future__ import annotations
 
 import math
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -27,6 +28,7 @@ from xfemslip.reference.screen import (
 )
 
 MPA = 1e6
+ROOT = Path(__file__).resolve().parents[3]
 PAPER = (-20 * MPA, -40 * MPA, 0.0)
 
 
@@ -35,16 +37,15 @@ def test_hand_numbers_at_45_degrees():
     assert sn == pytest.approx(-30 * MPA, rel=1e-14)
     assert tau == pytest.approx(-10 * MPA, rel=1e-14)
     assert slip_tendency(sn, tau) == pytest.approx(1 / 3)
-    # f = 0.1: 0.1 * 30 - 10 = -7 MPa, slips; to stop it p must drop 70 MPa
+    # f = 0.1: 0.1 * 30 - 10 = -7 MPa, slips in situ: dp = 0
     assert coulomb_margin(sn, tau, 0.1) == pytest.approx(-7 * MPA)
     fs = screen_fracture("f", 45.0, PAPER, 0.0, 0.1)
-    assert fs.dp_slip == pytest.approx(-70 * MPA) and fs.dp_critical == fs.dp_slip
-    # f = 0.6: 18 - 10 = 8 MPa stable; slips once p rises by 8 / 0.6 MPa
+    assert fs.dp_critical == 0.0 and not fs.opens
+    # f = 0.6: 18 - 10 = 8 MPa stable; slips once p rises by 8 / 0.6 MPa,
+    # before it would open (30 MPa)
     fs = screen_fracture("f", 45.0, PAPER, 0.0, 0.6)
     assert fs.margin == pytest.approx(8 * MPA)
-    assert fs.dp_slip == pytest.approx(8 / 0.6 * MPA)
-    assert fs.dp_open == pytest.approx(30 * MPA)
-    assert fs.dp_critical == pytest.approx(8 / 0.6 * MPA)
+    assert fs.dp_critical == pytest.approx(8 / 0.6 * MPA) and not fs.opens
 
 
 def test_pore_pressure_makes_the_normal_stress_less_compressive():
@@ -55,22 +56,26 @@ def test_pore_pressure_makes_the_normal_stress_less_compressive():
     assert fs.sigma_n_eff == pytest.approx(-20 * MPA)
     assert fs.slip_tendency == pytest.approx(0.5)
     assert fs.margin == pytest.approx(2 * MPA)
-    assert fs.dp_slip == pytest.approx(2 / 0.6 * MPA)
+    assert fs.dp_critical == pytest.approx(2 / 0.6 * MPA)
     # the pressure change found is where the margin is zero
-    at = screen_fracture("f", 45.0, PAPER, 10 * MPA + fs.dp_slip, 0.6)
+    at = screen_fracture("f", 45.0, PAPER, 10 * MPA + fs.dp_critical, 0.6)
     assert at.margin == pytest.approx(0.0, abs=1e-6)
 
 
 def test_cohesion_and_opening_come_first_when_friction_is_zero():
-    # f = 0, c = 12 MPa > |tau| = 10 MPa: stable at any pressure until it opens
-    dp_slip, dp_open, dp_crit = pressure_to_slip(-30 * MPA, -10 * MPA, 0.0, 12 * MPA)
-    assert dp_slip == math.inf and dp_open == pytest.approx(30 * MPA)
-    assert dp_crit == pytest.approx(30 * MPA)
+    # f = 0, c = 12 MPa > |tau| = 10 MPa: tau does not change with p, so the
+    # plane stays stuck until it opens at dp = 30 MPa
+    found = pressure_to_slip(-30 * MPA, -10 * MPA, 0.0, 12 * MPA)
+    assert found.change == pytest.approx(30 * MPA) and found.opens
     # f = 0, c = 5 MPa < |tau|: slipping already, whatever the pressure
-    assert pressure_to_slip(-30 * MPA, -10 * MPA, 0.0, 5 * MPA)[0] == -math.inf
+    assert pressure_to_slip(-30 * MPA, -10 * MPA, 0.0, 5 * MPA).change == 0.0
     # large cohesion with friction: opening (30 MPa) before Coulomb (130 MPa)
-    _, _, dp_crit = pressure_to_slip(-30 * MPA, -10 * MPA, 0.1, 20 * MPA)
-    assert dp_crit == pytest.approx(30 * MPA)
+    found = pressure_to_slip(-30 * MPA, -10 * MPA, 0.1, 20 * MPA)
+    assert found.change == pytest.approx(30 * MPA) and found.opens
+    # at constant total stress a drop of p only closes the plane: never, down
+    # to p = 0
+    found = pressure_to_slip(-30 * MPA, -10 * MPA, 0.6, 0.0, -1.0, 20 * MPA)
+    assert np.isnan(found.change) and not found.opens
 
 
 def test_plane_stresses_match_closed_form_crack_tractions():
@@ -138,7 +143,7 @@ def test_cli_screen_case(runner, tmp_path):
     text = result.stdout
     assert "slip band: beta = 5.83..78.46 deg from sigma1" in text
     assert "fractures[0]: theta = 45.00 deg (beta = 45.00 deg)" in text
-    assert "margin = -7e+06 -> SLIPS already; a pore-pressure drop of 7e+07 Pa" in text
+    assert "margin = -7e+06 -> SLIPS already" in text
     assert (out / "mohr.png").stat().st_size > 10_000
     assert (out / "mohr.pdf").read_bytes()[:4] == b"%PDF"
     rows = csv_path.read_text().splitlines()
@@ -159,7 +164,7 @@ def test_cli_screen_options(runner):
     assert "margin = 2e+06 -> stable; slips at a pore-pressure change dp = " in (
         result.stdout
     )
-    assert "dp = 3.33333e+06 Pa (Coulomb 3.33333e+06, opening 2e+07)" in result.stdout
+    assert "slips at a pore-pressure change dp = 3.33333e+06 Pa" in result.stdout
 
 
 def test_cli_screen_needs_a_stress_and_a_friction(runner):
@@ -174,17 +179,76 @@ def test_cli_screen_needs_a_stress_and_a_friction(runner):
 
 
 def test_cli_screen_states_its_stress_path(runner):
-    """The report says which stress path it assumes; a case that depletes a
-    reservoir region (whose contraction loads the fractures, a path the
-    closed form does not follow) gets a warning naming deplete, a case
-    without one does not."""
+    """Without a pore-pressure change the screen keeps the total stress and
+    raises p, and says so, without a warning."""
     plain = runner.invoke(cli, ["screen", "cases/reservoir_depletion.toml"])
     assert plain.exit_code == 0, plain.stderr
-    assert "stress path: the total stress stays as given" in plain.stdout
+    assert "stress path: constant total stress" in plain.stdout
+    assert "pore pressure rises" in plain.stdout
     assert "WARNING" not in plain.stderr
+
+
+def _dp_line(text: str, label: str) -> float:
+    (line,) = [ln for ln in text.splitlines() if ln.startswith(label + ":")]
+    return float(line.rsplit("dp = ", 1)[1].split()[0])
+
+
+def test_cli_screen_follows_the_depleting_reservoir_path(runner):
+    """cases/depleting_reservoir.toml: a full-width reservoir layer between
+    rollers, depleted: the screen follows uniaxial strain inside the layer
+    and reports a depletion.  By hand (docs/depletion.md), in the layer
+    sigma_xx = -44 MPa - (1 - 2 nu)/(1 - nu) dp with nu = 0.2, sigma_yy =
+    -62 MPa, p = 30 MPa + dp; at 60 degrees (and 120, its mirror image)
+    sigma_n' = -18.5 MPa + (1 - 0.75 * 0.75) dp and |tau| = 7.794 MPa -
+    0.75 sin 60 cos 60 dp, and |tau| = -0.5 sigma_n' at dp = -13.7325 MPa.
+    Fracture 2 lies in the host, whose stress does not change."""
     case = "cases/depleting_reservoir.toml"
-    depleting = runner.invoke(cli, ["screen", case])
-    assert depleting.exit_code == 0, depleting.stderr
-    (line,) = [ln for ln in depleting.stderr.splitlines() if "WARNING" in ln]
-    assert "-2e+07 Pa in its reservoir only" in line
+    result = runner.invoke(cli, ["screen", case, "--step", "90"])
+    assert result.exit_code == 0, result.stderr
+    text = result.stdout
+    assert "WARNING" not in result.stderr
+    assert "stress path: uniaxial strain of a laterally confined layer" in text
+    assert "200 m < y < 300 m" in text and "depletion (dp < 0)" in text
+    assert "pore pressure p = 3e+07" in text
+    k = (1 - 2 * 0.2) / (1 - 0.2)
+    s, c = math.sin(math.radians(60)), math.cos(math.radians(60))
+    a0, a1 = -44e6 * s * s - 62e6 * c * c + 30e6, 1.0 - k * s * s
+    b0, b1 = abs((-62e6 + 44e6) * s * c), k * s * c
+    hand = (b0 + 0.5 * a0) / (b1 - 0.5 * a1)  # b0 - b1 dp = -0.5 (a0 + a1 dp)
+    assert hand == pytest.approx(-13.7325e6, rel=1e-5)
+    for label in ("fractures[0]", "fractures[1]"):
+        assert _dp_line(text, label) == pytest.approx(hand, rel=1e-5)
+    (line,) = [ln for ln in text.splitlines() if ln.startswith("fractures[2]:")]
+    assert line.endswith("stable; neither slips nor opens along the path")
+    # -p replaces the in-situ pore pressure on the same path: with 2 MPa
+    # less, sigma_n' starts 2 MPa more compressive and the onset moves
+    lower = runner.invoke(cli, ["screen", case, "-p", "28e6", "--step", "90"])
+    hand_lower = (b0 + 0.5 * (a0 - 2e6)) / (b1 - 0.5 * a1)
+    assert _dp_line(lower.stdout, "fractures[0]") == pytest.approx(hand_lower, rel=1e-5)
+    # a plane given by its angle is screened inside the layer
+    angle = runner.invoke(
+        cli, ["screen", case, "--angle", "60", "--friction", "0.5", "--step", "90"]
+    )
+    assert _dp_line(angle.stdout, "angle 60") == pytest.approx(hand, rel=1e-5)
+
+
+def test_cli_screen_warns_when_the_case_path_needs_the_full_solve(runner, tmp_path):
+    """A reservoir of finite width stresses its surroundings: the closed form
+    cannot follow it, the screen says why and names deplete, and keeps the
+    total stress in the direction of the case's change (a depletion, which
+    at constant total stress only closes the planes)."""
+    text = (ROOT / "cases" / "depleting_reservoir.toml").read_text()
+    case = tmp_path / "finite.toml"
+    case.write_text(
+        text.replace(
+            "box = [0.0, 200.0, 800.0, 300.0]", "box = [100.0, 200.0, 700.0, 300.0]"
+        )
+    )
+    result = runner.invoke(cli, ["screen", str(case)])
+    assert result.exit_code == 0, result.stderr
+    (line,) = [ln for ln in result.stderr.splitlines() if "WARNING" in ln]
+    assert "does not span the whole width" in line
     assert f"xfemslip deplete {case}" in line
+    assert "constant total stress" in result.stdout
+    assert "pore pressure drops" in result.stdout
+    assert "slips at a pore-pressure change" not in result.stdout
