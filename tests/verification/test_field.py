@@ -248,3 +248,69 @@ def test_fault_fluid_pressure_rules(rule):
     np.testing.assert_allclose(model.pore.fluid(1.0), want, rtol=1e-12)
     start = np.full(y.size, 25.0e6) if not isinstance(rule, str) else p0
     np.testing.assert_allclose(model.pore.fluid(0.0), start, rtol=1e-12)
+
+
+# --------------------------------------------------------------------------- #
+# Pressure changes from a file
+
+
+def _field_case(tmp_path, columns):
+    """cases/depleting_reservoir.toml with its pressure change read from a
+    VTU of three cells (host, reservoir layer, host) instead of region =
+    "reservoir": cell arrays dp (-20 MPa in the layer) and half (-10 MPa)."""
+    import meshio
+
+    pts = np.array(
+        [
+            [0, 0, 0],
+            [800, 0, 0],
+            [800, 200, 0],
+            [0, 200, 0],
+            [800, 300, 0],
+            [0, 300, 0],
+            [800, 500, 0],
+            [0, 500, 0],
+        ],
+        float,
+    )
+    cells = [("quad", np.array([[0, 1, 2, 3], [3, 2, 4, 5], [5, 4, 6, 7]]))]
+    meshio.Mesh(
+        pts,
+        cells,
+        cell_data={
+            "dp": [np.array([0.0, -20.0e6, 0.0])],
+            "half": [np.array([0.0, -10.0e6, 0.0])],
+        },
+    ).write(tmp_path / "dp.vtu")
+    from tests.support.golden import ROOT
+
+    text = (ROOT / "cases" / "depleting_reservoir.toml").read_text()
+    lines = [
+        line
+        for line in text.splitlines()
+        if not line.startswith(("change =", "region ="))
+    ]
+    lines += ["", "[pore_pressure.field]", 'file = "dp.vtu"', f"columns = {columns}"]
+    case = tmp_path / "field.toml"
+    case.write_text("\n".join(lines) + "\n")
+    return ROOT / "cases" / "depleting_reservoir.toml", case
+
+
+@pytest.mark.parametrize("columns", [["dp"], ["half", "dp"]])
+def test_a_field_from_a_file_equals_the_same_change_given_as_units(tmp_path, columns):
+    """The layer's -20 MPa as a VTU cell array gives the run of region =
+    "reservoir" (to round-off: the intact cells' Biot load is summed over
+    their Gauss points); -10 MPa then -20 MPa as two fields is the same
+    straight path in the load factor."""
+    from xfemslip import load_case
+
+    units, field = _field_case(tmp_path, columns)
+    a, b = run_case(load_case(units)), run_case(load_case(field))
+    scale = np.abs(a.displacement).max()
+    np.testing.assert_allclose(b.displacement, a.displacement, atol=1e-12 * scale)
+    for fa, fb in zip(a.fractures, b.fractures, strict=True):
+        np.testing.assert_allclose(fb.slid, fa.slid, atol=1e-12 * 0.01)
+        np.testing.assert_allclose(fb.fluid_pressure, fa.fluid_pressure, rtol=1e-13)
+    np.testing.assert_allclose(
+        b.steps[-1].pore_pressure, a.steps[-1].pore_pressure, rtol=1e-13
+    )
