@@ -171,13 +171,24 @@ def build_model(spec) -> Model:
     F = traction_load(
         mesh, spec.boundary, spec.loading, ec, cand, bulk.dofmap, fractures
     )
+    pieces = None
     if pore is not None:  # Biot body load and fracture fluid load (xfemslip.fem.poro)
         make_contact_effective(contact, pore, ip)
-        F = (
-            F
-            + body_load(mesh, bulk, pore, ec, kernel_backend)
-            + fracture_load(contact, ip, pore)
-        )
+        if not pore.later:
+            F = (
+                F
+                + body_load(mesh, bulk, pore, ec, kernel_backend)
+                + fracture_load(contact, ip, pore)
+            )
+        else:  # several fields from a file: reached in turn (PorePressure.weights)
+            pieces = (
+                pore.weights,
+                [
+                    body_load(mesh, bulk, p, ec, kernel_backend)
+                    + fracture_load(contact, ip, p)
+                    for p in (pore, *pore.later)
+                ],
+            )
     problem = Problem(
         K=bulk.K,
         F_unit=F,
@@ -191,6 +202,7 @@ def build_model(spec) -> Model:
         / mat.E,
         node_xy=mesh.nodes,
         load_stress=stress_increment(spec.loading),
+        load_pieces=pieces,
     )
     logger.info(
         "model: %d x %d cells, %d fracture(s), %d dofs (%d nodes enriched with %d "

@@ -196,7 +196,7 @@ def _describe_in_situ(spec: CaseSpec) -> str:
     else:
         yy = f"{fmt(s.yy)} Pa + {fmt(s.gradient_yy)} Pa/m x depth"
     if s.ratio_xx is None:
-        xx = f"{fmt(s.xx)} Pa + {fmt(s.gradient_xx)} Pa/m x depth"
+        xx = f"sigma_xx = {fmt(s.xx)} Pa + {fmt(s.gradient_xx)} Pa/m x depth"
     elif s.ratio_xx == "uniaxial_strain":
         xx = "sigma'_xx = nu / (1 - nu) sigma'_yy in each unit"
     else:

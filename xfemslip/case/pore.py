@@ -88,8 +88,28 @@ def read_pore_pressure(
 
 def check_region(root: Table, pore: PorePressureSpec | None, units) -> None:
     """``region`` names "all", "reservoir" (with a [reservoir] or a unit of
-    that name) or a unit."""
+    that name) or a unit; with a field from a file, the file gives the
+    change everywhere (no region, no unit's own change)."""
     if pore is None:
+        return
+    if pore.field is not None:
+        if pore.region != "all":
+            root.problems.append(
+                (
+                    "pore_pressure.region",
+                    "is not used with [pore_pressure.field]: the file gives the "
+                    "change everywhere (its outside rule beyond its data)",
+                )
+            )
+        for i, unit in enumerate(units or ()):
+            if unit.change is not None or unit.change_sides is not None:
+                root.problems.append(
+                    (
+                        f"units[{i}].change",
+                        "the pore-pressure change comes from [pore_pressure.field]; "
+                        "leave a unit's change out",
+                    )
+                )
         return
     names = [u.name for u in units or ()]
     if pore.region == "all" or pore.region in names:

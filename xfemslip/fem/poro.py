@@ -90,7 +90,7 @@ floating-point operations whatever the number of zones.
 from __future__ import annotations
 
 import logging
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -160,14 +160,44 @@ class PorePressure:
     point_p0: np.ndarray  # (n_ip,) fluid pressure at load factor 0, eq. (3) [Pa]
     point_ratio: np.ndarray  # (n_ip,) its change / scale at load factor 1 [-]
     uniform_p0: float | None = None  # p0 where it is one value (else None)
+    # a change from a file (field_changes): alpha dp / scale at the 2 x 2
+    # Gauss points of every cell (the intact cells' Biot load), and the
+    # fields after the first, each reached at its own load factor
+    cell_gauss: np.ndarray | None = None  # (n_cells, 4) [-]
+    later: tuple = ()  # PorePressure of fields 2..m
+
+    @property
+    def n_fields(self) -> int:
+        return 1 + len(self.later)
+
+    def weights(self, lam: float) -> np.ndarray:
+        """(m,) share of each field at load factor lam: the change follows
+        the fields in turn, field j reached at lam = j / m (from none at 0),
+        linearly between; with one field, lam itself."""
+        m = self.n_fields
+        if m == 1:
+            return np.array([lam])
+        knots = np.arange(m + 1) / m
+        return np.array(
+            [np.interp(lam, knots, np.eye(m + 1)[j]) for j in range(1, m + 1)]
+        )
+
+    def _sum(self, name: str, lam: float) -> np.ndarray:
+        if not self.later:
+            return lam * self.scale * getattr(self, name)
+        parts = (self, *self.later)
+        return sum(
+            w * p.scale * getattr(p, name)
+            for w, p in zip(self.weights(lam), parts, strict=True)
+        )
 
     def cell_pressure(self, lam: float) -> np.ndarray:
         """(n_cells,) pore pressure at load factor lam (area mean) [Pa]."""
-        return self.cell_p0 + lam * self.scale * self.cell_fraction
+        return self.cell_p0 + self._sum("cell_fraction", lam)
 
     def fluid(self, lam: float) -> np.ndarray:
         """(n_ip,) fluid pressure in the fractures, eq. (3) [Pa]."""
-        return self.point_p0 + lam * self.scale * self.point_ratio
+        return self.point_p0 + self._sum("point_ratio", lam)
 
 
 def cell_centres(mesh) -> np.ndarray:
@@ -315,6 +345,8 @@ def build_pore_pressure(
     p = spec.pore_pressure
     if p is None:
         return None
+    if p.field is not None:
+        return _field_pressure(spec, materials, mesh, ec, ip, fractures)
     zones = materials.zones
     scale = p.change if p.change != 0.0 else 1.0
     ratio = zones.change / scale  # (k,): exactly 1.0 or 0.0 where it is
@@ -355,7 +387,86 @@ def build_pore_pressure(
     )
 
 
-def _fluid(spec, zones, ip, eps, ratio, uniform, fractures):
+# 2 x 2 Gauss points of a cell in its reference square, and the corners' signs
+GAUSS = np.array([-1.0, 1.0]) / np.sqrt(3.0)
+CORNER_X = np.array([-1.0, 1.0, 1.0, -1.0])
+CORNER_Y = np.array([-1.0, -1.0, 1.0, 1.0])
+
+
+def gauss_points(mesh) -> np.ndarray:
+    """(n_cells, 4, 2) the 2 x 2 Gauss points of every cell [m], in the order
+    (xi, eta) = (-, -), (+, -), (-, +), (+, +)."""
+    b = mesh.bounds
+    xc, yc = 0.5 * (b[:, 0] + b[:, 1]), 0.5 * (b[:, 2] + b[:, 3])
+    hx, hy = b[:, 1] - b[:, 0], b[:, 3] - b[:, 2]
+    xi = np.array([GAUSS[0], GAUSS[1], GAUSS[0], GAUSS[1]])
+    eta = np.array([GAUSS[0], GAUSS[0], GAUSS[1], GAUSS[1]])
+    x = xc[:, None] + 0.5 * hx[:, None] * xi[None, :]
+    y = yc[:, None] + 0.5 * hy[:, None] * eta[None, :]
+    return np.stack([x, y], axis=-1)
+
+
+def _field_pressure(spec, materials, mesh, ec, ip, fractures) -> PorePressure:
+    """The pore pressure of a change read from a file ([pore_pressure.field],
+    xfemslip.case.pressure_field): each field interpolated to the 2 x 2 Gauss
+    points of every cell, the enriched cells' quadrature points and the
+    fractures' contact points; one PorePressure per field (scale 1 Pa)."""
+    p = spec.pore_pressure
+    zones = materials.zones
+    field = p.field.field
+    alpha = zones.biot
+    n_qp = 0 if ec is None else ec.qp_w.size
+    qp_zone = materials.qp if materials.qp is not None else np.zeros(n_qp, np.int64)
+    gauss = field.values(gauss_points(mesh).reshape(-1, 2))  # (m, 4 n_cells)
+    qp = field.values(ec.qp_xy) if n_qp else np.zeros((field.n_fields, 0))
+    points = field.values(ip.xy) if ip is not None else np.zeros((field.n_fields, 0))
+    uniform = p.gradient == 0.0 and not np.any(zones.overpressure)
+    centres = cell_centres(mesh)
+    cell_p0 = (
+        np.full(mesh.n_cells, p.initial)
+        if uniform
+        else initial_pressure(spec, zones, centres, materials.cell)
+    )
+    eps = FACE_OFFSET * mesh.h_min
+    out = []
+    for j in range(field.n_fields):
+        g = gauss[j].reshape(mesh.n_cells, 4)
+        fraction = g.mean(axis=1)  # the cell mean: exact for a bilinear field
+        if n_qp:
+            cell_of_qp = np.repeat(np.arange(ec.cells.size), np.diff(ec.qp_offsets))
+            area = np.bincount(cell_of_qp, weights=ec.qp_w, minlength=ec.cells.size)
+            part = np.bincount(
+                cell_of_qp, weights=ec.qp_w * qp[j], minlength=ec.cells.size
+            )
+            fraction[ec.cells] = part / area
+        point_p0, point_ratio = np.zeros(0), np.zeros(0)
+        if ip is not None:
+            point_p0, point_ratio = _fluid(
+                spec, zones, ip, eps, None, uniform, fractures, points[j]
+            )
+        out.append(
+            PorePressure(
+                initial=p.initial,
+                change=0.0,
+                biot=p.biot,
+                scale=1.0,
+                cell_p0=cell_p0,
+                cell_biot=alpha[materials.cell],
+                cell_load=np.zeros(mesh.n_cells),
+                cell_fraction=fraction,
+                qp_alpha=alpha[qp_zone],
+                qp_ratio=qp[j].copy(),
+                point_p0=point_p0,
+                point_ratio=point_ratio,
+                uniform_p0=p.initial if uniform else None,
+                cell_gauss=alpha[materials.cell][:, None] * g,
+            )
+        )
+    first = out[0]
+    return replace(first, later=tuple(out[1:]))
+
+
+def _fluid(spec, zones, ip, eps, ratio, uniform, fractures, values=None):
     """(p_f at load factor 0 [Pa], its change / scale at 1) at every
     interface point, eq. (3): each fracture's rule on its two faces."""
     sides = []
@@ -367,12 +478,13 @@ def _fluid(spec, zones, ip, eps, ratio, uniform, fractures):
             if uniform
             else initial_pressure(spec, zones, ip.xy, zone)
         )
-        sides.append((p0, ratio[zone]))
+        # a field from a file is continuous: both faces take its value
+        sides.append((p0, ratio[zone] if values is None else values))
     (p0_plus, r_plus), (p0_minus, r_minus) = sides
     rules = [getattr(f, "fluid_pressure", "mean") for f in fractures]
     if not rules or all(r == "mean" for r in rules):
         return 0.5 * (p0_plus + p0_minus), 0.5 * (r_plus + r_minus)
-    scale = spec.pore_pressure.change or 1.0
+    scale = (spec.pore_pressure.change or 1.0) if values is None else 1.0
     start = np.empty(ip.n)
     end = np.empty(ip.n)
     for fi, rule in enumerate(rules):
@@ -395,14 +507,17 @@ def body_load(mesh, bulk, pore: PorePressure, ec, backend: str) -> np.ndarray:
     computed by the model's kernel ``backend``.
     """
     F = np.zeros(bulk.dofmap.n_dofs)
-    q = pore.scale * pore.cell_load  # (n_cells,) alpha dp [Pa]
     std = bulk.std_cells
     b = mesh.bounds[std]
     hx, hy = b[:, 1] - b[:, 0], b[:, 3] - b[:, 2]
     xa = np.array([-1.0, 1.0, 1.0, -1.0])
     ya = np.array([-1.0, -1.0, 1.0, 1.0])
-    fx = q[std, None] * xa[None, :] * hy[:, None] / 2.0
-    fy = q[std, None] * ya[None, :] * hx[:, None] / 2.0
+    if pore.cell_gauss is None:
+        q = pore.scale * pore.cell_load  # (n_cells,) alpha dp [Pa]
+        fx = q[std, None] * xa[None, :] * hy[:, None] / 2.0
+        fy = q[std, None] * ya[None, :] * hx[:, None] / 2.0
+    else:  # alpha dp at the 2 x 2 Gauss points: sum_q w_q q_q grad N_a
+        fx, fy = _gauss_biot(pore.scale * pore.cell_gauss[std], hx, hy)
     nodes = mesh.cells[std]
     np.add.at(F, 2 * nodes, fx)
     np.add.at(F, 2 * nodes + 1, fy)
@@ -410,6 +525,20 @@ def body_load(mesh, bulk, pore: PorePressure, ec, backend: str) -> np.ndarray:
         for w, factor in _load_groups(ec, pore):
             _add_enriched_load(F, mesh, bulk, ec, w, factor, pore.scale, backend)
     return F
+
+
+def _gauss_biot(q, hx, hy):
+    """(fx, fy) (n, 4) int grad N_a q dOmega of rectangles hx x hy with q
+    (n, 4) at the 2 x 2 Gauss points (order of :func:`gauss_points`):
+    weights hx hy / 4, dN_a/dx = x_a (1 + y_a eta) / (2 hx) and
+    dN_a/dy = y_a (1 + x_a xi) / (2 hy)."""
+    xi = np.array([GAUSS[0], GAUSS[1], GAUSS[0], GAUSS[1]])
+    eta = np.array([GAUSS[0], GAUSS[0], GAUSS[1], GAUSS[1]])
+    dx = CORNER_X[None, :] * (1.0 + CORNER_Y[None, :] * eta[:, None]) / 2.0  # (q, a)
+    dy = CORNER_Y[None, :] * (1.0 + CORNER_X[None, :] * xi[:, None]) / 2.0
+    fx = (q @ dx) * (hy / 4.0)[:, None]  # hx hy / 4 * 1 / hx
+    fy = (q @ dy) * (hx / 4.0)[:, None]
+    return fx, fy
 
 
 def _load_groups(ec, pore: PorePressure):

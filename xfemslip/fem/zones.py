@@ -97,7 +97,15 @@ def _unit_change(unit, pore) -> float:
     """The pore-pressure change of a unit without sides [Pa]."""
     if unit.change is not None:
         return unit.change
-    if pore is not None and pore.region in ("all", unit.name):
+    if (
+        pore is not None
+        and pore.change is not None
+        and pore.region
+        in (
+            "all",
+            unit.name,
+        )
+    ):
         return pore.change
     return 0.0
 
@@ -114,7 +122,9 @@ def build_zones(spec) -> Zones:
             m.nu,
             biot,
             density,
-            pore.change if pore is not None and pore.region == "all" else 0.0,
+            pore.change
+            if pore is not None and pore.change is not None and pore.region == "all"
+            else 0.0,
             0.0,
         )
     ]

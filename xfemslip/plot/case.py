@@ -117,7 +117,12 @@ def _regions(ax, spec) -> list[str]:
         where = "everywhere" if pore.region == "all" else f"in {pore.region}"
         notes.append(
             f"pore pressure p0 = {pore.initial / 1e6:g} MPa, change "
-            f"\u0394p = {pore.change / 1e6:g} MPa {where} (Biot {pore.biot:g})"
+            + (
+                f"\u0394p = {pore.change / 1e6:g} MPa {where}"
+                if pore.change is not None
+                else f"\u0394p from {pore.field.file.name}"
+            )
+            + f" (Biot {pore.biot:g})"
         )
     return notes
 

@@ -91,6 +91,20 @@ class Problem:
     # (predictor.stress_increment), or None: only used to guess the stick/slip
     # set of a step (predictor.py)
     load_stress: tuple = None
+    # (weights(lam) -> (m,), [F_1 .. F_m]): loads that are not proportional
+    # to lam (pressure changes from a file at several times), added to
+    # lam F_unit as sum_j weights_j(lam) F_j; None: none
+    load_pieces: tuple = None
+
+    def load(self, lam: float) -> np.ndarray:
+        """The external force at load factor lam (n_dofs,) [N/m]."""
+        if self.load_pieces is None:
+            return lam * self.F_unit
+        weights, forces = self.load_pieces
+        F = lam * self.F_unit
+        for w, Fj in zip(weights(lam), forces, strict=True):
+            F = F + w * Fj
+        return F
 
 
 @dataclass
@@ -202,10 +216,9 @@ class NewtonSolver:
 
     def _residual(self, u, lam, res: ContactResult):
         f_int = self.p.K @ u + res.force - self.f_c0
-        r = f_int - lam * self.p.F_unit
-        ref2 = float(
-            np.sum((lam * self.p.F_unit[self.free]) ** 2) + np.sum(r[self.p.fixed] ** 2)
-        )
+        load = self.p.load(lam)
+        r = f_int - load
+        ref2 = float(np.sum(load[self.free] ** 2) + np.sum(r[self.p.fixed] ** 2))
         if self._release is not None:
             ref2 += float(np.sum(self._release**2))
         ref = math.sqrt(ref2)

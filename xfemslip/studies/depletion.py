@@ -357,6 +357,12 @@ def deplete(spec, out_dir=None, *, tolerance=None, plot=False, overwrite=False):
     if not spec.fractures:
         raise UsageError(f"{spec.path}: xfemslip deplete needs at least one fracture")
     change = spec.pore_pressure.change
+    if change is None:
+        raise UsageError(
+            f"{spec.path}: pore_pressure.field: xfemslip deplete scales one "
+            "pore-pressure change from 0 to find the first slip; a change from a "
+            "file is followed by xfemslip run, one load step per field or more"
+        )
     if change == 0.0:
         raise UsageError(
             f"{spec.path}: pore_pressure.change = 0: xfemslip deplete needs a "

@@ -112,6 +112,11 @@ def _load_change(spec) -> np.ndarray:
 def stress_path(spec) -> tuple[StressPath | None, str]:
     """(the path the screen assumes for ``spec``, "") or (None, why it cannot)."""
     pore = spec.pore_pressure
+    if pore is not None and pore.field is not None:
+        return (
+            None,
+            "the pore-pressure change comes from a file ([pore_pressure.field])",
+        )
     if pore is None or pore.change == 0.0:
         return None, "the case has no [pore_pressure] change to follow"
     if spec.loading.in_situ is not None or pore.gradient != 0.0:
@@ -459,7 +464,7 @@ def screen_plan(spec, planes, stress=None, pore_pressure=None) -> ScreenPlan:
     (:func:`xfemslip.reference.screen.pressure_to_slip`).
     """
     pore = None if spec is None else spec.pore_pressure
-    if pore is None or pore.change == 0.0:
+    if pore is None or pore.change in (None, 0.0):
         p = (
             pore_pressure
             if pore_pressure is not None

@@ -139,7 +139,7 @@ def _read_levels(table: Table) -> np.ndarray | None:
 def _check_levels(table: Table, levels: np.ndarray, base_spec) -> None:
     """Levels between 0 and the base case's pore_pressure.change."""
     pore = base_spec.pore_pressure
-    if pore is None or pore.change == 0.0:
+    if pore is None or pore.change in (None, 0.0):
         table.error(
             "levels",
             "the base case needs a [pore_pressure] table with a non-zero change "

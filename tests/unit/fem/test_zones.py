@@ -198,3 +198,17 @@ def test_fluid_rules():
     np.testing.assert_array_equal(fluid_value("higher", plus, minus), [20.0, 30.0])
     np.testing.assert_array_equal(fluid_value("lower", plus, minus), [10.0, 10.0])
     np.testing.assert_array_equal(fluid_value(7.0, plus, minus), [7.0, 7.0])
+
+
+def test_fields_are_reached_in_turn():
+    """m fields: field j at load factor j / m, linear between, none at 0."""
+    from xfemslip.fem.poro import PorePressure
+
+    z = np.zeros(1)
+    p = PorePressure(1.0, 0.0, 1.0, 1.0, z, z, z, z, z, z, z, z)
+    three = type(p)(**{**p.__dict__, "later": (p, p)})
+    np.testing.assert_allclose(three.weights(0.0), [0, 0, 0])
+    np.testing.assert_allclose(three.weights(1 / 6), [0.5, 0, 0])
+    np.testing.assert_allclose(three.weights(0.5), [0.5, 0.5, 0])
+    np.testing.assert_allclose(three.weights(1.0), [0, 0, 1])
+    assert p.weights(0.3)[0] == 0.3
