@@ -46,6 +46,8 @@ class ContactResult:
     pt: np.ndarray  # (m,) [Pa]
     state: np.ndarray  # (m,) int8
     slip_plastic: np.ndarray  # (m,) [m]
+    # accumulated frictional slip delta = int |d g_T^p| (kernels.contact)
+    accumulated: np.ndarray = field(repr=False, default=None)  # (m,) [m]
     # the displacement it was evaluated at (a reference, not a copy: the solver
     # never changes an array in place once it has been evaluated)
     u: np.ndarray = field(repr=False, default=None)  # (n_dofs,) [m]
@@ -76,6 +78,17 @@ class ContactResult:
     def point_state(self) -> np.ndarray:  # (n,) int8
         return self.state[self.contact.patch]
 
+    @property
+    def point_accumulated(self) -> np.ndarray:  # (n,) [m]
+        return self.accumulated[self.contact.patch]
+
+    @property
+    def point_friction(self) -> np.ndarray:  # (n,) [-]
+        """The friction coefficient f(delta) of each point's patch after this
+        evaluation's slip (the static one where it has not slipped)."""
+        c = self.contact
+        return c.friction_at(self.accumulated)[c.patch]
+
 
 @dataclass
 class ContactSet:
@@ -99,8 +112,8 @@ class ContactSet:
     pn0: np.ndarray  # (m,) in-situ normal traction [Pa]
     kn: np.ndarray
     kt: np.ndarray
-    friction: np.ndarray
-    cohesion: np.ndarray
+    friction: np.ndarray  # static f_s [-]
+    cohesion: np.ndarray  # static c_s [Pa]
     n_dofs: int
     fracture: np.ndarray = field(default=None)  # (m,) fracture of each patch
     patch: np.ndarray = field(default=None)  # (n,) patch of each interface point
@@ -114,10 +127,51 @@ class ContactSet:
     pt_committed: np.ndarray = field(default=None)
     # kernel backend of the model ("numba" | "numpy", kernels.choose)
     kernels: str = field(kw_only=True)
+    # slip weakening (kernels.contact): dynamic friction f_d [-] and cohesion
+    # c_d [Pa], reached after slip_distance D_c [m] of accumulated slip; for
+    # constant friction f_d = f_s, c_d = c_s and D_c = inf (the default)
+    friction_dynamic: np.ndarray = field(default=None, kw_only=True)
+    cohesion_dynamic: np.ndarray = field(default=None, kw_only=True)
+    slip_distance: np.ndarray = field(default=None, kw_only=True)
+    # committed accumulated slip delta of each patch [m], like slip_committed
+    accumulated_committed: np.ndarray = field(default=None, kw_only=True)
+
+    def __post_init__(self):
+        if self.friction_dynamic is None:
+            self.friction_dynamic = self.friction.copy()
+        if self.cohesion_dynamic is None:
+            self.cohesion_dynamic = self.cohesion.copy()
+        if self.slip_distance is None:
+            self.slip_distance = np.full(self.weight.size, np.inf)
+        if self.accumulated_committed is None:
+            self.accumulated_committed = np.zeros(self.weight.size)
 
     @property
     def n(self) -> int:
         return self.weight.size
+
+    @property
+    def weakens(self) -> np.ndarray:
+        """(m,) bool: patches whose friction or cohesion weakens with slip."""
+        return (self.friction != self.friction_dynamic) | (
+            self.cohesion != self.cohesion_dynamic
+        )
+
+    def friction_at(self, accumulated) -> np.ndarray:
+        """(m,) friction coefficient f(delta) of every patch at the
+        accumulated slip ``accumulated`` (m,) [m] (kernels.contact.weakened)."""
+        return kernels.backend("numpy").weakened(
+            self.friction, self.friction_dynamic, accumulated, self.slip_distance
+        )
+
+    def history(self) -> tuple:
+        """Copy of the committed history (what ``restore`` takes back)."""
+        return tuple(getattr(self, name).copy() for name in HISTORY)
+
+    def restore(self, history: tuple) -> None:
+        """Set the committed history to ``history`` (from ``history()``)."""
+        for name, value in zip(HISTORY, history, strict=True):
+            setattr(self, name, value.copy())
 
     def evaluate(
         self, u, tangent_mode, pt_prev, gt_prev, scratch=None
@@ -135,7 +189,7 @@ class ContactSet:
         J2 = self.dofs.shape[1]
         out_f = np.zeros((n, J2))
         out_K = np.zeros((n, J2, J2)) if scratch is None else scratch
-        gn, gt, pn, pt, slip = (np.zeros(n) for _ in range(5))
+        gn, gt, pn, pt, slip, accumulated = (np.zeros(n) for _ in range(6))
         state = np.zeros(n, np.int8)
         kernels.backend(self.kernels).contact_response(
             np.ascontiguousarray(u, dtype=np.float64),
@@ -146,10 +200,14 @@ class ContactSet:
             self.weight,
             self.pn0,
             self.slip_committed,
+            self.accumulated_committed,
             self.kn,
             self.kt,
             self.friction,
             self.cohesion,
+            self.friction_dynamic,
+            self.cohesion_dynamic,
+            self.slip_distance,
             int(tangent_mode),
             pt_prev,
             gt_prev,
@@ -161,6 +219,7 @@ class ContactSet:
             pt,
             state,
             slip,
+            accumulated,
         )
         return ContactResult(
             force=scatter_vector(self.dofs, out_f, self.n_dofs),
@@ -171,6 +230,7 @@ class ContactSet:
             pt=pt,
             state=state,
             slip_plastic=slip,
+            accumulated=accumulated,
             u=u,
             contact=self,
         )
@@ -215,6 +275,17 @@ class ContactSet:
         self.state_committed = result.state.copy()
         self.gt_committed = result.gt.copy()
         self.pt_committed = result.pt.copy()
+        self.accumulated_committed = result.accumulated.copy()
+
+
+# The committed history of a ContactSet, in the order of history()/restore().
+HISTORY = (
+    "slip_committed",
+    "state_committed",
+    "gt_committed",
+    "pt_committed",
+    "accumulated_committed",
+)
 
 
 def _point_jumps(u, dofs, coef) -> np.ndarray:
@@ -431,6 +502,26 @@ def _or_nan(value):
     return np.nan if value is None else value
 
 
+def _weakening_arrays(fractures, frac, friction, cohesion) -> dict:
+    """friction_dynamic, cohesion_dynamic and slip_distance (m,) of the
+    patches (fractures[frac[p]] each): the fracture's slip-weakening law, or
+    the static values and D_c = inf for constant friction."""
+    out = {
+        "friction_dynamic": friction.copy(),
+        "cohesion_dynamic": cohesion.copy(),
+        "slip_distance": np.full(frac.size, np.inf),
+    }
+    for fi, fr in enumerate(fractures):
+        law = getattr(fr, "weakening", None)
+        if law is None:
+            continue
+        mine = frac == fi
+        out["friction_dynamic"][mine] = law.dynamic_friction
+        out["cohesion_dynamic"][mine] = law.dynamic_cohesion
+        out["slip_distance"][mine] = law.slip_distance
+    return out
+
+
 def build_contact(
     mesh,
     fractures,
@@ -470,6 +561,7 @@ def build_contact(
         name: np.array([_or_nan(getattr(fractures[f], name)) for f in frac], float)
         for name in ("kn", "kt", "friction", "cohesion")
     }
+    par |= _weakening_arrays(fractures, frac, par["friction"], par["cohesion"])
     # mean cell size over each patch, for the automatic penalty
     h = np.bincount(patch, weights=ip.weight * _cell_size(mesh, ip.cell)) / W
     for name in ("kn", "kt"):

@@ -39,6 +39,8 @@ OPTIONAL_FRACTURE_ARRAYS = (
     "effective_normal_traction",
     "aperture",
     "transmissivity",
+    "accumulated_slip",
+    "friction_coefficient",
 )
 BULK_ARRAYS = ("stress", "stress_zz", "principal_stress")
 OPTIONAL_BULK_ARRAYS = ("effective_stress", "pore_pressure")

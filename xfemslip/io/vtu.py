@@ -39,7 +39,12 @@ from xfemslip.post.fields import FractureFields, VisMesh
 logger = logging.getLogger(__name__)
 
 FRACTURE_POINT_DATA = ("slip", "opening", "normal_traction", "shear_traction")
-OPTIONAL_FRACTURE_POINT_DATA = ("aperture", "transmissivity")
+OPTIONAL_FRACTURE_POINT_DATA = (
+    "aperture",
+    "transmissivity",
+    "accumulated_slip",
+    "friction_coefficient",
+)
 
 
 def write_bulk(
@@ -145,8 +150,9 @@ def write_fractures(
     ``shear_traction``, ``contact_pressure`` = max(0, -normal_traction) [Pa],
     ``state`` (int32: 0 open, 1 stick, 2 slip), ``s`` [m] and ``fracture``
     (the index), with ``faces`` the two displacements above, and with
-    ``[permeability]`` also ``aperture`` [m] and ``transmissivity`` [m^3].
-    Points are 3D with z = 0.
+    ``[permeability]`` also ``aperture`` [m] and ``transmissivity`` [m^3],
+    with a slip-weakening friction ``accumulated_slip`` [m] and
+    ``friction_coefficient`` [-].  Points are 3D with z = 0.
 
     Returns
     -------
@@ -261,7 +267,7 @@ def _fracture_part(
     part["state"] = np.asarray(fields.state, dtype=np.int32).reshape(n_points)
     part["s"] = s
     part["fracture"] = np.full(n_points, index, dtype=np.int32)
-    for name in OPTIONAL_FRACTURE_POINT_DATA:  # [permeability]: a [m], a^3/12 [m^3]
+    for name in OPTIONAL_FRACTURE_POINT_DATA:  # [permeability], slip weakening
         value = getattr(fields, name, None)
         if value is not None:
             part[name] = np.asarray(value, dtype=np.float64).reshape(n_points)

@@ -11,7 +11,8 @@ for enriched elements).  Out-of-plane stress in plane strain:
 sigma_zz = nu (sigma_xx + sigma_yy) (the in-situ sigma_zz is taken as
 nu (sigma0_xx + sigma0_yy), consistent with plane strain); zero in plane stress.
 Fracture fields: slip = [[u]] . t, opening = [[u]] . n, p_N, p_T and the state
-codes of :mod:`xfemslip.conventions`.
+codes of :mod:`xfemslip.conventions`; with a slip-weakening friction also the
+accumulated slip and the friction coefficient it leaves.
 """
 
 from __future__ import annotations
@@ -43,6 +44,9 @@ class FractureFields:
     # with [permeability] only (xfemslip.post.hydraulics)
     aperture: np.ndarray | None = None  # (K,) hydraulic aperture a [m]
     transmissivity: np.ndarray | None = None  # (K,) a^3 / 12 [m^3]
+    # with a slip-weakening friction only (kernels.contact)
+    accumulated_slip: np.ndarray | None = None  # (K,) delta = int |d g_T^p| [m]
+    friction_coefficient: np.ndarray | None = None  # (K,) f(delta) [-]
 
 
 @dataclass
@@ -156,6 +160,9 @@ def fracture_fields(ip, res, n_fractures, fluid=None) -> list[FractureFields]:
             pf = np.asarray(fluid, float)[m].copy()
             extra = {"fluid_pressure": pf, "effective_normal_traction": pn}
             pn = pn - pf
+        if _weakening_law(res, m):
+            extra["accumulated_slip"] = res.point_accumulated[m].copy()
+            extra["friction_coefficient"] = res.point_friction[m].copy()
         out.append(
             FractureFields(
                 s=ip.s[m].copy(),
@@ -169,6 +176,16 @@ def fracture_fields(ip, res, n_fractures, fluid=None) -> list[FractureFields]:
             )
         )
     return out
+
+
+def _weakening_law(res, points) -> bool:
+    """Whether the interface points ``points`` lie on a fracture with a
+    slip-weakening friction (a finite slip distance; constant Coulomb has
+    D_c = inf)."""
+    c = getattr(res, "contact", None)
+    if c is None or res.accumulated is None or points.size == 0:
+        return False
+    return bool(np.isfinite(c.slip_distance[c.patch[points]]).any())
 
 
 def vis_mesh(mesh, ec, bulk, u) -> VisMesh:
