@@ -164,6 +164,13 @@ class ContactSet:
             self.friction, self.friction_dynamic, accumulated, self.slip_distance
         )
 
+    def cohesion_at(self, accumulated) -> np.ndarray:
+        """(m,) cohesion c(delta) [Pa] of every patch at the accumulated slip
+        ``accumulated`` (m,) [m]."""
+        return kernels.backend("numpy").weakened(
+            self.cohesion, self.cohesion_dynamic, accumulated, self.slip_distance
+        )
+
     def history(self) -> tuple:
         """Copy of the committed history (what ``restore`` takes back)."""
         return tuple(getattr(self, name).copy() for name in HISTORY)
@@ -286,6 +293,33 @@ HISTORY = (
     "pt_committed",
     "accumulated_committed",
 )
+
+
+@dataclass(frozen=True)
+class PatchGeometry:
+    """Where the contact patches of a ContactSet lie: what path following
+    (xfemslip.solve.continuation) reports a nucleation with."""
+
+    centre: np.ndarray  # (m, 2) length-weighted centre of each patch [m]
+    s: np.ndarray  # (m,) arc length of that centre along its fracture [m]
+    fracture: np.ndarray  # (m,) case-file index of each patch's fracture
+
+
+def patch_geometry(contact: ContactSet, ip, fracture_ids) -> PatchGeometry:
+    """The PatchGeometry of ``contact`` built on the interface points ``ip``;
+    ``fracture_ids`` gives the case-file index of each fracture position
+    (``[fr.index for fr in model.fractures]``)."""
+    m = contact.n
+    W = np.bincount(contact.patch, weights=ip.weight, minlength=m)
+
+    def mean(values):
+        return np.bincount(contact.patch, weights=ip.weight * values, minlength=m) / W
+
+    return PatchGeometry(
+        centre=np.column_stack([mean(ip.xy[:, 0]), mean(ip.xy[:, 1])]),
+        s=mean(ip.s),
+        fracture=np.asarray(fracture_ids, np.int64)[contact.fracture],
+    )
 
 
 def _point_jumps(u, dofs, coef) -> np.ndarray:
