@@ -123,7 +123,6 @@ def local_search(c, law, u, res, r, stubborn, c_dofs, K_ff, free, mode):
     c : the true contact law; c_dofs, K_ff, free : its dofs on, the bulk
     stiffness of, and the free dofs of the Newton system; mode : the tangent.
     """
-    near = local_branches.neighbours(c_dofs, K_ff, stubborn)
     # slip-weakening patches stay out: on them the slip branch is not affine
     # in the jump (the bound softens with the slip increment), which the
     # search's closed form assumes; Newton handles them under the true law
@@ -131,6 +130,7 @@ def local_search(c, law, u, res, r, stubborn, c_dofs, K_ff, free, mode):
     first = np.nonzero(stubborn & constant)[0]
     if first.size == 0:
         return None
+    near = local_branches.neighbours(c_dofs, K_ff, stubborn)
     # open neighbours stay out: the search has no open branch, and its
     # Woodbury form assumes a closed (stick) block for every member
     rest = np.nonzero(near & ~stubborn & constant & (res.state != OPEN))[0]
