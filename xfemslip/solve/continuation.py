@@ -41,13 +41,19 @@ The path in two stages:
 
 The control measures the slip of the fault itself, so its step size is
 measured in slip: dc = ``slip_step`` D_c times the slipping length (potency)
-or D_c (max_slip), D_c the smallest slip distance of the weakening patches;
+or D_c (max_slip), D_c the smallest slip distance of the weakening patches,
+and at most ``load_step`` over the path's slope (near first slip the
+control answers mostly through the elastic penalty, where a slip-sized step
+is a huge load step);
 it grows by 1.5 after a step converged in at most EASY_ITERATIONS iterations
 and halves after one that needed HARD_ITERATIONS or more, within
 [``min_slip_step``, ``max_slip_step``]; a failed step is retried at a quarter
 of it, and a step that fails at ``min_slip_step`` is a ConvergenceError (one
 line: step, iteration, residual), with the converged steps kept in
-``solver.completed``.
+``solver.completed``.  A converged state that has left the path (its load
+factor moved by more than ``load_step``, or a patch slipped by far more than
+the step: an equilibrium of a fault ruptured well beyond the nucleation
+patch, which reaches the same control value) counts as a failed step.
 
 **Limit point.**  A step whose end has dlambda/dc <= 0 or a lambda below the
 previous one brackets the maximum of lambda between its two ends.  The
@@ -112,6 +118,10 @@ APPROACH_OVERSHOOT = 1.0e-3
 # ... and at least this fraction of load_step, so that a patch predicted on
 # its bound (a prediction of zero) still moves the path.
 APPROACH_MIN_STEP = 1.0e-6
+# A converged control step whose slip on some weakening patch exceeds this
+# many times the step's slip (the control step over its length) has left the
+# path (_check_excursion).
+EXCURSION = 50.0
 # Lag of the plastic slip (a fraction of the elastic slip p_T / k_T) that
 # puts a committed slipping patch on its slip branch for the first tangent of
 # a path started from a committed slipping state (_slipping_tangent).
@@ -123,7 +133,7 @@ class ContinuationOptions:
     """Options of :func:`follow_to_nucleation` (slip steps in units of D_c)."""
 
     max_load: float = 1.0  # the path ends at this load factor [-]
-    load_step: float = 0.05  # load-factor step of the approach [-]
+    load_step: float = 0.05  # largest load-factor change of one step [-]
     approach_slip: float = 0.02  # largest slip at the end of the approach [D_c]
     control: str = "potency"  # "potency" | "max_slip"
     slip_step: float = 0.02  # first control step [D_c]
@@ -397,6 +407,14 @@ class _Follower:
                 self.c0 = float(a @ u[s.free])
                 self._origin = a
             dc = size * self.dc * self._control_scale(here.res)
+            # no step should move the load factor by more than load_step:
+            # near first slip the control answers mostly through the
+            # elastic penalty, and a slip-sized step there is a huge load step
+            if here.x_f is None:
+                here.x_f = self._load_response(here)
+                here.slope = self._slope(a, here.x_f)
+            if here.slope > 0.0:
+                dc = min(dc, opt.load_step / here.slope)
             try:
                 end = self._bordered(here, a, dc, k)
             except ConvergenceError as err:
@@ -417,7 +435,7 @@ class _Follower:
                     size,
                 )
                 continue
-            if end.lam > opt.max_load and end.slope > 0.0:
+            if end.lam > opt.max_load:  # reached on the rising path
                 self._finish_at_max_load(here.u, k)
                 return
             if end.slope <= 0.0 or end.lam < here.lam:
@@ -485,6 +503,7 @@ class _Follower:
         for it in range(s.max_it + 1):
             g = dc - float(a @ (u[free] - u0[free]))
             if it > 0 and eta <= s.tol and abs(g) <= 1e-12 * abs(dc):
+                self._check_excursion(start, u, lam, res, dc, k, it, eta)
                 x_f = s.solve_tangent(res, self._load_derivative(res), k, it, eta)
                 return _State(u, lam, res, it, self._slope(a, x_f), x_f)
             if it == s.max_it:
@@ -506,6 +525,25 @@ class _Follower:
             if not np.isfinite(eta):
                 raise self._error(k, it + 1, eta, "the residual is not finite")
         raise self._error(k, s.max_it, eta, f"no convergence in {s.max_it} iterations")
+
+    def _check_excursion(self, start, u, lam, res, dc, k, it, eta) -> None:
+        """ConvergenceError when a converged state lies off the path: its
+        load factor moved by more than load_step, or a weakening patch
+        slipped by more than EXCURSION times the step's slip (dc over the
+        control's length).  Such an equilibrium exists (a fault ruptured
+        far beyond the nucleation patch, at another load: the same control
+        value is reached there too), but Newton only got there by leaving
+        the neighbourhood of the start; a smaller step stays on the path."""
+        moved = abs(lam - start.lam)
+        slip = float(np.max(np.abs(res.accumulated - start.res.accumulated)[self.weak]))
+        step_slip = dc / self._control_scale(start.res)
+        if moved > self.opt.load_step:
+            why = f"the step left the path (load factor moved by {moved:.3g})"
+        elif slip > EXCURSION * step_slip:
+            why = f"the step left the path (a patch slipped by {slip:.3g} m)"
+        else:
+            return
+        raise self._error(k, it, eta, why)
 
     def _load_derivative(self, res) -> np.ndarray:
         """dR/dlambda on the free dofs: -F_ext plus the tangent times the
@@ -548,6 +586,10 @@ class _Follower:
                 lo, lo_state = mid, state
             else:
                 hi, hi_state = mid, state
+        if max(lo_state.lam, hi_state.lam) > opt.max_load:
+            # the maximum lies beyond the load: the rising path reaches it
+            self._finish_at_max_load(start.u, k)
+            return
         if lo_state is not start:
             self._record(
                 k,
