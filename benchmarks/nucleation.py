@@ -22,7 +22,6 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))  # tests.support
 from tests.support import nucleation as ur  # noqa: E402
-
 from xfemslip.solve.continuation import (  # noqa: E402
     ContinuationOptions,
     follow_to_nucleation,

@@ -65,7 +65,7 @@ def test_nucleation_length_on_20_cells():
     n = _nucleation(1.0, "gaussian")
     assert abs(_error(n)) <= 0.03
     assert n.max_slip < ur.DC
-    assert abs(n.x) <= 1.0 and n.fracture == 0
+    assert abs(n.x) <= 1.0 + 1e-9 and n.fracture == 0  # a patch centre at +-h
 
 
 @pytest.mark.slow

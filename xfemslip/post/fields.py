@@ -151,6 +151,7 @@ def fracture_fields(ip, res, n_fractures, fluid=None) -> list[FractureFields]:
     p_f are reported too (xfemslip.fem.poro).
     """
     out = []
+    weakening = _weakening_law(res)
     for fi in range(n_fractures):
         m = np.nonzero(ip.fracture == fi)[0]
         m = m[np.argsort(ip.s[m], kind="stable")]
@@ -160,7 +161,7 @@ def fracture_fields(ip, res, n_fractures, fluid=None) -> list[FractureFields]:
             pf = np.asarray(fluid, float)[m].copy()
             extra = {"fluid_pressure": pf, "effective_normal_traction": pn}
             pn = pn - pf
-        if _weakening_law(res, m):
+        if weakening:
             extra["accumulated_slip"] = res.point_accumulated[m].copy()
             extra["friction_coefficient"] = res.point_friction[m].copy()
         out.append(
@@ -178,14 +179,14 @@ def fracture_fields(ip, res, n_fractures, fluid=None) -> list[FractureFields]:
     return out
 
 
-def _weakening_law(res, points) -> bool:
-    """Whether the interface points ``points`` lie on a fracture with a
-    slip-weakening friction (a finite slip distance; constant Coulomb has
-    D_c = inf)."""
+def _weakening_law(res) -> bool:
+    """Whether a fracture of the contact set has a slip-weakening friction
+    (a finite slip distance; constant Coulomb has D_c = inf): every fracture
+    then reports its accumulated slip and friction."""
     c = getattr(res, "contact", None)
-    if c is None or res.accumulated is None or points.size == 0:
+    if c is None or res.accumulated is None:
         return False
-    return bool(np.isfinite(c.slip_distance[c.patch[points]]).any())
+    return bool(np.isfinite(c.slip_distance).any())
 
 
 def vis_mesh(mesh, ec, bulk, u) -> VisMesh:

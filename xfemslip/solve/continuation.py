@@ -86,9 +86,10 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from xfemslip.contact.interface import ContactResult, PatchGeometry
-from xfemslip.conventions import OPEN, SLIP
+from xfemslip.conventions import OPEN, SLIP, STICK
 from xfemslip.errors import ConvergenceError
 from xfemslip.fem.assembly import scatter_vector
+from xfemslip.solve import remedies
 
 logger = logging.getLogger(__name__)
 
@@ -366,10 +367,11 @@ class _Follower:
         law = dataclasses.replace(c, slip_committed=c.slip_committed - lag)
         return law.evaluate(u, s.mode, c.pt_committed, c.gt_committed)
 
-    def _first_slip(self, res, k) -> float:
-        """Load-factor increment [-] at which the first closed weakening
+    def _first_slip(self, res, k, x_f=None) -> float:
+        """Load-factor increment [-] at which the first sticking weakening
         patch reaches its bound, extrapolated linearly with the tangent of
-        res (inf when none is predicted to).
+        res (inf when none is predicted to); x_f: K_t^-1 dR/dlambda there
+        (None: solved here).
 
         Per patch p_N(d) = p_N + d p_N', p_T(d) = p_T + d p_T' with the
         rates of the jump rate -K_t^-1 dR/dlambda; the bound B = c - f p_N
@@ -378,7 +380,9 @@ class _Follower:
         d = (B + p_T) / (f p_N' - p_T')."""
         s, c = self.solver, self.c
         rate = np.zeros(s.p.n_dofs)
-        rate[s.free] = -s.solve_tangent(res, self._load_derivative(res), k, 0, 0.0)
+        if x_f is None:
+            x_f = s.solve_tangent(res, self._load_derivative(res), k, 0, 0.0)
+        rate[s.free] = -x_f
         rate[s.p.fixed] = s.p.fixed_values
         jump = np.where(c.dofs >= 0, rate[np.maximum(c.dofs, 0)], 0.0)
         jx = (c.coef * jump[:, 0::2]).sum(axis=1)
@@ -391,7 +395,7 @@ class _Follower:
             plus = (bound - res.pt) / (dpt + f * dpn)
             minus = (bound + res.pt) / (f * dpn - dpt)
         ahead = np.concatenate([plus, minus])
-        closed = np.tile(self.weak & (res.state != OPEN), 2)
+        closed = np.tile(self.weak & (res.state == STICK), 2)
         ahead = ahead[closed & np.isfinite(ahead) & (ahead > 0.0)]
         return float(ahead.min()) if ahead.size else math.inf
 
@@ -414,7 +418,11 @@ class _Follower:
                 here.x_f = self._load_response(here)
                 here.slope = self._slope(a, here.x_f)
             if here.slope > 0.0:
-                dc = min(dc, opt.load_step / here.slope)
+                # the path is linear until the slipping set changes: the
+                # step ends just past the next patch predicted to slip
+                ahead = self._first_slip(here.res, k, here.x_f)
+                ahead = min((1.0 + APPROACH_OVERSHOOT) * ahead, opt.load_step)
+                dc = min(dc, ahead / here.slope)
             try:
                 end = self._bordered(here, a, dc, k)
             except ConvergenceError as err:
@@ -500,6 +508,7 @@ class _Follower:
         u, lam = u0.copy(), start.lam
         res = c.evaluate(u, s.mode, c.pt_committed, c.gt_committed)
         r, eta = s.residual(u, lam, res)
+        seen = []  # the stick/slip sets of the iterates
         for it in range(s.max_it + 1):
             g = dc - float(a @ (u[free] - u0[free]))
             if it > 0 and eta <= s.tol and abs(g) <= 1e-12 * abs(dc):
@@ -508,6 +517,13 @@ class _Follower:
                 return _State(u, lam, res, it, self._slope(a, x_f), x_f)
             if it == s.max_it:
                 break
+            regime = remedies.regimes(res.state, res.pt).tobytes()
+            if regime in seen[:-1]:
+                # the set came back after another one: the full steps cycle
+                # between sets around the step's end; a shorter step ends
+                # closer to the start's set
+                raise self._error(k, it, eta, "the stick/slip states cycle")
+            seen.append(regime)
             tangent = converged if it == 0 and converged.blocks is not None else res
             x_r = s.solve_tangent(tangent, r, k, it, eta)
             x_f = s.solve_tangent(tangent, self._load_derivative(tangent), k, it, eta)

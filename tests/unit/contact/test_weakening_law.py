@@ -204,3 +204,39 @@ def test_local_search_skips_weakening_patches():
         c, c, u, None, None, stubborn, None, None, None, TANGENT_CONSISTENT
     )
     assert out is None
+
+
+def test_mixed_fractures_all_carry_the_history_in_every_output(tmp_path):
+    """One weakening and one constant fracture: both carry accumulated_slip
+    and friction_coefficient in result.h5 (the constant one its friction)
+    and in fractures.vtu, read back as written."""
+    import meshio
+
+    from xfemslip.case import build, loads_case
+
+    table = {
+        "domain": {"size": [6.0, 6.0]},
+        "mesh": {"elements": [12, 12]},
+        "material": {"E": 10.0e9, "nu": 0.3},
+        "fractures": [
+            {"points": POINTS, "friction": _law(), "tip": "ramp"},
+            {"points": [[0.5, 5.0], [2.5, 5.5]], "friction": 0.25, "tip": "ramp"},
+        ],
+        "loading": {"stress": build.stress_table((-20.0e6, -40.0e6, 0.0))},
+        "boundary": {"bottom": {"ux": 0.0, "uy": 0.0}, "top": "traction"},
+        "output": {"formats": ["h5", "vtu"]},
+    }
+    run_case(loads_case(build.case_text(table)), tmp_path)
+    weak, plain = read_result(tmp_path).fractures
+    assert np.all(plain.friction_coefficient == 0.25)
+    assert np.all(weak.friction_coefficient <= FS)
+    assert np.any(weak.friction_coefficient < FS)
+    np.testing.assert_allclose(
+        weak.friction_coefficient,
+        FS - (FS - FD) * np.minimum(weak.accumulated_slip / DC, 1.0),
+    )
+    vtu = meshio.read(tmp_path / "fractures.vtu")
+    both = np.concatenate([weak.accumulated_slip, plain.accumulated_slip])
+    np.testing.assert_allclose(
+        np.sort(vtu.point_data["accumulated_slip"]), np.sort(both)
+    )
