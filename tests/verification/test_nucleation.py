@@ -74,7 +74,8 @@ def test_nucleation_length_converges_and_does_not_depend_on_the_load_shape():
     3 % of 2 a_c, the error shrinking with h, the two shapes within 1 % of
     each other on each mesh while their onset load factors differ (the shape
     changes when, not how long)."""
-    found = {(h, s): _nucleation(h, s) for h in (1.0, 0.5) for s in ("gaussian", "parabola")}  # fmt: skip
+    shapes = ("gaussian", "parabola")
+    found = {(h, s): _nucleation(h, s) for h in (1.0, 0.5) for s in shapes}
     for n in found.values():
         assert abs(_error(n)) <= 0.03
         assert n.max_slip < ur.DC
