@@ -22,8 +22,8 @@ Measured (benchmarks/nucleation.py, docs/method.md "Nucleation"): error of
 =====================  ========  ========  ========  ========
 cells over 2 a_c       10.3      20.6      41.2      82.3
 =====================  ========  ========  ========  ========
-Gaussian               +6.9 %    +0.90 %   +0.29 %   see docs
-parabola               +7.2 %    +0.94 %   see docs  see docs
+Gaussian               +6.94 %   +0.90 %   +0.29 %   +0.08 %
+parabola               +7.15 %   +0.94 %   +0.31 %   +0.08 %
 =====================  ========  ========  ========  ========
 """
 
