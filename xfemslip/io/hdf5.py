@@ -33,6 +33,8 @@ or for the derived quantities ``"m^2"``, ``"m^3"``, ``"N m/m"``, ``"N m"``)::
                               max_slip_increment [m] and
                               moment_per_length_increment [N m/m] of the
                               step's own slip; attr extent_given
+    with a slip-weakening friction on a fracture, every fracture also:
+    accumulated_slip [m] and friction_coefficient [-]
     with [permeability] (xfemslip.post.hydraulics) also: per fracture aperture
     [m] and transmissivity [m^3], and /permeability/ with step (S,), in_situ
     (2, 2) and tensor (S, 2, 2) [m^2], initial_aperture (F,) [m], attrs block,
@@ -282,6 +284,8 @@ def _write_fracture(group: h5py.Group, fracture: FractureFields) -> None:
         ("aperture", "m"),  # with [permeability]
         ("transmissivity", "m^3"),
         ("utilisation", "-"),  # None only in a result read from an older file
+        ("accumulated_slip", "m"),  # with a slip-weakening friction
+        ("friction_coefficient", "-"),
     )
     for name, units in optional:
         value = getattr(fracture, name, None)

@@ -46,6 +46,8 @@ OPTIONAL_FRACTURE_ARRAYS = (
     "aperture",
     "transmissivity",
     "utilisation",
+    "accumulated_slip",
+    "friction_coefficient",
 )
 BULK_ARRAYS = ("stress", "stress_zz", "principal_stress")
 OPTIONAL_BULK_ARRAYS = ("effective_stress", "pore_pressure")

@@ -97,12 +97,11 @@ class DepletionReport:
 
 def _history(contact):
     """Copy of the committed friction history of a contact set."""
-    return tuple(getattr(contact, name).copy() for name in COMMITTED)
+    return contact.history()
 
 
 def _restore(contact, history) -> None:
-    for name, value in zip(COMMITTED, history, strict=True):
-        setattr(contact, name, value.copy())
+    contact.restore(history)
 
 
 def _slipping(contact, res, fi) -> np.ndarray:
@@ -280,7 +279,10 @@ def _step_and_bisect(solver, model, steps, tolerance, onsets, patch_length) -> N
                 )
                 lam_lo = onsets[fi].dp_lower / change if change else 0.0
                 pn_lo, pt_lo = (
-                    (contact.pn0.copy(), bracket.history[3].copy())
+                    (
+                        contact.pn0.copy(),
+                        bracket.history[COMMITTED.index("pt_committed")].copy(),
+                    )
                     if lo_res is None
                     else (lo_res.pn, lo_res.pt)
                 )
