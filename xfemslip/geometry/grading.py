@@ -184,8 +184,16 @@ def _pl_max(f: _Field, g: _Field) -> _Field:
     return _Field(m.xs, -m.vs)
 
 
+# a cell count no mesh can have: what an axis needs when int dx / s
+# overflows (a cell size far below the axis' length), for the element-count
+# check to refuse
+UNBOUNDED_CELLS = 10**18
+
+
 def _cells(phi: float) -> int:
     """Whole cells for int dx / s = phi (rounded up after ROUND_SLACK)."""
+    if not math.isfinite(phi) or phi > UNBOUNDED_CELLS:
+        return UNBOUNDED_CELLS
     return max(1, math.ceil(phi * (1.0 - ROUND_SLACK)))
 
 

@@ -396,6 +396,10 @@ DEPLETION_DATASETS = (
     ("x", "m"),
     ("y", "m"),
     ("dp_patch", "Pa"),
+    ("dp_seismic", "Pa"),
+    ("nucleation_length", "m"),
+    ("x_nucleation", "m"),
+    ("y_nucleation", "m"),
 )
 
 

@@ -254,6 +254,15 @@ def _depletion(h5: h5py.File) -> DepletionTable | None:
         at_singularity=g["first_slip_at_singularity"][()].astype(bool),
         singularity=tuple(_text(v) for v in g.attrs.get("singularity", ())),
         dp_patch=g["dp_patch"][()],
+        **{
+            name: g[name][()] if name in g else np.full(len(g["dp_patch"]), np.nan)
+            for name in (
+                "dp_seismic",
+                "nucleation_length",
+                "x_nucleation",
+                "y_nucleation",
+            )
+        },
         patch_length=float(g.attrs["patch_length"]),
         tolerance=float(g.attrs["tolerance"]),
     )

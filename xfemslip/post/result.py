@@ -94,6 +94,11 @@ class DepletionTable:
     at_singularity: np.ndarray  # bool: first slip at or next to a singular point
     singularity: tuple[str, ...]  # what it is ("" when not)
     dp_patch: np.ndarray  # the slipping length first reaches patch_length [Pa]
+    # slip-weakening friction: equilibrium lost (a seismic event nucleates)
+    dp_seismic: np.ndarray  # [Pa]
+    nucleation_length: np.ndarray  # [m]
+    x_nucleation: np.ndarray  # [m]
+    y_nucleation: np.ndarray
     patch_length: float  # [m]; NaN when not asked for
     tolerance: float  # of the bisections [Pa]
 

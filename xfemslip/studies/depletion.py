@@ -77,6 +77,12 @@ class FractureOnset:
     # the pore-pressure change at which the slipping length first reaches
     # the patch length asked for (bisected like the first slip) [Pa]
     dp_patch: float = np.nan
+    # with a slip-weakening friction: where quasi-static equilibrium is lost
+    # on this fracture (the nucleation of a seismic event), NaN when not
+    dp_seismic: float = np.nan  # [Pa]
+    nucleation_length: float = np.nan  # the slipping patch 2a then [m]
+    x_nucleation: float = np.nan  # the point of largest slip [m]
+    y_nucleation: float = np.nan
 
     @property
     def dp_critical(self) -> float:
@@ -310,6 +316,72 @@ def _step_and_bisect(solver, model, steps, tolerance, onsets, patch_length) -> N
         lam0 = lam1
 
 
+def weakening_path(solver, model, onsets, patch_length=None):
+    """Deplete a case with a slip-weakening friction: follow the equilibrium
+    path (xfemslip.solve.continuation, its states the steps written) to the
+    loss of equilibrium or the end of the change, and read the first slip,
+    the patch length and the seismic onset of every fracture off it.
+
+    A load-stepped bisection cannot pass the limit point where the slip
+    turns seismic (there is no equilibrium beyond it); the path follows the
+    slip instead.  The first slip is bracketed by the path's states (the
+    approach to it steps just past the predicted first slip), the patch
+    length by the first state that reaches it.  A path that fails is a
+    ConvergenceError, the converged states kept: never a wrong onset."""
+    from xfemslip.contact.interface import patch_geometry
+    from xfemslip.solve.continuation import ContinuationOptions, follow_to_nucleation
+
+    change = model.pore.change
+    onsets[:] = [FractureOnset(fracture=fr.index) for fr in model.fractures]
+    ids = [fr.index for fr in model.fractures]
+    steps = model.spec.loading.steps
+    options = ContinuationOptions(max_load=1.0, load_step=1.0 / steps)
+    path = follow_to_nucleation(
+        solver, patch_geometry(model.contact, model.ip, ids), options
+    )
+    contact, centres = model.contact, _patch_centres(model)
+    previous = 0.0
+    for r in solver.completed:
+        lam, res = r.load_factor, r.contact
+        for fi, onset in enumerate(onsets):
+            slipping = _slipping(contact, res, fi)
+            if np.isnan(onset.dp_upper) and slipping.any():
+                onset.dp_lower, onset.dp_upper = previous * change, lam * change
+                first = np.nonzero(slipping)[0]
+                bound = (
+                    contact.cohesion[first] - contact.friction[first] * res.pn[first]
+                )
+                util = np.abs(res.pt[first]) / np.where(bound > 0.0, bound, np.inf)
+                j = first[np.argmax(util)]
+                onset.x, onset.y = (float(v) for v in centres[j])
+                others = any(np.isfinite(o.dp_upper) and o is not onset for o in onsets)
+                _note_singularity(model, onset, fi, j, others)
+            if (
+                patch_length is not None
+                and np.isnan(onset.dp_patch)
+                and slipping_length(contact, res, fi) >= patch_length
+            ):
+                onset.dp_patch = lam * change
+        previous = lam
+    n = path.nucleation
+    if n is not None:
+        fi = ids.index(n.fracture)
+        onsets[fi].dp_seismic = n.load_factor * change
+        onsets[fi].nucleation_length = n.length
+        onsets[fi].x_nucleation, onsets[fi].y_nucleation = n.x, n.y
+        logger.info(
+            "fracture %d: quasi-static equilibrium is lost at dp = %.6g Pa (the "
+            "slip turns seismic): slipping patch %.4g m, largest slip at "
+            "(%.4g, %.4g)",
+            n.fracture,
+            onsets[fi].dp_seismic,
+            n.length,
+            n.x,
+            n.y,
+        )
+    return onsets, solver.completed
+
+
 def _note_singularity(model, onset, fi, patch, others_slip=False) -> None:
     """Record and say whether the first slip sits at a singular point."""
     what = at_singularity(model, fi, patch, others_slip)
@@ -539,8 +611,23 @@ def deplete(
         spec,
         out_dir,
         overwrite,
-        lambda solver, model: critical_depletion(
-            solver, model, spec.loading.steps, tolerance, report.onsets, patch_length
+        (
+            (
+                lambda solver, model: weakening_path(
+                    solver, model, report.onsets, patch_length
+                )
+            )
+            if any(f.weakening is not None for f in spec.fractures)
+            else (
+                lambda solver, model: critical_depletion(
+                    solver,
+                    model,
+                    spec.loading.steps,
+                    tolerance,
+                    report.onsets,
+                    patch_length,
+                )
+            )
         ),
         finish,
         # the series' time is the size of the pore-pressure change reached
@@ -569,6 +656,10 @@ def depletion_table(report: DepletionReport) -> DepletionTable:
         at_singularity=np.array([a.at_singularity for a in o], bool),
         singularity=tuple(a.singularity for a in o),
         dp_patch=col("dp_patch"),
+        dp_seismic=col("dp_seismic"),
+        nucleation_length=col("nucleation_length"),
+        x_nucleation=col("x_nucleation"),
+        y_nucleation=col("y_nucleation"),
         patch_length=np.nan if report.patch_length is None else report.patch_length,
         tolerance=report.tolerance,
     )
@@ -593,6 +684,10 @@ def write_tables(report: DepletionReport, out_dir: Path) -> list:
                 "singularity",
                 "patch_length_m",
                 "dp_patch_length_Pa",
+                "dp_seismic_Pa",
+                "nucleation_length_m",
+                "x_nucleation_m",
+                "y_nucleation_m",
             ]
         )
         length = report.patch_length if report.patch_length is not None else np.nan
@@ -611,6 +706,10 @@ def write_tables(report: DepletionReport, out_dir: Path) -> list:
                     o.singularity,
                     f"{length:.6g}",
                     f"{o.dp_patch:.9g}",
+                    f"{o.dp_seismic:.9g}",
+                    f"{o.nucleation_length:.6g}",
+                    f"{o.x_nucleation:.6g}",
+                    f"{o.y_nucleation:.6g}",
                 ]
             )
     table = out_dir / "slip_vs_depletion.csv"
@@ -651,6 +750,11 @@ def depletion_lines(table: DepletionTable) -> list[str]:
                 "(mesh-dependent)"
             )
         lines.append(text)
+        if np.isfinite(table.dp_seismic[i]):
+            lines.append(
+                f"    the slip turns seismic at dp = {table.dp_seismic[i] / 1e6:.4g} "
+                f"MPa (nucleation length {table.nucleation_length[i]:.4g} m)"
+            )
         if np.isfinite(table.patch_length):
             reached = table.dp_patch[i]
             lines.append(
@@ -685,6 +789,12 @@ def format_report(report: DepletionReport) -> str:
             lines.append(
                 f"{'':>8} first slip at {o.singularity}, where the stress is "
                 "singular: this depletion depends on the mesh"
+            )
+        if np.isfinite(o.dp_seismic):
+            lines.append(
+                f"{'':>8} the slip turns seismic at dp = {o.dp_seismic:.6g} Pa: "
+                f"nucleation length {o.nucleation_length:.4g} m at "
+                f"({o.x_nucleation:.4g}, {o.y_nucleation:.4g})"
             )
     if report.patch_length is not None:
         lines.append(

@@ -58,7 +58,18 @@ def scan_onset(state_at, friction, cohesion, direction, p0):
         sn, tau = state_at(np.atleast_1d(np.asarray(dp, float)))
         one = np.ones(sn.shape)
         state = coulomb_return_map(
-            0.0 * one, tau, 0.0 * one, sn, one, one, friction * one, cohesion * one
+            0.0 * one,
+            tau,
+            0.0 * one,
+            0.0 * one,
+            sn,
+            one,
+            one,
+            friction * one,
+            cohesion * one,
+            friction * one,
+            cohesion * one,
+            np.inf * one,
         )[2]
         return state != STICK
 
