@@ -339,7 +339,11 @@ def _dataset(
     """Create one dataset without timestamps and tag it with its units."""
     interrupt.checkpoint()  # between data sets: a deferred signal stops here
     refuse_non_finite(value, f"{group.name}/{name}")
-    dataset = group.create_dataset(name, data=value, track_times=False)
+    # a Fletcher-32 checksum per chunk: a flipped bit fails the read of the
+    # data set instead of reading as a wrong number (scalars take no filter)
+    dataset = group.create_dataset(
+        name, data=value, track_times=False, fletcher32=np.ndim(value) > 0
+    )
     dataset.attrs["units"] = units
     return dataset
 

@@ -5,6 +5,7 @@ imports matplotlib, and the commands write PNG and PDF."""
 from __future__ import annotations
 
 import os
+import shutil
 import subprocess
 import sys
 from pathlib import Path
@@ -110,6 +111,26 @@ def test_deformed_mesh_uses_the_split_mesh(two_runs):
         jump = max(jump, float(np.ptp(np.linalg.norm(u, axis=1))))
     slip = np.abs(data.fractures[0].slip).max()
     assert jump > 0.5 * slip
+
+
+def test_a_result_vtu_of_another_run_is_not_drawn_and_said(two_runs, tmp_path, runner):
+    """result.vtu beside result.h5 carries its run's run_id: one of another
+    run (here the 63-degree run's) is named in a warning and left out (the
+    figures draw result.h5's own mesh), never drawn as if it belonged."""
+    folder = tmp_path / "mixed"
+    folder.mkdir()
+    shutil.copy(two_runs[0] / "result.h5", folder / "result.h5")
+    shutil.copy(two_runs[1] / "result.vtu", folder / "result.vtu")
+    assert figure_data(folder / "result.h5").vis_edges is None
+    own = figure_data(two_runs[0] / "result.h5")
+    assert own.vis_edges is not None
+    result = runner.invoke(
+        cli, ["plot", str(folder), "-o", str(tmp_path / "f"), "--format", "png"]
+    )
+    assert result.exit_code == 0, result.stderr
+    warnings = [ln for ln in result.stderr.splitlines() if ln.startswith("WARNING:")]
+    assert len(warnings) == 1 and str(folder / "result.vtu") in warnings[0]
+    assert "is not of the run that wrote" in warnings[0]
 
 
 def test_piece_outlines_drop_inner_edges_of_one_side():
