@@ -9,9 +9,10 @@ import numpy as np
 
 from xfemslip.case.specs import PorePressureSpec, ReservoirSpec
 from xfemslip.case.tables import (
+    BIOT,
     COORDINATE,
+    POISSON,
     POSITIVE,
-    Range,
     Table,
     check_number,
     frozen,
@@ -32,7 +33,7 @@ def read_pore_pressure(root: Table) -> PorePressureSpec | None:
     start = len(table.problems)
     initial = table.number("initial")
     change = table.number("change")
-    biot = table.number("biot", 1.0, Range(0.0, 1.0, lo_open=True))
+    biot = table.number("biot", 1.0, BIOT)
     region = table.choice("region", PORE_PRESSURE_REGIONS, "all")
     if region == "reservoir" and not root.has("reservoir"):
         table.error(
@@ -156,7 +157,7 @@ def read_reservoir(root: Table, grid) -> ReservoirSpec | None:
     else:
         boxes = _read_boxes(table)
     E = table.number("E", rule=POSITIVE)
-    nu = table.number("nu", rule=Range(0.0, 0.5, hi_open=True))
+    nu = table.number("nu", rule=POISSON)
     if boxes is not None and grid is not None:
         x, y = grid.mesh.x, grid.mesh.y
         cx, cy = np.meshgrid(0.5 * (x[1:] + x[:-1]), 0.5 * (y[1:] + y[:-1]))
