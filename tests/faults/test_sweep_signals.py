@@ -297,6 +297,7 @@ def test_a_signal_stops_an_xfem_uncertainty_study(tmp_path, sig):
     assert harness.leftovers(tmp_path / "out") == []
 
 
+@pytest.mark.slow  # a million samples (test_writers checks the writer itself)
 def test_a_signal_stops_a_screen_study_while_it_writes(tmp_path):
     """A million samples by the closed form: the signal comes while
     uncertainty.csv is written (its temporary file is there); the study

@@ -18,7 +18,13 @@ import h5py
 import numpy as np
 
 from xfemslip.errors import ResultError
-from xfemslip.io.result_check import check_attrs, check_layout, check_result, reading
+from xfemslip.io.result_check import (
+    check_attrs,
+    check_final_copy,
+    check_layout,
+    check_result,
+    reading,
+)
 from xfemslip.post.fields import FractureFields, StepFields
 from xfemslip.post.result import EventTable, PermeabilityHistory, Result
 
@@ -217,6 +223,7 @@ def read_result(path: str | Path) -> Result:
                 events=_events(h5),
                 permeability=_permeability(h5),
             )
+            check_final_copy(h5, path)
         except KeyError:  # a dataset or attribute of the format is missing
             raise ResultError(
                 f"{path}: not a result.h5 of xfemslip (a dataset of "

@@ -13,6 +13,9 @@ three places:
 - :func:`reading`, around the reading itself: an error of HDF5 (a checksum,
   a truncated file), a dataset or attribute missing, a value of the wrong
   type;
+- :func:`check_final_copy`: a file of several load steps holds the final
+  step's displacement and fracture fields twice, at the root and in
+  ``/steps``; both copies must be the same (a reader of either sees one run);
 - :func:`check_result`, on what was read: the shapes the output format
   gives (one row per node, cell, contact point, converged step, fracture),
   cells that name existing nodes, contact states 0, 1 or 2, finite numbers
@@ -29,6 +32,7 @@ from __future__ import annotations
 import contextlib
 import os
 import re
+import tomllib
 from collections.abc import Iterator
 from dataclasses import fields
 from pathlib import Path
@@ -39,7 +43,7 @@ import numpy as np
 from xfemslip.conventions import OPEN, SLIP, STICK
 from xfemslip.errors import ResultError
 
-__all__ = ["check_layout", "check_result", "reading"]
+__all__ = ["check_final_copy", "check_layout", "check_result", "reading"]
 
 # A dataset is stored uncompressed by the writer; a foreign file may
 # compress, but not beyond this ratio (a header claiming more is damaged).
@@ -104,6 +108,34 @@ def check_layout(h5: h5py.File, path: Path) -> None:
         h5.visititems(visit)
 
 
+def check_final_copy(h5: h5py.File, path: Path) -> None:
+    """The root copy of the final step equals its ``/steps`` group."""
+    if "steps" not in h5 or not len(h5["steps"]):
+        return
+    last = h5["steps"][sorted(h5["steps"], key=int)[-1]]
+    pairs = [("fields/displacement", "fields/displacement")]
+    if "fractures" in last or "fractures" in h5:
+        if "fractures" not in last or "fractures" not in h5:
+            raise _bad(path, "/fractures and the final step's fractures differ")
+        ours, theirs = h5["fractures"], last["fractures"]
+        if sorted(ours) != sorted(theirs):
+            raise _bad(path, "/fractures and the final step's fractures differ")
+        for index in theirs:
+            names = set(theirs[index]) | set(ours[index])
+            pairs += [
+                (f"fractures/{index}/{n}", f"fractures/{index}/{n}") for n in names
+            ]
+    for root_name, step_name in sorted(pairs):
+        if root_name not in h5 or step_name not in last:
+            raise _bad(path, f"/{root_name}: missing at the root or in the final step")
+        a, b = h5[root_name], last[step_name]
+        if a.shape != b.shape or not np.array_equal(a[()], b[()]):
+            raise _bad(
+                path,
+                f"/{root_name} differs from its copy in the final step {last.name}",
+            )
+
+
 def check_attrs(attrs: dict, path: Path) -> None:
     """The root attributes a result needs, of the right type."""
     for name, types in REQUIRED_ATTRS.items():
@@ -122,6 +154,10 @@ def check_attrs(attrs: dict, path: Path) -> None:
         )
     if "run_id" in attrs and not isinstance(attrs["run_id"], int | np.integer):
         raise _bad(path, f"the root attribute 'run_id' is {attrs['run_id']!r}")
+    try:
+        tomllib.loads(attrs["case_toml"])
+    except tomllib.TOMLDecodeError as exc:
+        raise _bad(path, f"the case text case_toml is not TOML ({exc})") from None
 
 
 def _array(value, where: str, path: Path, shape: tuple, *, finite=True, ints=False):

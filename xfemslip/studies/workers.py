@@ -33,7 +33,6 @@ from __future__ import annotations
 
 import collections
 import ctypes
-import logging
 import os
 import pickle
 import signal
@@ -46,8 +45,6 @@ from multiprocessing import get_context
 from multiprocessing.connection import wait
 
 from xfemslip import interrupt
-
-logger = logging.getLogger(__name__)
 
 # A worker that has not unwound its task this long after SIGTERM is killed.
 GRACE_S = 1.0
@@ -79,11 +76,9 @@ def _unwind(signum, frame) -> None:
     the sweep kills a worker that takes longer than GRACE_S."""
     _handle(_noted)  # a Python handler: SIG_IGN would make Python raise
     # "signal ignored due to race condition" for a signal already arriving
-    raise (
-        interrupt.Terminated("SIGTERM")
-        if signum == signal.SIGTERM
-        else (KeyboardInterrupt())
-    )
+    if signum == signal.SIGTERM:
+        raise interrupt.Terminated("SIGTERM")
+    raise KeyboardInterrupt
 
 
 def _noted(signum, frame) -> None:

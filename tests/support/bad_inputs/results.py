@@ -201,6 +201,11 @@ EDITS = {
     "slip-row-short": _rows_short("fractures/0/slip"),
     "slip-strings": _replace("fractures/0/slip", np.array([b"x"] * 4)),
     "case-not-toml": _attr("case_toml", "[[[ not toml"),
+    "step-displacement-3-columns": lambda h5: _replace(
+        "steps/0002/fields/displacement", np.zeros((len(h5["mesh/points"]), 3))
+    )(h5),
+    "step-slip-row-short": _rows_short("steps/0002/fractures/0/slip"),
+    "step-load-factor-nan": _attr("load_factor", np.nan, where="steps/0001"),
     "mesh-missing": lambda h5: h5.__delitem__("mesh"),
 }
 PERMEABILITY_EDITS = (

@@ -124,9 +124,8 @@ def test_a_result_vtu_of_another_run_is_not_drawn_and_said(two_runs, tmp_path, r
     assert figure_data(folder / "result.h5").vis_edges is None
     own = figure_data(two_runs[0] / "result.h5")
     assert own.vis_edges is not None
-    result = runner.invoke(
-        cli, ["plot", str(folder), "-o", str(tmp_path / "f"), "--format", "png"]
-    )
+    args = ["plot", str(folder), "-o", str(tmp_path / "f"), "--format", "png"]
+    result = runner.invoke(cli, [*args, "--figure", "deformed_mesh"])
     assert result.exit_code == 0, result.stderr
     warnings = [ln for ln in result.stderr.splitlines() if ln.startswith("WARNING:")]
     assert len(warnings) == 1 and str(folder / "result.vtu") in warnings[0]
