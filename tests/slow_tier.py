@@ -32,6 +32,7 @@ SLOW_TESTS = frozenset(
         "tests/property/test_properties.py::test_return_map_lands_in_the_cone_and_is_idempotent",
         "tests/regression/test_cases.py::test_key_scalars_match_golden[depleting_reservoir]",
         "tests/regression/test_cases.py::test_key_scalars_match_golden[fracture_network]",
+        "tests/regression/test_cases.py::test_output_contract[fracture_network]",
         "tests/regression/test_cases.py::test_key_scalars_match_golden[liu_borja_plate]",
         "tests/regression/test_cases.py::test_key_scalars_match_golden[permeability]",
         "tests/regression/test_cases.py::test_linear_solvers_match_golden[depleting_reservoir-pardiso]",

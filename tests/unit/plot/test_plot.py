@@ -38,8 +38,7 @@ PNG = b"\x89PNG\r\n\x1a\n"
 
 @pytest.fixture(scope="module")
 def two_runs(tmp_path_factory):
-    """The small case at 45 and 63 degrees (result.h5 + vtu); the first run
-    with --plot."""
+    """The small case at 45 and 63 degrees (result.h5 + vtu)."""
     root = tmp_path_factory.mktemp("plots")
     runner = CliRunner()
     outs = []
@@ -48,15 +47,18 @@ def two_runs(tmp_path_factory):
         keys = {"fractures.0.angle": angle, "output.formats": ["h5", "vtu"]}
         case.write_text(build.case_text(build.with_keys(CASE, **keys)))
         out = root / f"{int(angle):03d}_angle={angle:g}"
-        plot = ["--plot"] if angle == 45.0 else []
-        result = runner.invoke(cli, ["run", str(case), "-o", str(out), *plot])
+        result = runner.invoke(cli, ["run", str(case), "-o", str(out)])
         assert result.exit_code == 0, result.output
         outs.append(out)
     return outs
 
 
-def test_run_plot_writes_every_figure_as_png_and_pdf(two_runs):
-    figures = two_runs[0] / "figures"
+def test_run_plot_writes_every_figure_as_png_and_pdf(two_runs, tmp_path):
+    case = two_runs[0].parent / "a45.toml"
+    out = tmp_path / "out"
+    result = CliRunner().invoke(cli, ["run", str(case), "-o", str(out), "--plot"])
+    assert result.exit_code == 0, result.output
+    figures = out / "figures"
     for kind in KINDS:
         assert (figures / f"{kind}.png").read_bytes()[:8] == PNG
         assert (figures / f"{kind}.pdf").read_bytes()[:4] == b"%PDF"
