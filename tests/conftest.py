@@ -1,4 +1,5 @@
-"""Shared pytest configuration: the ``--run-slow`` opt-in for ``slow`` tests,
+"""Shared pytest configuration: the ``--run-slow`` opt-in for ``slow`` tests
+(marked where they are defined, or named in ``tests/slow_tier.py``),
 the ``xfemslip`` logger put back after each test, and ``runner``, the CLI
 runner of the command tests."""
 
@@ -20,9 +21,20 @@ def pytest_addoption(parser: pytest.Parser) -> None:
     )
 
 
+def pytest_configure(config: pytest.Config) -> None:
+    from tests.support import tiers
+
+    tiers.SLOW = bool(config.getoption("--run-slow"))
+
+
 def pytest_collection_modifyitems(
     config: pytest.Config, items: list[pytest.Item]
 ) -> None:
+    from tests.slow_tier import SLOW_TESTS
+
+    for item in items:
+        if item.nodeid in SLOW_TESTS or item.nodeid.split("[")[0] in SLOW_TESTS:
+            item.add_marker(pytest.mark.slow)
     if config.getoption("--run-slow"):
         return
     skip_slow = pytest.mark.skip(reason="slow: run with --run-slow")

@@ -15,7 +15,7 @@ stays cheap: neither NumPy nor Numba is loaded until it is used):
   traction, state) and the run's attributes (:mod:`xfemslip.post.result`);
 - ``errors`` and its classes ``XfemslipError``, ``CaseError``,
   ``UsageError``, ``MeshError``, ``GeometryError``, ``ConvergenceError``,
-  ``OutputError``.
+  ``OutputError`` and its ``ResultError`` (a file that is not a result).
 
 >>> import xfemslip
 >>> spec = xfemslip.load_case("cases/liu_borja_plate.toml")  # doctest: +SKIP
@@ -42,6 +42,7 @@ __all__ = [
     "MeshError",
     "OutputError",
     "Result",
+    "ResultError",
     "UsageError",
     "XfemslipError",
     "__version__",
@@ -68,6 +69,7 @@ _LAZY = {
             "GeometryError",
             "ConvergenceError",
             "OutputError",
+            "ResultError",
         )
     },
 }

@@ -87,3 +87,14 @@ class ConvergenceError(XfemslipError):
 
 class OutputError(XfemslipError):
     """Output that cannot be written (unwritable directory, disk full, ...)."""
+
+
+class ResultError(OutputError, UsageError):
+    """A file read as a ``result.h5`` that is not one: missing, not HDF5,
+    damaged (a checksum, a truncated file) or not what the output format
+    says (a dataset missing, of the wrong shape, non-finite).
+
+    It is an ``OutputError``, what :func:`xfemslip.read_result` promises,
+    and a ``UsageError``: the file is bad input to the command that reads
+    it, so the command-line reports it in one line with exit code 2.
+    """

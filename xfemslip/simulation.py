@@ -17,10 +17,11 @@ from pathlib import Path
 import numpy as np
 
 from xfemslip import __version__, interrupt, kernels
+from xfemslip.case.specs import CaseSpec
 from xfemslip.contact.interface import ContactSet, build_contact
 from xfemslip.contact.predictor import stress_increment
 from xfemslip.conventions import OPEN, SLIP, STATE_CODES, STICK
-from xfemslip.errors import ConvergenceError, GeometryError
+from xfemslip.errors import ConvergenceError, GeometryError, UsageError
 from xfemslip.fem.assembly import BulkSystem, assemble_bulk
 from xfemslip.fem.boundary import dirichlet, hold_enriched, traction_load
 from xfemslip.fem.enrichment import EnrichedCells, build_enriched_cells, find_candidates
@@ -323,8 +324,11 @@ def run_case(spec, out_dir: Path | str | None = None, *, overwrite: bool = False
     ------
     ConvergenceError when a load step fails, after writing the converged
     steps (``converged = false``); its ``result`` holds them.  UsageError when
-    ``out_dir`` holds results and ``overwrite`` is False.
+    ``spec`` is not a CaseSpec (a path, a dict, None: load it with
+    :func:`xfemslip.load_case` first), or ``out_dir`` holds results and
+    ``overwrite`` is False.
     """
+    require_spec(spec, "run_case")
     done = solve_and_write(
         spec, out_dir, overwrite, lambda solver, _: solver.run(spec.loading.steps)
     )
@@ -333,6 +337,23 @@ def run_case(spec, out_dir: Path | str | None = None, *, overwrite: bool = False
         raise done.failure
     logger.info("Newton iterations per load step: %s", done.result.iterations_per_step)
     return done.result
+
+
+def require_spec(spec, function: str) -> None:
+    """UsageError unless ``spec`` is a CaseSpec (the one thing the solve
+    entry points take: a case that went through the case loader)."""
+    if isinstance(spec, CaseSpec):
+        return
+    kind = type(spec).__name__
+    shown = repr(spec) if isinstance(spec, str | Path) else kind
+    hint = (
+        f"; load it first: {function}(xfemslip.load_case({shown}))"
+        if isinstance(spec, str | Path)
+        else ""
+    )
+    raise UsageError(
+        f"{function} needs a CaseSpec from xfemslip.load_case(path), got {kind}{hint}"
+    )
 
 
 @dataclass
@@ -436,7 +457,8 @@ def collect_result(model: Model, results, *, converged, wall):
         "xfemslip_version": __version__,
         "case_toml": spec.text,
         "converged": bool(converged),
-        "load_steps": int(spec.loading.steps),
+        # the case's steps, or more: the states of a followed path
+        "load_steps": int(max(spec.loading.steps, len(fields))),
         "newton_iterations": int(sum(iterations)),
         "newton_iterations_per_step": np.array(iterations, dtype=np.int64),
         # load-step bisections per written step (0 = not cut)

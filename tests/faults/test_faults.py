@@ -80,6 +80,9 @@ def test_signal_during_a_run_leaves_no_partial_file(tmp_path, sig, code, name):
         stderr=subprocess.PIPE,
         text=True,
         env=env,
+        # SIGINT as in a terminal: a suite started in the background (a
+        # script, CI) hands its children SIGINT ignored
+        preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL),
     )
     lines = []
     deadline = time.monotonic() + 120

@@ -28,6 +28,7 @@ from xfemslip.cli import cli
 from xfemslip.io import folder as folder_module
 from xfemslip.io.fileset import replace_files
 from xfemslip.io.lock import folder_lock
+from xfemslip.io.read import read_result
 
 
 @pytest.fixture(scope="module")
@@ -107,7 +108,10 @@ def test_sigkill_between_renames_leaves_one_whole_run(scenario, point, expected)
 
 @pytest.mark.parametrize(
     ("sig", "code", "name"),
-    [(signal.SIGTERM, 143, "SIGTERM"), (signal.SIGINT, 130, "SIGINT")],
+    [
+        (signal.SIGTERM, 143, "SIGTERM"),
+        pytest.param(signal.SIGINT, 130, "SIGINT", marks=pytest.mark.slow),
+    ],
 )
 @pytest.mark.parametrize(
     ("point", "expected", "says"),
@@ -159,6 +163,7 @@ def _delay_sweep(scenario, sig: int, delays, tag: str) -> list[harness.Trial]:
     return trials
 
 
+@pytest.mark.slow  # (test_signals_over_the_write_phase: 24 delays)
 def test_sigkill_over_the_write_phase(scenario):
     """Four SIGKILLs spread over the write phase: old or new, never mixed."""
     trials = _delay_sweep(scenario, signal.SIGKILL, [0.0, 0.03, 0.08, 0.15], "few")
@@ -223,7 +228,14 @@ def _races(scenario, overwrite, staggers, tag: str) -> None:
         _one_run_id(scenario.work / name / "out")
 
 
-@pytest.mark.parametrize("overwrite", [(False, False), (True, True), (False, True)])
+@pytest.mark.parametrize(
+    "overwrite",
+    [
+        (False, False),
+        pytest.param((True, True), marks=pytest.mark.slow),
+        pytest.param((False, True), marks=pytest.mark.slow),
+    ],
+)
 def test_racing_runs_leave_one_whole_run(scenario, overwrite):
     """Two runs started together into a fresh folder: exactly one whole run
     is there, every file with its run_id; a refused run says why in one line."""
@@ -451,6 +463,57 @@ def test_sweep_reruns_a_member_whose_set_is_not_whole(tmp_path):
     assert not is_done(member, sweep.cases[0].text, sweep.cases[0].spec)
     assert harness.leftovers(member) == []
     assert sorted(p.name for p in tmp_path.glob(".*")) == []
+
+
+def _flip(path: Path, offset: int) -> None:
+    data = bytearray(path.read_bytes())
+    data[offset] ^= 0x04
+    path.write_bytes(bytes(data))
+
+
+def test_sweep_recomputes_a_member_whose_files_are_damaged(tmp_path, runner):
+    """A rerun over members whose result.h5 has a flipped bit (in a data
+    set: its checksum; in the file's header) or whose result.pvd is cut
+    short runs those members again, with a warning naming the file, and
+    skips the whole one; no traceback."""
+    base = harness.write_case(tmp_path, "base.toml", 8, 2)
+    sweep_file = tmp_path / "sweep.toml"
+    sweep_file.write_text(
+        f'name = "s"\nbase = "{base.name}"\n\n[vary]\n'
+        '"fractures[0].friction" = [0.1, 0.2, 0.3, 0.4]\n'
+    )
+    out = tmp_path / "runs"
+    args = ["sweep", "-j", "1", str(sweep_file), "-o", str(out)]
+    first = runner.invoke(cli, args)
+    assert first.exit_code == 0, first.stderr
+    folders = sorted(p for p in out.iterdir() if p.is_dir())
+    data, header, pvd, whole = folders
+    with h5py.File(data / "result.h5", "r") as h5:
+        offset = h5["mesh/points"].id.get_chunk_info(0).byte_offset
+    _flip(data / "result.h5", offset + 5)
+    _flip(header / "result.h5", 0)  # the signature of the superblock
+    text = (pvd / "result.pvd").read_text()
+    (pvd / "result.pvd").write_text(text[: len(text) // 2])
+    with h5py.File(whole / "result.h5", "r") as h5:
+        whole_id = int(h5.attrs["run_id"])
+    again = runner.invoke(cli, args)
+    assert again.exit_code == 0, again.stderr
+    assert "Traceback" not in again.stderr + again.stdout
+    rows = (out / "summary.csv").read_text().splitlines()[1:]
+    status = {row.split(",")[0]: row.split(",")[-2] for row in rows}
+    assert {k: status[k.name] for k in folders} == {
+        data: "ok",
+        header: "ok",
+        pvd: "ok",
+        whole: "skipped",
+    }
+    warned = [ln for ln in again.stderr.splitlines() if ln.startswith("WARNING:")]
+    assert any(str(data / "result.h5") in ln and "run again" in ln for ln in warned)
+    for folder in (data, header, pvd):
+        assert read_result(folder).converged
+    with h5py.File(whole / "result.h5", "r") as h5:
+        assert int(h5.attrs["run_id"]) == whole_id  # not run again
+    assert harness.leftovers(out) == []
 
 
 def test_replace_files_changes_nothing_when_one_file_fails(tmp_path):

@@ -2,7 +2,8 @@
 in one interpreter (click's CliRunner), each under a time bound.
 
 Usage: ``python bad_input_worker.py INPUTS.json RESULTS.jsonl``.  INPUTS is a
-JSON list of ``{"id", "cwd", "argv", "env", "timeout"}``; for each, one JSON
+JSON list of ``{"id", "cwd", "argv", "env", "timeout", "stdin"}`` (stdin as
+hex, or null); for each, one JSON
 line ``{"id", "exit_code", "stdout", "stderr", "exception", "traceback",
 "status", "seconds", "rss_before", "rss_after"}`` is appended to RESULTS and
 flushed, so that the harness keeps every answer given before a crash.
@@ -48,7 +49,13 @@ def _run_one(runner, cli, item: dict) -> dict:
     out = {"id": item["id"], "status": "done", "rss_before": before}
     signal.setitimer(signal.ITIMER_REAL, item["timeout"])
     try:
-        result = runner.invoke(cli, item["argv"], env=item["env"])
+        stdin = item.get("stdin")
+        result = runner.invoke(
+            cli,
+            item["argv"],
+            env=item["env"],
+            input=None if stdin is None else bytes.fromhex(stdin),
+        )
         signal.setitimer(signal.ITIMER_REAL, 0)
         exc = result.exception
         out.update(

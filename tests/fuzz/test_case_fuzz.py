@@ -25,6 +25,7 @@ from click.testing import CliRunner
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
+from tests.support.tiers import examples
 from xfemslip.cli import cli
 
 BASE = {
@@ -267,7 +268,7 @@ def _check_outcome(result, path: Path, key) -> None:
 
 @settings(
     derandomize=True,
-    max_examples=1000,
+    max_examples=examples(1000),
     deadline=None,
     database=None,
     suppress_health_check=[HealthCheck.function_scoped_fixture, HealthCheck.too_slow],

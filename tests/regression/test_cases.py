@@ -91,6 +91,16 @@ def runs(tmp_path_factory):
     return get
 
 
+# The network case costs ten times the others: its runs through the other
+# kernel backend and the linear solvers one by one are in the slow tier.
+ACROSS = [
+    pytest.param(case, id=i, marks=pytest.mark.slow)
+    if case.stem == "fracture_network"
+    else pytest.param(case, id=i)
+    for case, i in zip(CASES, IDS, strict=True)
+]
+
+
 def test_cases_exist():
     assert {"reservoir_depletion", "liu_borja_plate"} <= set(IDS)
 
@@ -104,7 +114,7 @@ def test_key_scalars_match_golden(runs, case):
     _assert_matches_golden(case, out)
 
 
-@pytest.mark.parametrize("case", CASES, ids=IDS)
+@pytest.mark.parametrize("case", ACROSS)
 def test_numba_kernels_match_golden(case, tmp_path, monkeypatch):
     """The same goldens through the other kernel backend: "auto" runs every
     shipped case with the NumPy kernels (xfemslip.kernels.choose); here the
@@ -118,7 +128,7 @@ def test_numba_kernels_match_golden(case, tmp_path, monkeypatch):
 
 
 @pytest.mark.parametrize("method", ["superlu", "pardiso"])
-@pytest.mark.parametrize("case", CASES, ids=IDS)
+@pytest.mark.parametrize("case", ACROSS)
 def test_linear_solvers_match_golden(case, method, tmp_path):
     """The same goldens through each direct linear solver, forced in the
     case's [solver] table ("auto" gives these small cases SuperLU)."""

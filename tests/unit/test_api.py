@@ -185,3 +185,20 @@ def test_a_failed_run_keeps_its_converged_steps(tmp_path):
 def test_read_result_of_a_missing_file_is_a_usage_error(tmp_path):
     with pytest.raises(xfemslip.UsageError, match="no such file"):
         xfemslip.read_result(tmp_path / "result.h5")
+
+
+@pytest.mark.parametrize("spec", [None, {"name": "x"}, "cases/x.toml", 3])
+def test_run_case_of_anything_but_a_case_spec_is_a_usage_error(spec, tmp_path):
+    with pytest.raises(xfemslip.UsageError, match="run_case needs a CaseSpec"):
+        xfemslip.run_case(spec, tmp_path / "out")
+    assert not (tmp_path / "out").exists()
+
+
+def test_read_result_of_a_case_file_is_an_output_error():
+    """api.md: read_result raises OutputError for a file that is not a
+    result (a ResultError, which the command line reports with exit 2)."""
+    path = CASES / "reservoir_depletion.toml"
+    with pytest.raises(xfemslip.OutputError, match="not a readable result.h5") as info:
+        xfemslip.read_result(path)
+    assert isinstance(info.value, xfemslip.ResultError)
+    assert str(info.value).startswith(f"{path}: ")

@@ -139,7 +139,14 @@ MEASURED = {
 FACTOR = (0.85, 1.5)
 
 
-@pytest.mark.parametrize("name", list(MEASURED))
+# the long and the crowded run take a minute of CPU: slow tier
+@pytest.mark.parametrize(
+    "name",
+    [
+        pytest.param(name, marks=pytest.mark.slow) if name != "reservoir" else name
+        for name in MEASURED
+    ],
+)
 def test_estimate_against_the_measured_peak(tmp_path, monkeypatch, name):
     """The peak resident memory of `xfemslip run` in its own process (its
     ru_maxrss, a measured reference) against the estimates."""

@@ -23,6 +23,7 @@ from __future__ import annotations
 import math
 import re
 import subprocess
+import sys
 import tomllib
 import xml.etree.ElementTree as ET
 from pathlib import Path
@@ -142,11 +143,19 @@ def _check_error_line(line: str, step: int):
     assert re.search(r"residual[^0-9]*[0-9.]+e[-+][0-9]+", line), line
 
 
+def console_script() -> list[str]:
+    """The installed ``xfemslip`` script of this interpreter's environment
+    (beside sys.executable, whether or not the environment is activated),
+    else ``python -m xfemslip``."""
+    script = Path(sys.executable).with_name("xfemslip")
+    return [str(script)] if script.is_file() else [sys.executable, "-m", "xfemslip"]
+
+
 def test_cli_exit_code_and_message(tmp_path):
     """The installed console script: exit 1, one 'Error:' line, last on stderr."""
     case = write_case(tmp_path)
     proc = subprocess.run(
-        ["xfemslip", "run", str(case), "-o", str(tmp_path / "out")],
+        [*console_script(), "run", str(case), "-o", str(tmp_path / "out")],
         capture_output=True,
         text=True,
         timeout=300,

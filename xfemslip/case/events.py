@@ -9,20 +9,23 @@ printed magnitude says which W it used.
 from __future__ import annotations
 
 from xfemslip.case.specs import EventsSpec
-from xfemslip.case.tables import POSITIVE, Table
+from xfemslip.case.tables import Range, Table
 
-__all__ = ["EVENTS_KEYS", "read_events"]
+__all__ = ["EVENTS_KEYS", "EXTENT", "read_events"]
 
 EVENTS_KEYS = ("extent",)
+# W from a millimetre (a laboratory slip patch) to 10,000 km (beyond the
+# longest ruptures on Earth); M0' W then stays a normal number.
+EXTENT = Range(1e-3, 1e7)
 
 
 def read_events(root: Table) -> EventsSpec | None:
-    """[events]: ``extent`` > 0 [m] (optional); None without the table."""
+    """[events]: ``extent`` in EXTENT [m] (optional); None without the table."""
     table = root.table("events", EVENTS_KEYS)
     if table is None or not table.present:
         return None
     start = len(table.problems)
-    extent = table.number("extent", None, POSITIVE)
+    extent = table.number("extent", None, EXTENT)
     if len(table.problems) > start:
         return None
     return EventsSpec(extent=extent)

@@ -7,9 +7,13 @@ Used by the case readers of this package, by the sweep reader and by the CLI
 Every input file (case and sweep files, boundary and network CSV files) is
 read by ``read_input``:
 
-- only a regular file is read: a FIFO, a device such as ``/dev/zero``, a
-  socket or a directory is refused without reading a byte (opening does not
-  wait for a FIFO's writer);
+- a regular file or a pipe is read: a FIFO or a process substitution
+  (``xfemslip run <(...)``), and standard input as the path ``-``; a
+  device such as ``/dev/zero``, a socket or a directory is refused without
+  reading a byte.  Opening does not wait for a FIFO's writer: a FIFO that
+  nobody writes to reads as empty, one whose writer is there is read to its
+  end.  Relative paths in a file read from a pipe resolve against the
+  working directory (:func:`input_folder`), as it has no folder of its own;
 - a file larger than its cap (``MAX_TOML_BYTES``, ``MAX_CSV_BYTES``) is
   refused from its size, and a file that keeps growing while it is read (or
   reports no size, as some kernel files do) is refused once the cap is passed;
@@ -28,7 +32,9 @@ from __future__ import annotations
 
 import logging
 import os
+import select
 import stat
+import sys
 import tomllib
 from pathlib import Path
 
@@ -57,9 +63,11 @@ MAX_TOML_DEPTH = 32
 MAX_NAME_BYTES = 255
 MAX_PATH_BYTES = 4095
 
+# The path that names standard input.
+STDIN = "-"
+
 _KINDS = (
     (stat.S_ISDIR, "a directory"),
-    (stat.S_ISFIFO, "a FIFO (named pipe)"),
     (stat.S_ISCHR, "a character device"),
     (stat.S_ISBLK, "a block device"),
     (stat.S_ISSOCK, "a socket"),
@@ -84,9 +92,11 @@ def _megabytes(n: int) -> str:
 def read_input(path: Path, limit: int) -> str:
     """The UTF-8 text of the regular file ``path``, at most ``limit`` bytes.
 
-    Raises ``UnreadableInput`` with a one-line reason: not a regular file,
-    larger than ``limit``, not readable, not UTF-8.
+    Raises ``UnreadableInput`` with a one-line reason: not a regular file
+    or a pipe, larger than ``limit``, not readable, not UTF-8.
     """
+    if str(path) == STDIN:
+        return _decode(_read_stdin(limit))
     try:
         fd = os.open(path, os.O_RDONLY | os.O_NONBLOCK | os.O_NOCTTY | os.O_CLOEXEC)
     except ValueError:  # a NUL byte in the path
@@ -95,15 +105,22 @@ def read_input(path: Path, limit: int) -> str:
         raise UnreadableInput(exc.strerror or str(exc)) from None
     try:
         size = _regular_size(fd)
-        if size > limit:
+        if size is not None and size > limit:
             raise UnreadableInput(
                 f"the file is {_megabytes(size)}, more than the limit of "
                 f"{_megabytes(limit)}"
             )
-        logger.debug("reading %s (%d bytes)", path, size)
+        logger.debug(
+            "reading %s (%s bytes)", path, "a pipe of unknown" if size is None else size
+        )
         data = _read_capped(fd, limit)
     finally:
         os.close(fd)
+    return _decode(data)
+
+
+def _decode(data: bytes) -> str:
+    """UTF-8 text without a byte-order mark."""
     try:
         text = data.decode("utf-8")
     except UnicodeDecodeError as exc:
@@ -127,6 +144,8 @@ def input_size(path: Path, limit: int) -> int:
         size = _regular_size(fd)
     finally:
         os.close(fd)
+    if size is None:
+        raise UnreadableInput("is a pipe; this file is read by name, give a file")
     if size > limit:
         raise UnreadableInput(
             f"the file is {_megabytes(size)}, more than the limit of "
@@ -135,26 +154,75 @@ def input_size(path: Path, limit: int) -> int:
     return size
 
 
-def _regular_size(fd: int) -> int:
-    """Size of an open regular file; UnreadableInput for anything else."""
+def _regular_size(fd: int) -> int | None:
+    """Size of an open regular file, None for a pipe; UnreadableInput for
+    anything else."""
     try:
         info = os.fstat(fd)
     except OSError as exc:
         raise UnreadableInput(exc.strerror or str(exc)) from None
+    if stat.S_ISFIFO(info.st_mode):
+        return None
     for test, kind in _KINDS:
         if test(info.st_mode):
-            raise UnreadableInput(f"is {kind}, not a regular file")
+            raise UnreadableInput(f"is {kind}, not a regular file or a pipe")
     if not stat.S_ISREG(info.st_mode):
-        raise UnreadableInput("is not a regular file")
+        raise UnreadableInput("is not a regular file or a pipe")
     return info.st_size
 
 
+def _read_stdin(limit: int) -> bytes:
+    """Standard input to its end, at most ``limit`` bytes (a terminal is
+    refused: nothing would end it but Ctrl-D)."""
+    stream = getattr(sys.stdin, "buffer", None)
+    if stream is None:
+        raise UnreadableInput("there is no standard input to read")
+    try:
+        if stream.isatty():
+            raise UnreadableInput(
+                "standard input is a terminal; pipe the file into it "
+                "(xfemslip run - < case.toml)"
+            )
+    except (ValueError, OSError):  # closed, or a stream without a descriptor
+        pass
+    chunks, total = [], 0
+    while True:
+        try:
+            chunk = stream.read(READ_CHUNK)
+        except (OSError, ValueError) as exc:
+            raise UnreadableInput(f"cannot read standard input: {exc}") from None
+        if not chunk:
+            return b"".join(chunks)
+        total += len(chunk)
+        if total > limit:
+            raise UnreadableInput(f"more than the limit of {_megabytes(limit)}")
+        chunks.append(chunk)
+
+
+def input_folder(path: Path | str) -> Path:
+    """The folder relative paths in the input file ``path`` resolve against:
+    its own, or the working directory for standard input and a pipe."""
+    path = Path(path)
+    if str(path) == STDIN:
+        return Path(".")
+    try:
+        if stat.S_ISFIFO(os.stat(path).st_mode):
+            return Path(".")
+    except (OSError, ValueError):
+        pass
+    return path.parent
+
+
 def _read_capped(fd: int, limit: int) -> bytes:
-    """Read to the end in chunks; refuse once more than ``limit`` bytes came."""
+    """Read to the end in chunks; refuse once more than ``limit`` bytes came.
+    A pipe with nothing to read yet is waited on (a signal ends the wait)."""
     chunks, total = [], 0
     while True:
         try:
             chunk = os.read(fd, READ_CHUNK)
+        except BlockingIOError:  # a pipe whose writer has not written yet
+            select.select([fd], [], [], 1.0)
+            continue
         except OSError as exc:
             raise UnreadableInput(exc.strerror or str(exc)) from None
         if not chunk:
@@ -172,9 +240,12 @@ def read_text(path: Path, what: str, limit: int = MAX_TOML_BYTES) -> str:
     """``read_input`` for a file that is itself the input (a case or sweep
     file): CaseError naming it if it is refused."""
     try:
-        return read_input(path, limit)
+        text = read_input(path, limit)
     except UnreadableInput as exc:
         raise CaseError(path, [("", f"cannot read the {what}: {exc}")]) from None
+    if not text.strip():  # an empty file, or a pipe nobody wrote to
+        raise CaseError(path, [("", f"the {what} is empty")])
+    return text
 
 
 def parse_toml(text: str, path: Path | str) -> dict:

@@ -17,10 +17,19 @@ from __future__ import annotations
 
 import math
 
+import numpy as np
+
 from xfemslip.case.specs import HydraulicSpec, PermeabilitySpec
 from xfemslip.case.tables import NON_NEGATIVE, POSITIVE, Range, Table, fmt
 
-__all__ = ["HYDRAULIC_KEYS", "PERMEABILITY_KEYS", "read_hydraulic", "read_permeability"]
+__all__ = [
+    "HYDRAULIC_KEYS",
+    "LAW_RULES",
+    "MATRIX",
+    "PERMEABILITY_KEYS",
+    "read_hydraulic",
+    "read_permeability",
+]
 
 HYDRAULIC_KEYS = (
     "aperture",
@@ -30,19 +39,29 @@ HYDRAULIC_KEYS = (
     "normal_stiffness",
 )
 PERMEABILITY_KEYS = (*HYDRAULIC_KEYS, "matrix", "block")
-_RULES = {
-    "aperture": POSITIVE,
+# Physical bounds (docs/case-format.md): an aperture from a nanometre (below
+# it water does not flow as a continuum) to a metre (a void, not a fracture
+# the cubic law describes), so a0^3 / 12 is a normal number; a normal
+# stiffness far beyond measured rock joints on either side, within which the
+# closure law neither underflows (0 / 0 at zero stress) nor overflows; a
+# matrix permeability up to above that of gravel.
+MIN_APERTURE, MAX_APERTURE = 1e-9, 1.0  # [m]
+MIN_NORMAL_STIFFNESS, MAX_NORMAL_STIFFNESS = 1e3, 1e16  # [Pa/m]
+MAX_MATRIX = 1e-6  # [m^2]
+LAW_RULES = {
+    "aperture": Range(MIN_APERTURE, MAX_APERTURE),
     "dilation_angle": Range(0.0, 90.0, hi_open=True),
     "dilation_slip": POSITIVE,
     "max_closure": NON_NEGATIVE,
-    "normal_stiffness": POSITIVE,
+    "normal_stiffness": Range(MIN_NORMAL_STIFFNESS, MAX_NORMAL_STIFFNESS),
 }
+MATRIX = Range(0.0, MAX_MATRIX)
 
 
 def _law(table: Table) -> HydraulicSpec:
     """The keys of a law that ``table`` gives (None for the others)."""
     return HydraulicSpec(
-        **{name: table.number(name, None, rule) for name, rule in _RULES.items()}
+        **{name: table.number(name, None, rule) for name, rule in LAW_RULES.items()}
     )
 
 
@@ -130,6 +149,16 @@ def _read_block(table: Table, grid) -> tuple[float, float, float, float] | None:
             f"[{fmt(lo[1])}, {fmt(hi[1])}], got {list(block)}",
         )
         return None
+    # the fractures are resolved cell by cell: a block is upscaled over at
+    # least one cell each way (and its area is a normal number)
+    dx, dy = float(min(np.diff(grid.mesh.x))), float(min(np.diff(grid.mesh.y)))
+    if x1 - x0 < (1.0 - 1e-9) * dx or y1 - y0 < (1.0 - 1e-9) * dy:
+        table.error(
+            "block",
+            f"must be at least one cell of the mesh wide and high ({fmt(dx)} x "
+            f"{fmt(dy)} m), got {fmt(x1 - x0)} x {fmt(y1 - y0)} m",
+        )
+        return None
     return block
 
 
@@ -151,7 +180,7 @@ def read_permeability(root: Table, grid, fractures) -> PermeabilitySpec | None:
         return None
     start = len(root.problems)
     defaults = _law(table)
-    matrix = table.number("matrix", 0.0, NON_NEGATIVE)
+    matrix = table.number("matrix", 0.0, MATRIX)
     if table.has("block"):
         block = _read_block(table, grid)
     elif grid is not None:

@@ -24,12 +24,20 @@ Resolution rules beyond ``case-format.md`` (see ``describe`` for the printout):
 
 from __future__ import annotations
 
+import re
 from pathlib import Path
 
 from xfemslip.case import options
 from xfemslip.case.boundary import read_boundary
-from xfemslip.case.events import read_events
-from xfemslip.case.files import MAX_NAME_BYTES, parse_toml, path_problem, read_text
+from xfemslip.case.events import EXTENT, read_events
+from xfemslip.case.files import (
+    MAX_NAME_BYTES,
+    STDIN,
+    input_folder,
+    parse_toml,
+    path_problem,
+    read_text,
+)
 from xfemslip.case.fractures import read_fractures
 from xfemslip.case.grading import (
     case_refinement,
@@ -38,7 +46,7 @@ from xfemslip.case.grading import (
     unit_refinement,
 )
 from xfemslip.case.grid import read_grid
-from xfemslip.case.hydraulics import read_permeability
+from xfemslip.case.hydraulics import LAW_RULES, MATRIX, read_permeability
 from xfemslip.case.network import read_network
 from xfemslip.case.options import (
     IN_SITU_KEYS,
@@ -50,6 +58,7 @@ from xfemslip.case.options import (
     TOP_KEYS,
 )
 from xfemslip.case.pore import check_region, read_pore_pressure
+from xfemslip.case.segments import PROPERTY_RULES
 from xfemslip.case.specs import (
     CaseSpec,
     InSituSpec,
@@ -58,7 +67,16 @@ from xfemslip.case.specs import (
     OutputSpec,
     SolverSpec,
 )
-from xfemslip.case.tables import POSITIVE, Range, Table, check_choice, show
+from xfemslip.case.tables import (
+    BIOT,
+    FINITE,
+    POISSON,
+    POSITIVE,
+    Range,
+    Table,
+    check_choice,
+    show,
+)
 from xfemslip.case.units import (
     read_reservoir,
     read_units,
@@ -67,7 +85,7 @@ from xfemslip.case.units import (
 )
 from xfemslip.errors import CaseError
 
-__all__ = ["load_case", "loads_case"]
+__all__ = ["load_case", "loads_case", "value_rule"]
 
 
 # --------------------------------------------------------------------------- #
@@ -76,8 +94,9 @@ __all__ = ["load_case", "loads_case"]
 
 
 def _read_name(root: Table, path: Path) -> str | None:
-    """``name``, default the file's stem; it becomes a directory name."""
-    name = root.string("name", path.stem)
+    """``name``, default the file's stem (``stdin`` for standard input); it
+    becomes a directory name."""
+    name = root.string("name", "stdin" if str(path) == STDIN else path.stem)
     if name is None or not root.has("name"):
         return name
     if any(c in "/\\" or ord(c) < 32 for c in name) or name in (".", ".."):
@@ -105,12 +124,47 @@ def _read_material(root: Table) -> MaterialSpec | None:
     if table is None:
         return None
     E = table.number("E", rule=POSITIVE)
-    nu = table.number("nu", rule=Range(0.0, 0.5, hi_open=True))
+    nu = table.number("nu", rule=POISSON)
     model = table.choice("model", MATERIAL_MODELS, "plane_strain")
     density = table.number("density", None, POSITIVE)
     if E is None or nu is None or model is None:
         return None
     return MaterialSpec(E=E, nu=nu, model=model, density=density)
+
+
+def value_rule(key: str) -> Range | None:
+    """The interval the case format allows for the number at ``key`` (a key
+    path such as ``fractures[0].friction``): the rule its reader checks, for
+    the keys a study may vary by a distribution; None for other keys (their
+    values are checked when a case is loaded).  Every number of a case is
+    finite besides."""
+    parts = re.sub(r"\[\d+\]", "", key).split(".")
+    table, name = ".".join(parts[:-1]), parts[-1]
+    rules: dict[str, Range] = {}
+    if table in ("material", "reservoir", "units"):
+        rules = {"E": POSITIVE, "nu": POISSON}
+        if table == "units":
+            rules |= {"biot": BIOT, "density": POSITIVE, "overpressure": FINITE}
+            rules |= {"change": FINITE}
+    elif table in ("loading.stress", "loading.initial_stress"):
+        rules = dict.fromkeys(STRESS_KEYS, FINITE)
+    elif table == "pore_pressure":
+        rules = {
+            "initial": FINITE,
+            "change": FINITE,
+            "biot": BIOT,
+            "gradient": FINITE,
+            "datum": FINITE,
+        }
+    elif table in ("fractures", "network"):
+        rules = {**PROPERTY_RULES, "length": POSITIVE, "angle": FINITE}
+    elif table in ("fractures.hydraulic", "network.hydraulic"):
+        rules = LAW_RULES
+    elif table == "permeability":
+        rules = {**LAW_RULES, "matrix": MATRIX}
+    elif table == "events":
+        rules = {"extent": EXTENT}
+    return rules.get(name)
 
 
 # --------------------------------------------------------------------------- #
@@ -372,7 +426,9 @@ def load_case(path: str | Path) -> CaseSpec:
 
     Parameters
     ----------
-    path : the TOML case file; CSV files it names are relative to its folder.
+    path : the TOML case file, a pipe, or ``-`` for standard input; CSV files
+        it names are relative to its folder (to the working directory for a
+        pipe and standard input).
 
     Returns
     -------
@@ -385,13 +441,17 @@ def load_case(path: str | Path) -> CaseSpec:
     each with its key path.
     """
     path = Path(path)
-    return loads_case(read_text(path, "case file"), path)
+    return loads_case(read_text(path, "case file"), path, folder=input_folder(path))
 
 
-def loads_case(text: str, path: str | Path = "<string>") -> CaseSpec:
-    """Validate and resolve case-file ``text``; ``path`` names it in messages,
-    gives the default ``name`` (its stem) and the folder of CSV files."""
+def loads_case(
+    text: str, path: str | Path = "<string>", *, folder: Path | None = None
+) -> CaseSpec:
+    """Validate and resolve case-file ``text``; ``path`` names it in messages
+    and gives the default ``name`` (its stem; ``stdin`` for ``-``), ``folder``
+    (default: the folder of ``path``) the folder of CSV files."""
     path = Path(path)
+    folder = path.parent if folder is None else Path(folder)
     document = parse_toml(text, path)
     problems: list[tuple[str, str]] = []
     root = Table(document, "", problems, TOP_KEYS)
@@ -399,17 +459,17 @@ def loads_case(text: str, path: str | Path = "<string>") -> CaseSpec:
     grid = read_grid(root)
     material = _read_material(root)
     fractures = read_fractures(root, grid)
-    fractures = _with_network(root, grid, path.parent, fractures)
+    fractures = _with_network(root, grid, folder, fractures)
     reservoir = read_reservoir(root)
     units = read_units(root, fractures, material)
     grid = _graded(root, grid, fractures, reservoir, units)
     units, reservoir = settle_units(root, units, reservoir, fractures, grid)
-    boundary, needs_stress = read_boundary(root, grid, path.parent)
+    boundary, needs_stress = read_boundary(root, grid, folder)
     loading = _read_loading(root, needs_stress)
     solver = _read_solver(root)
     output = _read_output(root, name)
     datum = loading.in_situ.datum if loading and loading.in_situ else None
-    pore_pressure = read_pore_pressure(root, datum, path.parent)
+    pore_pressure = read_pore_pressure(root, datum, folder)
     if reservoir is not None:
         units = (reservoir_unit(reservoir),)
     check_region(root, pore_pressure, units)

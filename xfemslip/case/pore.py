@@ -10,7 +10,7 @@ from pathlib import Path
 
 from xfemslip.case.pressure_field import read_field_table
 from xfemslip.case.specs import PorePressureSpec
-from xfemslip.case.tables import Range, Table
+from xfemslip.case.tables import BIOT, Table
 
 PORE_PRESSURE_KEYS = (
     "initial",
@@ -52,7 +52,7 @@ def read_pore_pressure(
         change = table.number(
             "change", hint=" (or a field table: [pore_pressure.field] file = ...)"
         )
-    biot = table.number("biot", 1.0, Range(0.0, 1.0, lo_open=True))
+    biot = table.number("biot", 1.0, BIOT)
     region = table.string("region", "all")
     gradient = table.number("gradient", 0.0)
     datum = table.number("datum", in_situ_datum)

@@ -37,6 +37,9 @@ MAX_SUGGESTIONS = 20  # unknown keys of one table that get a 'did you mean'
 
 POSITIVE = Range(0.0, lo_open=True)
 NON_NEGATIVE = Range(0.0)
+FINITE = Range()  # any finite number (every number of a case is finite)
+POISSON = Range(0.0, 0.5, hi_open=True)  # nu of [material] and [reservoir]
+BIOT = Range(0.0, 1.0, lo_open=True)  # pore_pressure.biot
 # |x|, |y| of every point of a case [m]: the geometry squares distances, which
 # must stay finite (1e150**2 = 1e300); a kilometre-scale model is at 1e3.
 MAX_COORDINATE = 1e150

@@ -25,8 +25,10 @@ import numpy as np
 
 from xfemslip.case.specs import RegionSpec, ReservoirSpec, UnitSpec
 from xfemslip.case.tables import (
+    BIOT,
     COORDINATE,
     NON_NEGATIVE,
+    POISSON,
     POSITIVE,
     Range,
     Table,
@@ -59,8 +61,8 @@ RESERVOIR_KEYS = ("box", "boxes", "polygon", "E", "nu")
 # cell is far below what the mesh resolves as a separate feature and far
 # above the rounding of coordinates typed to a few decimals.
 SNAP_CELLS = 0.1
-NU_RANGE = Range(0.0, 0.5, hi_open=True)
-BIOT_RANGE = Range(0.0, 1.0, lo_open=True)
+NU_RANGE = POISSON
+BIOT_RANGE = BIOT
 MAX_UNITS = 1000
 
 

@@ -29,7 +29,7 @@ from pathlib import Path
 
 import click
 
-from xfemslip.case.files import path_problem
+from xfemslip.case.files import STDIN, path_problem
 from xfemslip.errors import (
     CaseError,
     GeometryError,
@@ -124,15 +124,15 @@ def reported_errors(debug: bool) -> Iterator[None]:
 
 
 def load_case_file(case: Path):
-    """Load and validate a case file (``CaseError`` on any problem); values
-    that are valid but look like a mistake are logged as warnings
-    (xfemslip.case.plausibility)."""
+    """Load and validate a case file, a pipe or standard input (``-``)
+    (``CaseError`` on any problem); values that are valid but look like a
+    mistake are logged as warnings (xfemslip.case.plausibility)."""
     from xfemslip.case import load_case
 
     problem = path_problem(case)
     if problem:
         raise UsageError(f"{shown_path(case)}: the path {problem}")
-    if not case.exists():
+    if str(case) != STDIN and not case.exists():
         raise UsageError(f"{case}: no such file")
     if case.is_dir():
         raise UsageError(f"{case}: is a directory, expected a case file (.toml)")

@@ -40,7 +40,8 @@ def run(
     plot: bool,
     debug: bool,
 ) -> None:
-    """Run the case file CASE and write its results.
+    """Run the case file CASE and write its results (CASE may be a pipe,
+    such as <(...), or - for standard input).
 
     Ends with what happened on each fracture (slip, moment, magnitude), as
     ``xfemslip summary`` prints it; -q leaves that out.

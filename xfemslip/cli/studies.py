@@ -253,6 +253,7 @@ def plot(results, case, output, kinds, formats, labels, scale, dpi, debug) -> No
     their folders); several results are drawn side by side or overlaid.
     With --case, draw a case file before it runs (the paper's Fig. 5)."""
     with reported_errors(debug):
+        configure_logging(False, True)  # the warnings; the paths are printed
         if case is not None:
             spec = load_case_file(case)
             from xfemslip.plot.case import plot_case

@@ -11,20 +11,32 @@ together.  Rows are text cells, written by :mod:`csv` with its default
 from __future__ import annotations
 
 import csv
+import itertools
 from collections.abc import Iterable, Sequence
 from pathlib import Path
 
+from xfemslip import interrupt
 from xfemslip.io.atomic import atomic_path
 
 __all__ = ["write_csv", "write_rows", "write_text"]
 
 
+# Rows written between two checkpoints of a deferred signal: a table of a
+# million rows takes a minute, and Ctrl-C must not wait for it.
+ROWS_PER_CHECKPOINT = 10_000
+
+
 def write_rows(path: Path | str, header: Sequence, rows: Iterable[Sequence]) -> None:
-    """Write ``header`` and ``rows`` as CSV to ``path`` (not atomically)."""
+    """Write ``header`` and ``rows`` as CSV to ``path`` (not atomically); a
+    signal held back while a set is written (:func:`xfemslip.interrupt.deferred`)
+    is acted on every ROWS_PER_CHECKPOINT rows."""
+    rows = iter(rows)
     with open(path, "w", newline="", encoding="utf-8") as fh:
         writer = csv.writer(fh)
         writer.writerow(header)
-        writer.writerows(rows)
+        while chunk := list(itertools.islice(rows, ROWS_PER_CHECKPOINT)):
+            writer.writerows(chunk)
+            interrupt.checkpoint()
 
 
 def write_csv(path: Path | str, header: Sequence, rows: Iterable[Sequence]) -> None:

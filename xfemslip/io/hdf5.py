@@ -426,7 +426,11 @@ def _dataset(
     refuse_non_finite(
         np.where(np.isnan(value), 0.0, value) if nan else value, f"{group.name}/{name}"
     )
-    dataset = group.create_dataset(name, data=value, track_times=False)
+    # a Fletcher-32 checksum per chunk: a flipped bit fails the read of the
+    # data set instead of reading as a wrong number (scalars take no filter)
+    dataset = group.create_dataset(
+        name, data=value, track_times=False, fletcher32=np.ndim(value) > 0
+    )
     dataset.attrs["units"] = units
     return dataset
 

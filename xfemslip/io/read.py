@@ -17,7 +17,14 @@ from typing import Any
 import h5py
 import numpy as np
 
-from xfemslip.errors import UsageError
+from xfemslip.errors import ResultError
+from xfemslip.io.result_check import (
+    check_attrs,
+    check_final_copy,
+    check_layout,
+    check_result,
+    reading,
+)
 from xfemslip.post.fields import FractureFields, FractureProperties, StepFields
 from xfemslip.post.result import (
     DepletionTable,
@@ -54,12 +61,12 @@ OPTIONAL_BULK_ARRAYS = ("effective_stress", "pore_pressure")
 
 
 def _result_file(path: str | Path) -> Path:
-    """``path``, or ``path/result.h5`` for a folder; UsageError when missing."""
+    """``path``, or ``path/result.h5`` for a folder; ResultError when missing."""
     path = Path(path)
     if path.is_dir():
         path = path / "result.h5"
     if not path.is_file():
-        raise UsageError(f"{path}: no such file (expected a result.h5)")
+        raise ResultError(f"{path}: no such file (expected a result.h5)")
     return path
 
 
@@ -67,7 +74,8 @@ def _open(path: Path) -> h5py.File:
     try:
         return h5py.File(path, "r")
     except OSError as exc:
-        raise UsageError(f"{path}: not a readable result.h5: {exc}") from None
+        reason = " ".join(str(exc).split())
+        raise ResultError(f"{path}: not a readable result.h5: {reason}") from None
 
 
 def _plain(value: Any) -> Any:
@@ -83,10 +91,10 @@ def _plain(value: Any) -> Any:
 def read_attrs(path: str | Path) -> dict[str, Any]:
     """The root attributes of a ``result.h5`` (or of ``path/result.h5``).
 
-    Raises UsageError when the file is missing or not HDF5.
+    Raises ResultError when the file is missing, not HDF5 or damaged.
     """
     path = _result_file(path)
-    with _open(path) as h5:
+    with _open(path) as h5, reading(path):
         return {key: _plain(value) for key, value in h5.attrs.items()}
 
 
@@ -272,17 +280,20 @@ def read_result(path: str | Path) -> Result:
     """Read a ``result.h5`` (or ``path/result.h5``) into a Result.
 
     A file whose first load step did not converge gives a Result without
-    steps.  Raises UsageError when the file is missing, not HDF5, or lacks a
-    dataset of the format.
+    steps.  Raises ResultError (an OutputError) when the file is missing,
+    not HDF5, damaged, or not what the output format says
+    (:mod:`xfemslip.io.result_check`).
     """
     path = _result_file(path)
-    with _open(path) as h5:
+    with _open(path) as h5, reading(path):
+        check_layout(h5, path)
         attrs = {key: _plain(value) for key, value in h5.attrs.items()}
+        check_attrs(attrs, path)
         for name in ("mesh/points", "mesh/cells"):
             if name not in h5:
-                raise UsageError(f"{path}: not a result.h5 of xfemslip (no /{name})")
+                raise ResultError(f"{path}: not a result.h5 of xfemslip (no /{name})")
         try:
-            return Result(
+            result = Result(
                 attrs=attrs,
                 points=h5["mesh/points"][()],
                 cells=h5["mesh/cells"][()],
@@ -293,8 +304,11 @@ def read_result(path: str | Path) -> Result:
                 permeability=_permeability(h5),
                 depletion=_depletion(h5),
             )
+            check_final_copy(h5, path)
         except KeyError:  # a dataset or attribute of the format is missing
-            raise UsageError(
+            raise ResultError(
                 f"{path}: not a result.h5 of xfemslip (a dataset of "
                 "output-format.md is missing)"
             ) from None
+    check_result(result, path)
+    return result

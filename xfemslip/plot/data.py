@@ -384,6 +384,26 @@ def figure_data(path: str | Path, label: str | None = None) -> ResultData:
         case, result.final
     )
     vtu = path.with_name("result.vtu")
-    if vtu.is_file():
+    if vtu.is_file() and _same_run(vtu, path, result.attrs.get("run_id")):
         _read_vtu(data, vtu)
     return data
+
+
+def _same_run(vtu: Path, path: Path, run_id) -> bool:
+    """Whether ``result.vtu`` was written by the run that wrote ``path``
+    (the ``run_id`` both carry, output-format.md); if not, say so: the
+    figures then draw result.h5's own mesh, without the split cells."""
+    from xfemslip.io.vtu import read_run_id
+
+    theirs = read_run_id(vtu)
+    if run_id is not None and theirs == int(run_id):
+        return True
+    logger.warning(
+        "%s is not of the run that wrote %s (run_id %s, not %s): it is not "
+        "drawn; the figures show result.h5's mesh without the jump",
+        vtu,
+        path,
+        "unreadable" if theirs is None else theirs,
+        run_id,
+    )
+    return False

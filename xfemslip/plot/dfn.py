@@ -24,6 +24,10 @@ from xfemslip.errors import OutputError, UsageError
 from xfemslip.io.read import read_result
 
 PANEL = 4.2  # inches
+# A case holds at most this many fractures: inline ones within the 8 MB of
+# a case file, and 5,000 per network source.
+MAX_FRACTURE_COUNT = 1_000_000
+MAX_BARS = 200  # one histogram bar per count up to this spread
 
 
 def _domain_frame(ax, spec) -> None:
@@ -85,7 +89,13 @@ def read_slipping_counts(summary: Path) -> tuple[np.ndarray, np.ndarray]:
         lines = read_input(summary, MAX_CSV_BYTES).splitlines()
     except UnreadableInput as exc:
         raise UsageError(f"{summary}: cannot read: {exc}") from None
-    rows = list(csv.DictReader(lines))
+    reader = csv.DictReader(lines)
+    try:
+        rows = list(reader)
+    except csv.Error as exc:  # a cell over csv's field limit, a NUL byte
+        raise UsageError(
+            f"{summary} line {reader.line_num}: not a CSV row of a summary: {exc}"
+        ) from None
     needed = ("status", "slipping_fractures", "fractures")
     if rows and any(name not in rows[0] for name in needed):
         raise UsageError(
@@ -97,19 +107,37 @@ def read_slipping_counts(summary: Path) -> tuple[np.ndarray, np.ndarray]:
         if row["status"] not in ("ok", "skipped"):
             continue
         try:
-            counts.append(int(row["slipping_fractures"]))
-            totals.append(int(row["fractures"]))
+            slipping, total = int(row["slipping_fractures"]), int(row["fractures"])
         except (TypeError, ValueError):
             raise UsageError(
                 f"{summary} line {line}: slipping_fractures and fractures must be "
                 "integers"
             ) from None
+        if not 0 <= slipping <= total <= MAX_FRACTURE_COUNT:
+            raise UsageError(
+                f"{summary} line {line}: slipping_fractures = {_short(slipping)} "
+                f"and fractures = {_short(total)} are not the counts of a case: "
+                f"expected 0 <= slipping_fractures <= fractures <= "
+                f"{MAX_FRACTURE_COUNT}"
+            )
+        counts.append(slipping)
+        totals.append(total)
     return np.array(counts, dtype=np.int64), np.array(totals, dtype=np.int64)
 
 
+def _short(n: int) -> str:
+    """An integer for a message: its digits, or its size when very long."""
+    text = str(n)
+    return text if len(text) <= 20 else f"a number of {len(text)} digits"
+
+
 def _draw_counts(ax, counts: np.ndarray, totals: np.ndarray) -> None:
-    """Histogram of the slipping count over the realizations."""
-    bins = np.arange(counts.min(), counts.max() + 2) - 0.5 if counts.size else 1
+    """Histogram of the slipping count over the realizations: one bar per
+    count up to MAX_BARS counts apart, else numpy's automatic bins."""
+    if counts.size and counts.max() - counts.min() < MAX_BARS:
+        bins = np.arange(counts.min(), counts.max() + 2) - 0.5
+    else:
+        bins = "auto" if counts.size else 1
     ax.hist(counts, bins=bins, color="tab:blue", edgecolor="k")
     total = f"{int(totals[0])}" if totals.size and np.ptp(totals) == 0 else "varies"
     ax.set_xlabel(f"slipping fractures (of {total})")

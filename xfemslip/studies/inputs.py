@@ -9,10 +9,12 @@ recorded with its key path in the table's problem list (docs/sweep-format.md,
 from __future__ import annotations
 
 import math
+import warnings
 
 import numpy as np
 
-from xfemslip.case.tables import Range, Table, show
+from xfemslip.case.load import value_rule
+from xfemslip.case.tables import Range, Table, range_problem, show
 from xfemslip.studies.sampling import KINDS, Distribution, score_correlation
 from xfemslip.studies.vary import MAX_CASES, parse_key_path
 
@@ -123,10 +125,61 @@ def _read_choice(table: Table, start: int) -> Distribution | None:
                 f"expected {len(values)} numbers >= 0, not all 0 (one per value)",
             )
             return None
-        weights = tuple(float(w) for w in weights)
+        # relative to the largest: weights of 1e308 must not sum to inf
+        top = max(float(w) for w in weights)
+        weights = tuple(float(w) / top for w in weights)
     if len(table.problems) > start:
         return None
     return Distribution("choice", tuple(float(v) for v in values), weights=weights)
+
+
+# The smallest and largest quantile the samplers draw (their uniform numbers
+# are multiples of 2^-53 in [0, 1)); a draw of exactly 0 is checked per sample.
+TAILS = np.array([2.0**-53, 1.0 - 2.0**-53])
+
+
+def draw_range(dist: Distribution) -> tuple[float, float]:
+    """(lowest, highest) value ``dist`` draws: the quantiles at TAILS, or
+    the values a choice can take; inf / NaN where a tail overflows."""
+    if dist.kind == "choice":
+        w = np.ones(len(dist.params)) if dist.weights is None else dist.weights
+        values = np.asarray(dist.params, float)[np.asarray(w) > 0.0]
+        return float(values.min()), float(values.max())
+    with np.errstate(all="ignore"), warnings.catch_warnings():
+        warnings.simplefilter("ignore", RuntimeWarning)
+        lo, hi = sorted(dist.ppf(TAILS))
+    return float(lo), float(hi)
+
+
+def support_problem(key: str, dist: Distribution) -> str:
+    """Why the values ``dist`` draws cannot be used for ``key``, or "": a
+    tail that overflows (inf) or, for a lognormal, underflows to 0, or
+    every value outside what the case format allows for the key
+    (:func:`xfemslip.case.load.value_rule`).  A distribution partly outside
+    is kept: its samples outside are refused one by one."""
+    lo, hi = draw_range(dist)
+    if not (math.isfinite(lo) and math.isfinite(hi)):
+        return (
+            f"the {dist.kind} distribution draws values beyond the largest "
+            f"number (from {lo!r} to {hi!r}); narrow it"
+        )
+    if dist.kind == "lognormal" and (lo == 0.0 or hi == 0.0):
+        return (
+            "the lognormal distribution draws values that underflow to 0 "
+            f"(sigma = {dist.params[1]!r} is too wide); narrow it"
+        )
+    rule = value_rule(key)
+    if rule is None:
+        return ""
+    below = rule.lo is not None and (hi <= rule.lo if rule.lo_open else hi < rule.lo)
+    above = rule.hi is not None and (lo >= rule.hi if rule.hi_open else lo > rule.hi)
+    if below or above:
+        inside = range_problem(hi if below else lo, rule, key.rsplit(".", 1)[-1])
+        return (
+            f"every value the {dist.kind} distribution draws ({lo:.6g} to "
+            f"{hi:.6g}) is outside what the case format allows: {inside}"
+        )
+    return ""
 
 
 def read_inputs(table: Table) -> tuple[list[str], list[Distribution]]:
@@ -158,7 +211,10 @@ def read_inputs(table: Table) -> tuple[list[str], list[Distribution]]:
             )
             continue
         dist = _read_distribution(Table(value, where, inputs.problems))
-        if dist is not None:
+        why = support_problem(key, dist) if dist is not None else ""
+        if why:
+            inputs.problems.append((where, why))
+        elif dist is not None:
             keys.append(key)
             dists.append(dist)
     return keys, dists

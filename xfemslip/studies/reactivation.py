@@ -22,8 +22,10 @@ slipping beyond every level (ranked last).
 
 from __future__ import annotations
 
+import contextlib
 import csv
 import logging
+import os
 import time
 import traceback
 from dataclasses import dataclass, field
@@ -88,12 +90,13 @@ def evaluate_screen(spec) -> UncertaintyResult:
 
     path, _ = stress_path(spec.base_spec)
     start = time.perf_counter()
-    bad = sample_problems(spec.keys, spec.values)
-    dp = critical_changes(spec.base_spec, spec.base, path, spec.keys, spec.values)
+    errors = sample_problems(spec.keys, spec.values)
+    bad = np.array([bool(e) for e in errors], dtype=bool)
+    with np.errstate(all="ignore"):  # the refused samples' values are not used
+        dp = critical_changes(spec.base_spec, spec.base, path, spec.keys, spec.values)
     dp[bad] = np.nan
     elapsed = time.perf_counter() - start
     status = np.where(bad, REFUSED, OK)
-    errors = ["a value outside the case format's bounds" if b else "" for b in bad]
     ids = [f"{i:0{max(3, len(str(spec.samples - 1)))}d}" for i in range(spec.samples)]
     result = UncertaintyResult(spec, path.description, ids, status, errors, dp)
     result.compute_time_s = elapsed
@@ -188,7 +191,7 @@ def evaluate_xfem(
     spec, directory: Path, *, jobs=1, client=None, force=False, progress=None
 ) -> UncertaintyResult:
     """Every sample through ``deplete`` (see the module doc)."""
-    from xfemslip.studies.run import is_done, run_dask, run_local, write_case
+    from xfemslip.studies.run import run_dask, run_local, write_case
 
     start = time.perf_counter()
     cases = sample_cases(spec)
@@ -207,32 +210,35 @@ def evaluate_xfem(
             status[i], errors[i] = REFUSED, reason
             logger.warning("sample %s refused: %s", cid, reason)
             write_case(spec, out_dir, text)
-        elif not force and is_done(out_dir, text, case) and _tables(out_dir):
+        elif not force and (found := _read_back(out_dir, text, case)) is not None:
             status[i] = SKIPPED
-            _store(values, i, read_sample(out_dir))
+            _store(values, i, found)
         else:
             write_case(spec, out_dir, text)
-            tasks.append(SampleTask(cid, text, str(spec.case_path), str(out_dir)))
+            # absolute: a Dask worker runs in a working directory of its own
+            tasks.append(
+                SampleTask(
+                    cid, text, os.path.abspath(spec.case_path), os.path.abspath(out_dir)
+                )
+            )
         if progress is not None and status[i] != OK:
             progress(cid, status[i])
     results = (
-        (
-            run_dask(tasks, client, deplete_task)
-            if client
-            else run_local(tasks, jobs, deplete_task)
-        )
-        if tasks
-        else ()
+        run_dask(tasks, client, deplete_task)
+        if client
+        else run_local(tasks, jobs, deplete_task)
     )
-    for cid, state, found, error in results:
-        i = index[cid]
-        status[i], errors[i] = state, error
-        if state == OK:
-            _store(values, i, found)
-        else:
-            logger.warning("sample %s failed: %s", cid, error)
-        if progress is not None:
-            progress(cid, state)
+    # closed on any way out: an interrupt stops the workers at once
+    with contextlib.closing(results) as outcomes:
+        for cid, state, found, error in outcomes:
+            i = index[cid]
+            status[i], errors[i] = state, error
+            if state == OK:
+                _store(values, i, found)
+            else:
+                logger.warning("sample %s failed: %s", cid, error)
+            if progress is not None:
+                progress(cid, state)
     result = UncertaintyResult(
         spec,
         "the full XFEM solve of every sample (xfemslip deplete: bisection of "
@@ -248,11 +254,29 @@ def evaluate_xfem(
     return aggregate(result)
 
 
-def _tables(out_dir: Path) -> bool:
-    return all(
-        (out_dir / name).is_file()
-        for name in ("critical_depletion.csv", "slip_vs_depletion.csv")
-    )
+def _read_back(out_dir: Path, text: str, case) -> dict | None:
+    """The values of a sample whose folder holds its whole result
+    (:func:`xfemslip.studies.run.is_done`) and both tables, read back; None
+    when it must be solved (again): a table missing, cut short or damaged
+    (said in a warning)."""
+    from xfemslip.studies.run import is_done
+
+    if not is_done(out_dir, text, case):
+        return None
+    try:
+        found = read_sample(out_dir)
+        if any(len(v) != len(case.fractures) for v in found.values()):
+            raise ValueError("not one value per fracture")
+    except (OSError, KeyError, ValueError, IndexError, TypeError, csv.Error) as exc:
+        if any((out_dir / name).exists() for name in TABLES):
+            logger.warning(
+                "%s: solve again: its tables cannot be read (%s)", out_dir, exc
+            )
+        return None
+    return found
+
+
+TABLES = ("critical_depletion.csv", "slip_vs_depletion.csv")
 
 
 def _store(values: dict, i: int, found: dict) -> None:

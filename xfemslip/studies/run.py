@@ -31,16 +31,16 @@ refused) and error. A sweep that varies a
 
 from __future__ import annotations
 
+import contextlib
 import logging
 import os
 import traceback
 from collections.abc import Callable, Iterable
-from concurrent.futures import ProcessPoolExecutor, as_completed
 from dataclasses import dataclass, field
-from multiprocessing import get_context
 from pathlib import Path
+from xml.etree import ElementTree
 
-from xfemslip.errors import OutputError, UsageError, XfemslipError
+from xfemslip.errors import OutputError, ResultError, UsageError, XfemslipError
 from xfemslip.io.csv import write_rows
 from xfemslip.io.fileset import replace_files
 from xfemslip.io.lock import folder_lock
@@ -95,7 +95,7 @@ def is_done(out_dir: Path, text: str, spec=None) -> bool:
         return False
     try:
         attrs = read_attrs(path)
-    except UsageError:  # unreadable: run it again
+    except ResultError:  # unreadable: run it again
         return False
     if not (
         bool(attrs.get("converged", False))
@@ -122,8 +122,25 @@ def _vtu_set_whole(out_dir: Path, spec, run_id: int) -> bool:
         for name in series:
             if read_run_id(out_dir / name) != run_id:
                 return False
-            names += pvd_files(out_dir / name)
+            try:
+                names += pvd_files(out_dir / name)
+            except (OSError, ElementTree.ParseError):  # cut short: run it again
+                return False
     return all(read_run_id(out_dir / name) == run_id for name in names)
+
+
+def done_metrics(out_dir: Path, text: str, spec) -> dict | None:
+    """The summary columns of a case whose folder holds its result whole
+    (:func:`is_done`), read back; None when it must run (again): no result,
+    another case's, or a file that cannot be read (damaged: flipped bits, cut
+    short), which is said in a warning."""
+    if not is_done(out_dir, text, spec):
+        return None
+    try:
+        return case_metrics(read_result(out_dir), spec)
+    except ResultError as err:
+        logger.warning("%s: run again: %s", out_dir, " ".join(str(err).split()))
+        return None
 
 
 # --------------------------------------------------------------------------- #
@@ -160,7 +177,7 @@ def run_task(task: CaseTask) -> tuple[str, str, dict, str]:
     if spec is not None and (out_dir / "result.h5").is_file():
         try:  # the converged steps of a failed run
             metrics = case_metrics(read_result(out_dir), spec)
-        except UsageError:
+        except ResultError:
             metrics = {}
     return task.case_id, "failed", metrics, error
 
@@ -184,13 +201,20 @@ def _prepare(sweep, directory: Path, force: bool) -> tuple[list, list[CaseRow]]:
             if case.text:  # for `xfemslip check` on it
                 write_case(sweep, out_dir, case.text)
             continue
-        if not force and is_done(out_dir, case.text, case.spec):
-            row = CaseRow(case.case_id, case.params, "skipped")
-            row.metrics = case_metrics(read_result(out_dir), case.spec)
-            skipped.append(row)
+        metrics = done_metrics(out_dir, case.text, case.spec) if not force else None
+        if metrics is not None:
+            skipped.append(CaseRow(case.case_id, case.params, "skipped", metrics))
             continue
         write_case(sweep, out_dir, case.text)
-        tasks.append(CaseTask(case.case_id, case.text, str(case.path), str(out_dir)))
+        # absolute: a Dask worker runs in a working directory of its own
+        tasks.append(
+            CaseTask(
+                case.case_id,
+                case.text,
+                os.path.abspath(case.path),
+                os.path.abspath(out_dir),
+            )
+        )
     return tasks, skipped
 
 
@@ -213,27 +237,22 @@ def _outcome(task: CaseTask, future) -> tuple:
     try:
         return future.result()
     except Exception as exc:  # noqa: BLE001 -- reported in the case's row
-        return task.case_id, "failed", {}, f"worker error: {type(exc).__name__}: {exc}"
+        return lost_task(task, f"{type(exc).__name__}: {exc}")
+
+
+def lost_task(task, reason: str) -> tuple:
+    """The outcome of a task whose worker was lost: that case failed."""
+    return task.case_id, "failed", {}, f"worker error: {reason}"
 
 
 def run_local(tasks: list, jobs: int, fn=run_task) -> Iterable[tuple]:
-    """``fn(task)`` of every task, in completion order: in this process, or a
-    spawn process pool (``fn`` must be importable by the workers and never
-    raise, as :func:`run_task`)."""
-    jobs = min(jobs, len(tasks))  # no idle workers to start
-    if jobs <= 1:
-        for task in tasks:
-            yield fn(task)
-        return
-    context = get_context("spawn")  # no forked Numba/BLAS state in the workers
-    with ProcessPoolExecutor(max_workers=jobs, mp_context=context) as pool:
-        futures = {pool.submit(fn, task): task for task in tasks}
-        try:
-            for future in as_completed(futures):
-                yield _outcome(futures[future], future)
-        except BaseException:
-            pool.shutdown(wait=False, cancel_futures=True)
-            raise
+    """``fn(task)`` of every task, in completion order: in this process, or
+    on ``jobs`` worker processes that stop with the sweep
+    (:mod:`xfemslip.studies.workers`; ``fn`` must be importable by the
+    workers and never raise, as :func:`run_task`)."""
+    from xfemslip.studies.workers import run_local as run_on_workers
+
+    return run_on_workers(tasks, jobs, fn, lost_task)
 
 
 def require_dask() -> None:
@@ -262,17 +281,57 @@ def connect(scheduler: str):
 
 def run_dask(tasks: list, client, fn=run_task) -> Iterable[tuple]:
     """``fn(task)`` of every task, in completion order, from a
-    dask.distributed ``client``."""
+    dask.distributed ``client``.  Each task runs in a child process of its
+    Dask worker (:func:`dask_task`), stopped when the sweep cancels the task
+    (an interrupt, an error) or its process dies: a Dask worker's thread
+    cannot be stopped, a process can."""
     from distributed import as_completed as dask_completed
 
     # pure=False: a rerun of the same task must run, not hit a cached result
-    futures = client.map(fn, tasks, pure=False)
+    futures = client.map(dask_task, tasks, fn=fn, pure=False)
     owner = {future.key: task for future, task in zip(futures, tasks, strict=True)}
     try:
         for future in dask_completed(futures):
             yield _outcome(owner[future.key], future)
     finally:
         client.cancel(futures)
+
+
+def dask_task(task, fn=run_task) -> tuple:
+    """On a Dask worker: ``fn(task)`` in a child process
+    (:func:`xfemslip.studies.workers.run_in_child`), stopped once the
+    scheduler no longer wants the task (cancelled, or its client gone)."""
+    from xfemslip.studies.workers import run_in_child
+
+    wanted = _dask_task_wanted()
+    try:
+        out = run_in_child(fn, task, wanted)
+    except RuntimeError as exc:
+        return lost_task(task, str(exc))
+    return out if out is not None else lost_task(task, "stopped with the sweep")
+
+
+def _dask_task_wanted() -> Callable[[], bool]:
+    """Whether the Dask task running in this thread is still wanted: its
+    state on this worker is not "cancelled" (the scheduler marks it so when
+    its client cancels it or disconnects).  Always True where the worker's
+    state cannot be read."""
+    try:
+        from distributed import get_worker
+        from distributed.worker import thread_state
+
+        worker, key = get_worker(), thread_state.key
+    except (ImportError, ValueError, AttributeError):
+        return lambda: True
+
+    def wanted() -> bool:
+        try:
+            state = worker.state.tasks.get(key)
+        except AttributeError:
+            return True
+        return state is not None and state.state not in ("cancelled", "released")
+
+    return wanted
 
 
 def run_sweep(
@@ -330,15 +389,19 @@ def _run_all(sweep, directory, jobs, client, force, progress) -> list[CaseRow]:
     tasks, rows = _prepare(sweep, directory, force)
     for row in rows if progress is not None else ():
         progress(row)
+    if not tasks:
+        return rows
     params = {case.case_id: case.params for case in sweep.cases}
     results = run_dask(tasks, client) if client else run_local(tasks, jobs)
-    for case_id, status, metrics, error in results if tasks else ():
-        row = CaseRow(case_id, params[case_id], status, metrics, error)
-        if status == "failed":
-            logger.warning("case %s failed: %s", case_id, error)
-        rows.append(row)
-        if progress is not None:
-            progress(row)
+    # closed on any way out: an interrupt stops the workers at once
+    with contextlib.closing(results) as outcomes:
+        for case_id, status, metrics, error in outcomes:
+            row = CaseRow(case_id, params[case_id], status, metrics, error)
+            if status == "failed":
+                logger.warning("case %s failed: %s", case_id, error)
+            rows.append(row)
+            if progress is not None:
+                progress(row)
     return rows
 
 

@@ -522,20 +522,30 @@ def _plane_ends(path: StressPath, theta: float, ends):
     return (mid - half)[None, :], (mid + half)[None, :]
 
 
-def sample_problems(keys, values) -> np.ndarray:
-    """(n,) bool: samples with a value the case format refuses (friction < 0,
-    cohesion < 0, length <= 0, nu outside (-1, 0.5), biot outside (0, 1],
-    E <= 0)."""
-    bad = np.zeros(values.shape[0], bool)
+def sample_problems(keys, values) -> list[str]:
+    """Per sample, why the case format refuses one of its values ("" when
+    none): each input against the rule of its key
+    (:func:`xfemslip.case.load.value_rule`, the rule the case reader checks),
+    and a value that is not finite (a draw that overflowed)."""
+    from xfemslip.case.load import value_rule
+    from xfemslip.case.tables import range_problem
+
+    reasons = [""] * values.shape[0]
     for j, key in enumerate(keys):
         x = values[:, j]
-        name = key.rsplit(".", 1)[-1]
-        if name in ("friction", "cohesion"):
-            bad |= x < 0.0
-        elif name in ("length", "E", "kn", "kt"):
-            bad |= x <= 0.0
-        elif name == "nu":
-            bad |= (x <= -1.0) | (x >= 0.5)
-        elif name == "biot":
-            bad |= (x <= 0.0) | (x > 1.0)
-    return bad
+        rule = value_rule(key)
+        bad = ~np.isfinite(x)
+        if rule is not None:
+            if rule.lo is not None:
+                bad |= (x <= rule.lo) if rule.lo_open else (x < rule.lo)
+            if rule.hi is not None:
+                bad |= (x >= rule.hi) if rule.hi_open else (x > rule.hi)
+        for i in np.flatnonzero(bad):
+            if not reasons[i]:
+                why = (
+                    range_problem(float(x[i]), rule, key.rsplit(".", 1)[-1])
+                    if np.isfinite(x[i])
+                    else f"must be finite, got {float(x[i])!r}"
+                )
+                reasons[i] = f"{key}: {why}"
+    return reasons

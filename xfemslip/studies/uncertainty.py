@@ -37,6 +37,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
+from scipy import special
 
 from xfemslip.case import loads_case, parse_toml, path_problem, read_text
 from xfemslip.case.tables import Range, Table, show
@@ -243,7 +244,13 @@ def loads_uncertainty(text: str, path: str | Path = "<string>") -> UncertaintySp
     if problems:
         raise CaseError(path, problems)
     base_spec = _base_spec(base, case_path, path)
+    if not base_spec.fractures:
+        raise CaseError(
+            path,
+            [("base", "the base case has no fracture: nothing could slip")],
+        )
     _check_levels(table, levels, base_spec)
+    _check_half_width(table, half_width, confidence)
     if evaluate == "screen":
         _check_screen(table, keys, base, base_spec)
     if problems:
@@ -269,6 +276,25 @@ def loads_uncertainty(text: str, path: str | Path = "<string>") -> UncertaintySp
         correlation=correlation,
         values=values,
     )
+
+
+def _check_half_width(table: Table, half_width: float, confidence: float) -> None:
+    """The samples ``half_width`` asks for (at P = 0.5, the most: about
+    (z / 2 half_width)^2) must be samples a study can draw: a target beyond
+    them only means a search over numbers too large to count exactly."""
+    if half_width is None or confidence is None:
+        return
+    z = float(special.ndtri(0.5 + confidence / 2.0))
+    with np.errstate(over="ignore"):
+        needed = (z / (2.0 * half_width)) ** 2
+    if needed > MAX_SCREEN_SAMPLES:
+        smallest = z / (2.0 * math.sqrt(MAX_SCREEN_SAMPLES))
+        table.error(
+            "half_width",
+            f"{half_width!r} at confidence {confidence:g} needs about {needed:.3g} "
+            f"samples at P = 0.5, more than the {MAX_SCREEN_SAMPLES} a study may "
+            f"draw; give at least {smallest:.2g}",
+        )
 
 
 def _check_screen(table: Table, keys: list[str], base: dict, base_spec) -> None:

@@ -224,14 +224,24 @@ def format_summary(result) -> str:
             for k in shown
         )
         if len(spec.keys):
-            k = int(np.nanargmax(np.abs(np.nan_to_num(result.sensitivity[j], nan=0.0))))
-            lines.append(
-                f"    most sensitive to {spec.keys[k]} (Spearman with dp_critical "
-                f"{result.sensitivity[j, k]:+.3f})"
-            )
+            lines.append(_sensitivity_line(spec.keys, result.sensitivity[j]))
         if result.max_slip is not None:
             lines.append(_slip_line(result, j))
     return "\n".join(lines)
+
+
+def _sensitivity_line(keys, rho) -> str:
+    """The input with the largest |Spearman rho|, or why there is none: a
+    rank correlation is undefined (NaN) over fewer than two evaluated
+    samples, or when the input or dp_critical does not vary over them."""
+    rho = np.asarray(rho, float)
+    if not np.any(np.isfinite(rho)):
+        return (
+            "    sensitivity: not defined (the Spearman correlation needs at "
+            "least two evaluated samples in which the input and dp_critical vary)"
+        )
+    k = int(np.nanargmax(np.abs(rho)))
+    return f"    most sensitive to {keys[k]} (Spearman with dp_critical {rho[k]:+.3f})"
 
 
 def _slip_line(result, j: int) -> str:

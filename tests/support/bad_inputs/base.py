@@ -47,6 +47,7 @@ class Input:
     out: str | None = OUT  # the folder that must stay empty on exit 2
     subprocess: bool = False  # run as `python -m xfemslip` (env read at import)
     timeout: float = 30.0
+    stdin: bytes | None = None  # standard input of the command (None: empty)
 
 
 def toml(doc: dict) -> str:

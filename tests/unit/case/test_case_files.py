@@ -3,9 +3,11 @@ encodings, TOML nesting, paths that no file system holds."""
 
 from __future__ import annotations
 
+import io
 import os
 import signal
 import threading
+from pathlib import Path
 
 import pytest
 
@@ -18,7 +20,7 @@ from xfemslip.case import (
     parse_toml,
     path_problem,
 )
-from xfemslip.case.files import READ_CHUNK, UnreadableInput, read_input
+from xfemslip.case.files import READ_CHUNK, UnreadableInput, input_folder, read_input
 from xfemslip.errors import CaseError
 
 TINY = {
@@ -62,25 +64,74 @@ def test_a_byte_order_mark_is_dropped(tmp_path):
     [("/dev/zero", "character device"), ("/dev/urandom", "character device")],
 )
 def test_devices_are_refused_unread(device, kind):
-    assert _refusal(device) == f"is a {kind}, not a regular file"
+    assert _refusal(device) == f"is a {kind}, not a regular file or a pipe"
 
 
-def test_a_fifo_is_refused_without_waiting_for_a_writer(tmp_path):
+def test_a_fifo_nobody_writes_to_reads_as_empty_without_waiting(tmp_path):
     fifo = tmp_path / "pipe"
     os.mkfifo(fifo)
     result = {}
-    reader = threading.Thread(target=lambda: result.update(r=_refusal(fifo)))
+    reader = threading.Thread(target=lambda: result.update(r=read_input(fifo, 100)))
     reader.start()
     reader.join(timeout=10)  # the harness's bound: a blocking open never returns
     if reader.is_alive():  # unblock the reader so the test process can end
         with open(fifo, "w"):
             pass
         reader.join()
-    assert result.get("r") == "is a FIFO (named pipe), not a regular file"
+    assert result.get("r") == ""
+    with pytest.raises(CaseError, match="the case file is empty"):
+        load_case(fifo)
+
+
+def test_a_pipe_is_read_to_its_end_with_the_cap(tmp_path):
+    """A process substitution ``<(...)``: the read end of a pipe, named by
+    /proc/self/fd/N, whose writer writes in pieces and then closes it; its
+    relative CSV paths resolve against the working directory."""
+    read_end, write_end = os.pipe()
+    data = CASE.encode() * 3
+
+    def write() -> None:
+        for k in range(0, len(data), 1000):
+            os.write(write_end, data[k : k + 1000])
+        os.close(write_end)
+
+    writer = threading.Thread(target=write)
+    writer.start()
+    try:
+        path = f"/proc/self/fd/{read_end}"
+        assert read_input(path, 10**6) == data.decode()
+        assert input_folder(path) == Path(".")
+    finally:
+        writer.join()
+        os.close(read_end)
+    read_end, write_end = os.pipe()
+    writer = threading.Thread(
+        target=lambda: (os.write(write_end, b"x" * 5000), os.close(write_end))
+    )
+    writer.start()
+    try:
+        assert _refusal(f"/proc/self/fd/{read_end}", limit=4000).startswith(
+            "more than the limit"
+        )
+    finally:
+        writer.join()
+        os.close(read_end)
+
+
+def test_standard_input_is_the_path_dash(monkeypatch, tmp_path):
+    monkeypatch.setattr("sys.stdin", io.TextIOWrapper(io.BytesIO(CASE.encode())))
+    assert read_input("-", 10**6) == CASE
+    assert input_folder("-") == Path(".")
+    monkeypatch.setattr("sys.stdin", io.TextIOWrapper(io.BytesIO(CASE.encode())))
+    monkeypatch.chdir(tmp_path)
+    spec = load_case("-")
+    assert spec.name == "tiny" and str(spec.path) == "-"
+    monkeypatch.setattr("sys.stdin", io.TextIOWrapper(io.BytesIO(b"x" * 5000)))
+    assert _refusal("-", limit=4000) == "more than the limit of 0.00381 MB"
 
 
 def test_a_directory_and_a_missing_file_are_refused(tmp_path):
-    assert _refusal(tmp_path) == "is a directory, not a regular file"
+    assert _refusal(tmp_path) == "is a directory, not a regular file or a pipe"
     assert _refusal(tmp_path / "nope") == "No such file or directory"
 
 
@@ -116,7 +167,8 @@ def test_load_case_names_the_file_and_the_reason(tmp_path):
     with pytest.raises(CaseError) as info:
         load_case(tmp_path)
     assert str(info.value) == (
-        f"{tmp_path}: cannot read the case file: is a directory, not a regular file"
+        f"{tmp_path}: cannot read the case file: is a directory, not a regular "
+        "file or a pipe"
     )
 
 

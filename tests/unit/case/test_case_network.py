@@ -244,7 +244,11 @@ GENERATE_ERRORS = [
         {"friction": None, "frction": 0.5},
         "unknown key 'frction' in [network]; did you mean 'friction'?",
     ),
-    ({"generate.count": 60, "generate.min_spacing": 0.1}, "placed only"),
+    pytest.param(  # places 60 fractures one by one: slow tier
+        {"generate.count": 60, "generate.min_spacing": 0.1},
+        "placed only",
+        marks=pytest.mark.slow,
+    ),
 ]
 
 

@@ -102,7 +102,48 @@ def test_the_network_hydraulic_table_applies_to_its_fractures(tmp_path):
 @pytest.mark.parametrize(
     ("permeability", "hydraulic", "key", "words"),
     [
-        ({"aperture": 0.0}, None, "permeability.aperture", "must be > 0"),
+        (
+            {"aperture": 0.0},
+            None,
+            "permeability.aperture",
+            "1e-09 <= aperture <= 1, got 0.0",
+        ),
+        (
+            {"aperture": 1e-110},
+            None,
+            "permeability.aperture",
+            "1e-09 <= aperture <= 1, got 1e-110",
+        ),
+        (
+            {"aperture": 1e110},
+            None,
+            "permeability.aperture",
+            "1e-09 <= aperture <= 1, got 1e+110",
+        ),
+        (
+            {"aperture": 1e-4},
+            {"aperture": 2.0},
+            "fractures[0].hydraulic.aperture",
+            "1e-09 <= aperture <= 1",
+        ),
+        (
+            {"aperture": 1e-4, "max_closure": 1e-4, "normal_stiffness": 5e-324},
+            None,
+            "permeability.normal_stiffness",
+            "1000 <= normal_stiffness <= 1e+16",
+        ),
+        (
+            {"aperture": 1e-4, "matrix": 1e300},
+            None,
+            "permeability.matrix",
+            "0 <= matrix <= 1e-06",
+        ),
+        (
+            {"aperture": 1e-4, "block": [1.0, -1.0, 1.4, -0.5]},
+            None,
+            "permeability.block",
+            "at least one cell of the mesh wide and high (0.5 x 0.5 m), got 0.4",
+        ),
         (
             {"aperture": 1e-4, "dilation_angle": 90.0},
             None,
@@ -125,7 +166,7 @@ def test_the_network_hydraulic_table_applies_to_its_fractures(tmp_path):
             {"aperture": 1e-4, "matrix": -1e-18},
             None,
             "permeability.matrix",
-            "must be >= 0",
+            "0 <= matrix <= 1e-06, got -1e-18",
         ),
         (
             {"aperture": 1e-4, "max_closure": 2e-4, "normal_stiffness": 1e10},

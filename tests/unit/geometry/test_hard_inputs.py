@@ -51,6 +51,7 @@ def test_dense_polyline_runs_simplified_with_a_warning(tmp_path, make, points):
     assert peak < PEAK_MB
 
 
+@pytest.mark.slow  # (benchmarks/hard_inputs.py measures it)
 def test_many_vertex_reservoir_polygon_runs(tmp_path):
     code, _, peak, lines = _run(tmp_path, polygon(), "run")
     assert code == 0, lines[-3:]

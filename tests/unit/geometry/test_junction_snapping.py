@@ -35,6 +35,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from tests.support.casegen import SHIPPED_DFN, fracture_spec
+from tests.support.tiers import examples
 from xfemslip.case import build, loads_case
 from xfemslip.errors import GeometryError
 from xfemslip.fem.mesh import build_mesh
@@ -319,7 +320,7 @@ def tricky_network(draw):
     return [s for s in segments if np.linalg.norm(s[1] - s[0]) > 1e-3]
 
 
-@settings(max_examples=300, deadline=None, derandomize=True)
+@settings(max_examples=examples(300), deadline=None, derandomize=True)
 @given(tricky_network())
 def test_tricky_pairs_and_triples_build_with_consistent_junctions(segments):
     tol = GEOMETRY_TOL * H

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import copy
 import os
+import signal
 import xml.etree.ElementTree as ET
 
 import h5py
@@ -12,10 +13,12 @@ import numpy as np
 import pytest
 
 import xfemslip
-from xfemslip import __version__
-from xfemslip.errors import OutputError
+from xfemslip import __version__, interrupt
+from xfemslip.errors import OutputError, ResultError
 from xfemslip.io.atomic import atomic_path
+from xfemslip.io.csv import ROWS_PER_CHECKPOINT, write_rows
 from xfemslip.io.hdf5 import write_result
+from xfemslip.io.read import read_result
 from xfemslip.io.vtu import write_bulk, write_fractures, write_pvd
 from xfemslip.post.fields import FractureFields, StepFields, VisMesh
 from xfemslip.post.result import EventTable
@@ -165,6 +168,45 @@ def _check_fracture(group, fracture: FractureFields):
     pressure = group["contact_pressure"][()]
     np.testing.assert_array_equal(pressure, np.maximum(-fracture.normal_traction, 0.0))
     assert not np.signbit(pressure).any()  # no -0.0
+
+
+def test_result_h5_data_sets_carry_checksums(tmp_path):
+    """Every array data set has a Fletcher-32 checksum: one flipped bit in
+    the stored numbers fails the read with a ResultError naming the file
+    (without the checksum it reads back as another number)."""
+    path = tmp_path / "result.h5"
+    _write(path)
+    with h5py.File(path, "r") as h5:
+        arrays = []
+        h5.visititems(
+            lambda name, item: arrays.append(item)
+            if isinstance(item, h5py.Dataset) and item.ndim
+            else None
+        )
+        assert arrays and all(item.fletcher32 for item in arrays)
+        offset = h5["mesh/points"].id.get_chunk_info(0).byte_offset
+    data = bytearray(path.read_bytes())
+    data[offset + 3] ^= 0x10  # a bit of the first number
+    path.write_bytes(bytes(data))
+    with pytest.raises(ResultError, match=f"{path}: not a readable result.h5"):
+        read_result(path)
+
+
+def test_write_rows_acts_on_a_held_signal_every_chunk_of_rows(tmp_path):
+    """A signal held back while a set of files is written stops a long
+    table after at most ROWS_PER_CHECKPOINT more rows, not at its end."""
+    consumed = []
+
+    def rows():
+        for k in range(5 * ROWS_PER_CHECKPOINT):
+            if k == 10:
+                os.kill(os.getpid(), signal.SIGINT)
+            consumed.append(k)
+            yield [str(k)]
+
+    with pytest.raises(KeyboardInterrupt), interrupt.deferred():
+        write_rows(tmp_path / "t.csv", ["k"], rows())
+    assert 10 < len(consumed) <= ROWS_PER_CHECKPOINT + 1
 
 
 def test_result_h5_root_attributes(tmp_path):

@@ -175,6 +175,7 @@ def test_choose(monkeypatch):
         kernels.choose("cuda", 1.0)
 
 
+@pytest.mark.slow  # compiles the Numba kernels in a fresh process
 def test_shipped_reservoir_case_is_numpy_and_the_dfn_limit_is_numba(
     monkeypatch, tmp_path
 ):

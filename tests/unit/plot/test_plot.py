@@ -5,6 +5,7 @@ imports matplotlib, and the commands write PNG and PDF."""
 from __future__ import annotations
 
 import os
+import shutil
 import subprocess
 import sys
 from pathlib import Path
@@ -37,8 +38,7 @@ PNG = b"\x89PNG\r\n\x1a\n"
 
 @pytest.fixture(scope="module")
 def two_runs(tmp_path_factory):
-    """The small case at 45 and 63 degrees (result.h5 + vtu); the first run
-    with --plot."""
+    """The small case at 45 and 63 degrees (result.h5 + vtu)."""
     root = tmp_path_factory.mktemp("plots")
     runner = CliRunner()
     outs = []
@@ -47,15 +47,18 @@ def two_runs(tmp_path_factory):
         keys = {"fractures.0.angle": angle, "output.formats": ["h5", "vtu"]}
         case.write_text(build.case_text(build.with_keys(CASE, **keys)))
         out = root / f"{int(angle):03d}_angle={angle:g}"
-        plot = ["--plot"] if angle == 45.0 else []
-        result = runner.invoke(cli, ["run", str(case), "-o", str(out), *plot])
+        result = runner.invoke(cli, ["run", str(case), "-o", str(out)])
         assert result.exit_code == 0, result.output
         outs.append(out)
     return outs
 
 
-def test_run_plot_writes_every_figure_as_png_and_pdf(two_runs):
-    figures = two_runs[0] / "figures"
+def test_run_plot_writes_every_figure_as_png_and_pdf(two_runs, tmp_path):
+    case = two_runs[0].parent / "a45.toml"
+    out = tmp_path / "out"
+    result = CliRunner().invoke(cli, ["run", str(case), "-o", str(out), "--plot"])
+    assert result.exit_code == 0, result.output
+    figures = out / "figures"
     for kind in KINDS:
         assert (figures / f"{kind}.png").read_bytes()[:8] == PNG
         assert (figures / f"{kind}.pdf").read_bytes()[:4] == b"%PDF"
@@ -114,6 +117,25 @@ def test_deformed_mesh_uses_the_split_mesh(two_runs):
         jump = max(jump, float(np.ptp(np.linalg.norm(u, axis=1))))
     slip = np.abs(data.fractures[0].slip).max()
     assert jump > 0.5 * slip
+
+
+def test_a_result_vtu_of_another_run_is_not_drawn_and_said(two_runs, tmp_path, runner):
+    """result.vtu beside result.h5 carries its run's run_id: one of another
+    run (here the 63-degree run's) is named in a warning and left out (the
+    figures draw result.h5's own mesh), never drawn as if it belonged."""
+    folder = tmp_path / "mixed"
+    folder.mkdir()
+    shutil.copy(two_runs[0] / "result.h5", folder / "result.h5")
+    shutil.copy(two_runs[1] / "result.vtu", folder / "result.vtu")
+    assert figure_data(folder / "result.h5").vis_edges is None
+    own = figure_data(two_runs[0] / "result.h5")
+    assert own.vis_edges is not None
+    args = ["plot", str(folder), "-o", str(tmp_path / "f"), "--format", "png"]
+    result = runner.invoke(cli, [*args, "--figure", "deformed_mesh"])
+    assert result.exit_code == 0, result.stderr
+    warnings = [ln for ln in result.stderr.splitlines() if ln.startswith("WARNING:")]
+    assert len(warnings) == 1 and str(folder / "result.vtu") in warnings[0]
+    assert "is not of the run that wrote" in warnings[0]
 
 
 def test_piece_outlines_drop_inner_edges_of_one_side():

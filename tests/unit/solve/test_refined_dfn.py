@@ -13,6 +13,7 @@ from __future__ import annotations
 from pathlib import Path
 
 import numpy as np
+import pytest
 
 from tests.support.casegen import sweep_member
 from xfemslip.case import loads_case
@@ -26,6 +27,7 @@ HERE = Path(__file__).resolve().parent
 CASE = sweep_member(**{"mesh.elements": [100, 100], "solver.max_step_cuts": 0})
 
 
+@pytest.mark.slow  # a 100 x 100 network realization: ~10 s of CPU
 def test_refined_dfn_realization_converges_to_the_true_law():
     model = build_model(loads_case(CASE, HERE / "dfn_refined.toml"))
     solver = newton_solver(model)

@@ -151,6 +151,107 @@ def test_bad_uncertainty_tables_name_the_key(
     assert str(path) in text and key in text and words in text
 
 
+@pytest.mark.parametrize(
+    ("inputs", "words"),
+    [
+        (
+            '"fractures[0].friction" = { distribution = "uniform", low = -1e308, '
+            "high = 1e308 }",
+            "draws values beyond the largest number",
+        ),
+        (
+            '"fractures[0].friction" = { distribution = "lognormal", median = 0.5, '
+            "sigma = 1000.0 }",
+            "draws values beyond the largest number",
+        ),
+        (
+            '"fractures[0].friction" = { distribution = "normal", mean = 0.5, '
+            "std = 1e308 }",
+            "draws values beyond the largest number",
+        ),
+        (
+            '"material.nu" = { distribution = "uniform", low = -0.4, high = -0.1 }',
+            "every value the uniform distribution draws (-0.4 to -0.1) is outside "
+            "what the case format allows: must satisfy 0 <= nu < 0.5, got -0.1",
+        ),
+        (
+            '"fractures[0].friction" = { distribution = "choice", '
+            "values = [-0.2, -0.1] }",
+            "must be >= 0, got -0.1",
+        ),
+    ],
+)
+def test_distributions_that_overflow_or_lie_outside_the_key_are_refused(
+    tmp_path, inputs, words
+):
+    path = study(tmp_path, inputs, samples=10)
+    with pytest.raises(CaseError) as info:
+        load(path)
+    assert "uncertainty.inputs." in str(info.value) and words in str(info.value)
+
+
+def test_samples_outside_the_case_format_are_refused_by_the_screen(tmp_path):
+    """nu < 0 is no value of the case format (it reads 0 <= nu < 0.5): the
+    screen refuses those samples one by one and counts the others."""
+    inputs = '"material.nu" = { distribution = "uniform", low = -0.2, high = 0.3 }'
+    spec = load(study(tmp_path, inputs, samples=100))
+    result = evaluate_screen(spec)
+    negative = spec.values[:, 0] < 0.0
+    assert 0 < negative.sum() < 100
+    assert np.array_equal(result.status == "refused", negative)
+    assert result.evaluated == 100 - negative.sum()
+    reasons = {e for e, bad in zip(result.errors, negative, strict=True) if bad}
+    assert all(e.startswith("material.nu: must satisfy 0 <= nu < 0.5") for e in reasons)
+
+
+def test_choice_weights_of_1e308_draw_every_value(tmp_path):
+    """Weights summing beyond the largest float are normalised by the
+    largest: three equal weights of 1e308 draw each value a third of the
+    time (Latin hypercube: exactly, up to one sample)."""
+    inputs = (
+        '"fractures[0].friction" = { distribution = "choice", '
+        "values = [0.45, 0.5, 0.55], weights = [1e308, 1e308, 1e308] }"
+    )
+    spec = load(study(tmp_path, inputs, samples=300))
+    values, counts = np.unique(spec.values[:, 0], return_counts=True)
+    assert list(values) == [0.45, 0.5, 0.55]
+    assert all(abs(c - 100) <= 1 for c in counts)
+
+
+def test_a_half_width_no_study_can_reach_is_refused(tmp_path):
+    path = study(tmp_path)
+    path.write_text(path.read_text().replace("seed = 3", "seed = 3\nhalf_width = 1e-9"))
+    with pytest.raises(CaseError) as info:
+        load(path)
+    # (z / 2h)^2 at the 95 % confidence: z = 1.959964
+    assert "uncertainty.half_width: 1e-09 at confidence 0.95 needs about 9.6e+17" in (
+        str(info.value)
+    )
+    assert "give at least 0.00098" in str(info.value)
+
+
+def test_a_base_case_without_fractures_is_refused(tmp_path):
+    base = BASE.replace(
+        "[[fractures]]\ncenter = [50.0, 50.0]\nlength = 10.0\nangle = 60.0\n"
+        "friction = 0.6\n",
+        "",
+    )
+    inputs = '"material.E" = { distribution = "uniform", low = 9e9, high = 11e9 }'
+    for evaluate in ("screen", "xfem"):
+        with pytest.raises(CaseError, match="base: the base case has no fracture"):
+            load(study(tmp_path, inputs, samples=5, evaluate=evaluate, base=base))
+
+
+def test_one_sample_names_no_most_sensitive_input(tmp_path, runner):
+    """A rank correlation over one sample is undefined (NaN): the summary
+    says so instead of naming an input."""
+    path = study(tmp_path, samples=1)
+    res = runner.invoke(main, ["sweep", str(path), "-o", str(tmp_path / "out")])
+    assert res.exit_code == 0, res.output
+    assert "most sensitive" not in res.output
+    assert "sensitivity: not defined" in res.output
+
+
 def test_overlapping_inputs_are_refused(tmp_path):
     inputs = (
         FRICTION + '\n"fractures[0]" = { distribution = "choice", values = [1.0, 2.0] }'
