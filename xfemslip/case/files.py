@@ -116,6 +116,12 @@ def read_input(path: Path, limit: int) -> str:
         data = _read_capped(fd, limit)
     finally:
         os.close(fd)
+    if size is None and not data:
+        # a named pipe opened while nothing writes to it reads as its end at
+        # once; no input file is valid empty, so say what happened
+        raise UnreadableInput(
+            "is a pipe that gave nothing (is a program writing to it?)"
+        )
     return _decode(data)
 
 
