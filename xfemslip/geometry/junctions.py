@@ -108,8 +108,10 @@ def _check_fractures_per_cell(mesh, polylines, names, tol) -> None:
 # 2. Junctions are then found on the snapped polylines, within tol only:
 #    where two fractures meet at an end of both it is a V, at an end of one
 #    a T (that one is the secondary), elsewhere an X (the secondary is the
-#    lower-ranked, _rank_key).  So every junction point lies on both
-#    fractures, and two fractures that meet have a junction.
+#    lower-ranked, _rank_key).  An end within tol of the other fracture is
+#    where they meet, however small their angle (_segment_crossing).  So
+#    every junction point lies on both fractures, and two fractures that
+#    meet have a junction.
 # A junction at any angle can be built: the cut of an arm (Cut) needs only
 # the side of the main's line the arm lies on, defined wherever two fractures
 # meet without overlapping (for two collinear fractures meeting end to end,
@@ -181,10 +183,23 @@ def _apart(p0, p1, q0, q1, tol):
 
 def _segment_crossing(p0, p1, q0, q1, tol):
     """Parameters [(ta, tb)] where segments p0-p1 and q0-q1 ((2,) float
-    sequences, not overlapping) meet: their crossing, or the end points of
-    one lying within tol of the other (a T, a shared end, a near miss); []
-    where they are further apart than tol."""
+    sequences, not overlapping) meet: the end points of one lying within tol
+    of the other (a T, a shared end, a near miss), else their crossing; []
+    where they are further apart than tol.
+
+    An end within tol of the other segment lies in the stretch where the two
+    meet, so it is the same meeting as their crossing, and the one to report:
+    at an angle theta the crossing's place along the segments is uncertain by
+    the coordinates' round-off / theta (more than tol = 1e-9 h below about
+    1e-6 rad ten cells from the origin), the end's distance to the other
+    segment is not.  So two ends trimmed onto one crossing, or an end lying
+    on the other fracture, are found at those ends (a V, a T), however small
+    the angle.
+    """
     d1x, d1y, d2x, d2y = p1[0] - p0[0], p1[1] - p0[1], q1[0] - q0[0], q1[1] - q0[1]
+    hits = _end_hits(p0, p1, q0, q1, d1x, d1y, d2x, d2y, tol)
+    if hits:
+        return hits
     l1, l2 = math.hypot(d1x, d1y), math.hypot(d2x, d2y)
     cross = d1x * d2y - d1y * d2x
     if abs(cross) > 1e-12 * l1 * l2:
@@ -193,6 +208,12 @@ def _segment_crossing(p0, p1, q0, q1, tol):
         tb = (rx * d1y - ry * d1x) / cross
         if 0.0 <= ta <= 1.0 and 0.0 <= tb <= 1.0:
             return [(ta, tb)]
+    return []
+
+
+def _end_hits(p0, p1, q0, q1, d1x, d1y, d2x, d2y, tol):
+    """Parameters [(ta, tb)] of the end points of segment p or q lying within
+    tol of the other (d1, d2: their directions p1 - p0, q1 - q0)."""
     hits = []
     for ta, p in ((0.0, p0), (1.0, p1)):
         tb = _nearest_parameter(q0, d2x, d2y, p)

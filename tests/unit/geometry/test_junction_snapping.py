@@ -31,7 +31,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from hypothesis import given, settings
+from hypothesis import example, given, settings
 from hypothesis import strategies as st
 
 from tests.support.casegen import SHIPPED_DFN, fracture_spec
@@ -203,6 +203,35 @@ def test_v_with_a_gap_snaps_only_at_an_angle(degrees):
         np.testing.assert_array_equal(after[1], other)
 
 
+@pytest.mark.parametrize("delta", [1e-6, 1e-5, 1e-3, 1.0])
+@pytest.mark.parametrize("heading", [12.96, 41.19, 75.3])
+def test_crossing_just_short_of_both_ends_is_a_v(heading, delta):
+    """Two fractures crossing at C at a small angle delta [deg], both ending
+    less than snap beyond it (the starts are 0.25 delta apart): both ends are
+    trimmed back to where the fractures meet, one V there, the starts stay two
+    tips.  They meet within tol of each other over tol / sin(delta) either side
+    of C (6 mm at 1e-6 deg: the junction may be at the nearer end); the place
+    of the crossing itself is uncertain by round-off / delta (1e-8 m at 1e-6
+    deg, more than tol), and the two trims must still end on one point."""
+    C = np.array([0.55, 0.45])
+    u = [
+        np.array([math.cos(a), math.sin(a)])
+        for a in np.radians([heading, heading + delta])
+    ]
+    main = [C - 0.25 * u[0], C + 0.0014 * u[0]]
+    other = [C - 0.25 * u[1], C + 0.0012 * u[1]]
+    after, found, fractures = _check([main, other])
+    assert [k for k, *_ in found] == ["V"]
+    point = found[0][3]
+    meet = GEOMETRY_TOL * H / math.sin(math.radians(delta))
+    assert np.linalg.norm(point - C) <= meet + 1e-6 * H
+    for f in (0, 1):
+        assert np.linalg.norm(after[f][1] - point) <= GEOMETRY_TOL * H
+    np.testing.assert_array_equal(after[:, 0], np.array([main[0], other[0]]))
+    sec = fractures[found[0][2]]
+    assert sec.junction_ends == (1,) and len(sec.tips) == 1
+
+
 @pytest.mark.parametrize("reverse", [False, True])
 @pytest.mark.parametrize("offset", [0.05, 0.2, 0.45])
 def test_both_ends_within_snap_of_the_others_ends(reverse, offset):
@@ -322,6 +351,18 @@ def tricky_network(draw):
 
 @settings(max_examples=examples(300), deadline=None, derandomize=True)
 @given(tricky_network())
+@example(  # starts 3e-8 m apart, crossing at 2e-5 deg 1.2-1.4 mm from the ends
+    [
+        [
+            [0.5843287103451505, 0.40661521424845504],
+            [0.6656712896548495, 0.4778104645967063],
+        ],
+        [
+            [0.5843287311722484, 0.40661519045282524],
+            [0.665513764862967, 0.477672591202556],
+        ],
+    ]
+)
 def test_tricky_pairs_and_triples_build_with_consistent_junctions(segments):
     tol = GEOMETRY_TOL * H
     before = np.array(segments)
