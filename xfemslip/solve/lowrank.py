@@ -112,9 +112,7 @@ def patch_tangents(blocks, coef, dofs):
         for b in (0, 1):
             D[i, a, b] = blocks[i, 2 * k[i] + a, 2 * k[i] + b] / ck[i] ** 2
     cc = coef[:, :, None] * coef[:, None, :]  # (m, J, J)
-    recon = (cc[:, :, None, :, None] * D[:, None, :, None, :]).reshape(
-        m, 2 * J, 2 * J
-    )
+    recon = (cc[:, :, None, :, None] * D[:, None, :, None, :]).reshape(m, 2 * J, 2 * J)
     scale = np.abs(blocks).max(axis=(1, 2))
     if np.any(np.abs(recon - blocks).max(axis=(1, 2)) > FORM_RTOL * scale):
         return None
@@ -153,9 +151,7 @@ class LowRankSystems:
         self._row_abs_K = np.asarray(abs(K).sum(axis=1)).ravel()
         self._absL = abs(self.L).tocsr()
         R = K + self.Mt @ self.M
-        B = sp.bmat(
-            [[R, -self.Mt], [-self.M, 2.0 * sp.identity(2 * m)]], format="csr"
-        )
+        B = sp.bmat([[R, -self.Mt], [-self.M, 2.0 * sp.identity(2 * m)]], format="csr")
         upper = sp.triu(B, format="csr")
         upper.sum_duplicates()
         upper.sort_indices()
