@@ -150,9 +150,15 @@ class LowRankSystems:
         self.stats = stats
         self._row_abs_K = np.asarray(abs(K).sum(axis=1)).ravel()
         self._absL = abs(self.L).tocsr()
-        R = K + self.Mt @ self.M
-        B = sp.bmat([[R, -self.Mt], [-self.M, 2.0 * sp.identity(2 * m)]], format="csr")
-        upper = sp.triu(B, format="csr")
+        # the upper triangle of B, block by block (the whole of R and B
+        # would be two more copies of the stiffness at once)
+        upper = sp.bmat(
+            [
+                [sp.triu(K) + sp.triu(self.Mt @ self.M), -self.Mt],
+                [None, 2.0 * sp.identity(2 * m)],
+            ],
+            format="csr",
+        )
         upper.sum_duplicates()
         upper.sort_indices()
         self.handle = Handle(
