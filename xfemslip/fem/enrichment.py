@@ -340,8 +340,9 @@ def build_enriched_cells(
 ) -> EnrichedCells:
     """Slots, sub-cell quadrature and enrichment values of every enriched cell.
 
-    Two passes: the sub-cells of each cell (its own cut lines), then the
-    enrichment functions of each (fracture, tip or arm) group evaluated once
+    Two passes: the sub-cells of every cell (its own cut lines, all cells in
+    one call of the kernel ``backend``'s cell_subtriangles, "numba" or
+    "numpy"), then the enrichment functions of each (fracture, tip or arm) group evaluated once
     on the quadrature points and sub-triangle vertices of all the cells the
     group reaches (the functions are point-wise, so the values are those of a
     cell-by-cell evaluation; measured in docs/performance.md, "Fracture

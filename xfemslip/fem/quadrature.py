@@ -3,7 +3,8 @@
 Enriched cells are cut into convex sub-polygons along every line across which
 an enrichment function is not smooth (the fracture segments, the two kink
 lines of each tip ramp and the junction lines, see ``Fracture.kink_lines``
-and ``enrichment._cell_lines``), each sub-polygon is
+and ``enrichment._cell_lines_table``; the kernel kernels.cell_subtriangles
+cuts every cell at once), each sub-polygon is
 fan-triangulated and integrated with the 7-point degree-5 Dunavant rule, which
 is exact for the degree-4 integrand of B^T D B inside a sub-cell (bilinear N
 times linear F).  The side of the fracture (H in eq. 12) is taken at each

@@ -1,6 +1,6 @@
 """The kernels as NumPy array code: the same functions, signatures and results
-(to round-off) as the Numba kernels of bulk.py, contact.py and scatter.py,
-without importing Numba.
+(to round-off) as the Numba kernels of bulk.py, contact.py, scatter.py and
+subcells.py, without importing Numba.
 
 Why two implementations: a warm ``xfemslip run`` of a small case paid about
 0.2 s to import Numba and 0.3 s for its target set-up at the first cached

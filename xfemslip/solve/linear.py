@@ -42,7 +42,10 @@ them; PARDISO's own machinery is in pardiso.py.
   stats["amg_fallbacks"], stats["amg_fallback_time"].
 - ``"pardiso"``: MKL PARDISO (the mkl extra), xfemslip.solve.pardiso: one SPD
   factorization of K_ff for the run with the contact dofs eliminated last,
-  and a dense LU of their Schur complement per contact tangent.  A PARDISO
+  and a dense LU of their Schur complement per contact tangent; with more
+  contact dofs than that allows (networks), xfemslip.solve.lowrank: one SPD
+  factorization of the stuck matrix with the Schur complement on the patch
+  jumps, and per contact tangent a dense LU of its low-rank change.  A PARDISO
   failure sends the run to SuperLU (warning, stats["pardiso_fallbacks"]).
 - ``"auto"`` (default): ``"pardiso"`` from AUTO_PARDISO_MIN_DOFS free dofs
   when the mkl extra is installed; otherwise ``"amg"`` from
