@@ -1,88 +1,209 @@
 #!/usr/bin/env python3
-"""The 100-fracture network on 200 x 200 cells with branch tips (the network
-of benchmarks/network_build.py, seed 6) against the PARDISO floor: one SPD
-factorize-and-solve of the uncracked mesh, assembly included.
+"""A generated network of 100 fractures with branch tips against the
+PARDISO floor, whole processes, alternated in the same run.
 
     MKL_NUM_THREADS=2 OPENBLAS_NUM_THREADS=1 NUMBA_NUM_THREADS=2 \\
-    PYTHONPATH=$PWD python benchmarks/network_floor.py [--count 100] [--n 200] \\
-        [--solvers superlu,pardiso]
+    python benchmarks/network_floor.py [--runs 3] [--configs floor,pardiso,default]
+        [--count 100] [--n 200] [--seed 1] [--json FILE]
 
-Each configuration runs in its own process (build, Newton over the load
-step, no output written), the configurations one after the other; printed
-per configuration: wall and CPU time of build and Newton, Newton iterations,
-linear solves, PARDISO and SuperLU factorizations, the time in
-factorizations (factor_time) and in all linear solves (solve_time), and
-peak memory.  The floor is the same mesh without fractures.
+The network: ``[network.generate]`` with ``count`` fractures, uniform
+orientations, power-law lengths (exponent 2.5) on [0.06, 0.25] m, friction
+0.4, the default (branch) tips, on n x n cells of a 1 m block; in-situ
+stress (-20, -40) MPa, sigma_xx relaxed to -12 MPa in 2 load steps; the
+result written as h5 (``[output] formats = ["h5"]``).
+
+Configurations, each a process of its own (wall time from start to exit in
+the parent, CPU time and peak memory (ru_maxrss) of that child alone, wait4):
+
+- floor: the same mesh without fractures built by xfemslip (mesh, assembly),
+  then ONE factorize-and-solve of K_ff u = F by pypardiso in SPD mode
+  (mtype 2, upper triangle), imports included, nothing written (the floor of
+  benchmarks/scaling.py);
+- pardiso: ``xfemslip run`` with the mkl extra installed ("auto" takes
+  PARDISO);
+- default: the same run without the extra (pypardiso hidden from the child).
+
+Each run takes every configuration once, in the order given; times are
+medians over --runs runs (min and max printed too), the load average
+(os.getloadavg) is recorded before every child.  A warm-up of each
+configuration first compiles and caches the Numba kernels and byte-compiles
+the sources (as an installed package has them).
 """
 
 from __future__ import annotations
 
 import argparse
+import compileall
 import json
+import os
+import statistics
 import subprocess
 import sys
 import tempfile
+import threading
+import time
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
 
-CHILD = """
-import json, resource, sys, time
-sys.path.insert(0, {bench!r})
-t0 = time.perf_counter(); c0 = time.process_time()
-import numpy as np
-from network_build import case_text, network
-from xfemslip.case import loads_case
-from xfemslip.simulation import build_model, newton_solver
-count, n, solver = {count}, {n}, {solver!r}
-fracs = network(count) if solver != "floor" else []
-text = case_text(fracs, n, "branch")
-text += '\\n[solver]\\nlinear_solver = "' + (
-    "pardiso" if solver == "floor" else solver) + '"\\n'
-spec = loads_case(text, "network.toml")
-model = build_model(spec)
-t1 = time.perf_counter(); c1 = time.process_time()
-out = dict(dofs=int(model.problem.n_dofs))
-if solver == "floor":
-    import pypardiso, scipy.sparse as sp
-    p = model.problem
-    free = np.ones(p.n_dofs, bool); free[p.fixed] = False
-    K = p.K[free][:, free].tocsr()
-    A = sp.triu(K, format="csr"); A.sort_indices()
-    x = pypardiso.PyPardisoSolver(mtype=2).solve(A, np.asarray(p.F_unit)[free])
-else:
-    s = newton_solver(model)
-    res = s.run(spec.loading.steps)
-    st = s.linear.stats
-    out.update(newton_its=sum(r.iterations for r in res),
-               stats={{k: v for k, v in st.items() if v}})
-t2 = time.perf_counter(); c2 = time.process_time()
-out.update(build_wall=t1 - t0, build_cpu=c1 - c0, solve_wall=t2 - t1,
-           solve_cpu=c2 - c1,
-           maxrss_mib=resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024)
-print(json.dumps(out))
+
+def case_text(count: int, n: int, seed: int, cracked: bool) -> str:
+    from xfemslip.case import build
+
+    doc = {
+        "name": f"network-{count}",
+        "domain": {"size": [1.0, 1.0]},
+        "mesh": {"elements": [n, n]},
+        "material": {"E": 5.0e9, "nu": 0.25},
+        "loading": {
+            "initial_stress": {"xx": -20.0e6, "yy": -40.0e6, "xy": 0.0},
+            "stress": {"xx": -12.0e6, "yy": -40.0e6, "xy": 0.0},
+            "steps": 2,
+        },
+        "boundary": {
+            "bottom": {"uy": 0.0},
+            "top": "traction",
+            "left": "traction",
+            "right": "traction",
+        },
+        "output": {"formats": ["h5"]},
+    }
+    if cracked:
+        doc["network"] = {
+            "friction": 0.4,
+            "generate": {
+                "seed": seed,
+                "count": count,
+                "orientation": {"distribution": "uniform"},
+                "length": {
+                    "distribution": "power_law",
+                    "exponent": 2.5,
+                    "min": 0.06,
+                    "max": 0.25,
+                },
+            },
+        }
+    return build.case_text(doc)
+
+
+RUN = """
+import sys
+{hide}
+from xfemslip.cli import main
+sys.argv = ["xfemslip", "run", "-q", "--overwrite", {case!r}, "-o", {out!r}]
+main()
 """
+
+FLOOR = """
+import json, time
+t0 = time.perf_counter()
+import numpy as np, scipy.sparse as sp
+from xfemslip.case import load_case
+from xfemslip.simulation import build_model
+model = build_model(load_case({case!r}))
+p = model.problem
+free = np.ones(p.n_dofs, bool); free[p.fixed] = False
+K = p.K[free][:, free].tocsr()
+F = np.asarray(p.F_unit)[free]
+t1 = time.perf_counter()
+import pypardiso
+A = sp.triu(K, format="csr"); A.sort_indices()
+x = pypardiso.PyPardisoSolver(mtype=2).solve(A, F)
+t2 = time.perf_counter()
+print(json.dumps(dict(dofs=int(K.shape[0]), build=t1 - t0, solve=t2 - t1)))
+"""
+
+
+def child(config: str, work: Path, args) -> dict:
+    case = work / f"{config}.toml"
+    case.write_text(case_text(args.count, args.n, args.seed, config != "floor"))
+    out = work / f"out_{config}"
+    if config == "floor":
+        code = FLOOR.format(case=str(case))
+    else:
+        hide = 'sys.modules["pypardiso"] = None' if config == "default" else ""
+        code = RUN.format(hide=hide, case=str(case), out=str(out))
+    log = work / "child.log"
+    load = os.getloadavg()[0]
+    start = time.perf_counter()
+    with open(log, "w") as fh:
+        proc = subprocess.Popen(
+            [sys.executable, "-c", code], stdout=fh, stderr=subprocess.STDOUT, cwd=work
+        )
+        timer = threading.Timer(args.timeout, proc.kill)
+        timer.start()
+        _, status, usage = os.wait4(proc.pid, 0)  # this child alone
+        timer.cancel()
+    wall = time.perf_counter() - start
+    code = os.waitstatus_to_exitcode(status)
+    text = log.read_text()
+    if code != 0:
+        sys.exit(f"{config} failed ({code}): {text.strip()[-800:]}")
+    row = dict(
+        config=config,
+        wall=wall,
+        cpu=usage.ru_utime + usage.ru_stime,
+        rss_mib=usage.ru_maxrss / 1024,
+        load=load,
+    )
+    if config == "floor":
+        row.update(json.loads(text.strip().splitlines()[-1]))
+    else:
+        import h5py
+
+        with h5py.File(out / "result.h5") as f:
+            row.update(
+                run_wall=float(f.attrs["wall_time_s"]),
+                newton=[int(i) for i in f.attrs["newton_iterations_per_step"]],
+                dofs=int(f.attrs["n_dofs"]),
+            )
+    return row
 
 
 def main() -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("--runs", type=int, default=3)
+    ap.add_argument("--configs", default="floor,pardiso,default")
     ap.add_argument("--count", type=int, default=100)
     ap.add_argument("--n", type=int, default=200)
-    ap.add_argument("--solvers", default="floor,superlu,pardiso")
-    a = ap.parse_args()
-    for solver in a.solvers.split(","):
-        code = CHILD.format(
-            bench=str(ROOT / "benchmarks"), count=a.count, n=a.n, solver=solver
+    ap.add_argument("--seed", type=int, default=1)
+    ap.add_argument("--timeout", type=float, default=3600.0)
+    ap.add_argument("--no-warmup", action="store_true")
+    ap.add_argument("--json")
+    args = ap.parse_args()
+    configs = args.configs.split(",")
+    compileall.compile_dir(str(ROOT / "xfemslip"), quiet=1)
+    rows = []
+    with tempfile.TemporaryDirectory() as tmp:
+        work = Path(tmp)
+        if not args.no_warmup:
+            for config in configs:
+                if config != "default":  # compiles what the others load
+                    child(config, work, args)
+        for run in range(args.runs):
+            for config in configs:
+                row = child(config, work, args)
+                row["run"] = run
+                rows.append(row)
+                print(json.dumps(row), flush=True)
+    if args.json:
+        Path(args.json).write_text(json.dumps(rows, indent=1))
+    floor = statistics.median(r["wall"] for r in rows if r["config"] == "floor")
+    print(
+        "\n| configuration | wall, median (min, max) [s] | CPU [s] | / floor | "
+        "peak RSS [MiB] | load |"
+    )
+    print("| --- | --- | --- | --- | --- | --- |")
+    for config in configs:
+        mine = [r for r in rows if r["config"] == config]
+        walls = [r["wall"] for r in mine]
+        med = statistics.median(walls)
+        print(
+            f"| {config} | {med:.2f} ({min(walls):.2f}, {max(walls):.2f}) | "
+            f"{statistics.median(r['cpu'] for r in mine):.1f} | "
+            f"{med / floor:.1f} | {max(r['rss_mib'] for r in mine):.0f} | "
+            f"{min(r['load'] for r in mine):.1f}-{max(r['load'] for r in mine):.1f} |"
         )
-        with tempfile.TemporaryDirectory() as tmp:
-            proc = subprocess.run(
-                [sys.executable, "-c", code], capture_output=True, text=True, cwd=tmp
-            )
-        if proc.returncode != 0:
-            print(solver, "failed:", proc.stderr.strip().splitlines()[-1:])
-            continue
-        row = json.loads(proc.stdout.strip().splitlines()[-1])
-        print(solver, json.dumps(row), flush=True)
     return 0
 
 

@@ -7,11 +7,13 @@ The peak resident memory of a run is modelled from the sizes that set it
   plus Numba and its compiled kernels when the Numba backend runs
   (BASE_NUMBA);
 - ``enriched``: the enriched-cell quadrature (enrichment.EnrichedCells), per
-  quadrature point its position and weight and, per slot, F and grad F, and
-  per sub-triangle the vertex values: about QP_BYTES + QP_SLOT_BYTES * S
-  per point, S the slots of the widest cell (the arrays are padded to it);
+  quadrature point its position and weight and the sub-triangles' vertex
+  values (padded to S, the slots of the widest cell): QP_BYTES +
+  QP_PAD_BYTES * S per point, and F and grad F of every used slot at every
+  point of its cell (QP_SLOT_BYTES each);
 - ``assembly``, while the stiffness is assembled: the padded element
-  matrices of the enriched cells, (8 + 2 S)^2 doubles each, the intact
+  matrices of the enriched cells, (8 + 2 S)^2 doubles each, for at most
+  assembly.ENRICHED_CHUNK cells at a time, the intact
   cells summed into the grid's CSR (GRID_BYTES per node), the COO triplets
   of the enriched cells' entries with their conversion to CSR
   (TRIPLET_BYTES per entry) and, on the NumPy kernels, the shape-function
@@ -24,7 +26,10 @@ The peak resident memory of a run is modelled from the sizes that set it
   non-zero and per log2); with MKL PARDISO (the mkl extra), one factorization
   (PARDISO_BYTES per non-zero and per log2, measured on the reservoir case
   from 324k to 2.0M dofs) and the dense Schur complement of the contact dofs
-  with its LU (16 B per entry, up to SCHUR_MAX_DOFS of them); with AMG
+  with its LU (16 B per entry, up to SCHUR_MAX_DOFS of them) or, with more
+  contact dofs, that of the patches' jumps and its inverse part
+  (lowrank.LowRankSystems: 2 rows per patch, 16 B per entry, up to
+  lowrank.MAX_ROWS rows); with AMG
   (linsolve.choose), its hierarchy and set-up (AMG_BYTES per non-zero),
   the GMRES basis (AMG_RESTART + 1 vectors) and the kept solutions that
   start each solve (solve.guess.KEEP vectors).
@@ -86,7 +91,8 @@ ENV_LIMIT = "XFEMSLIP_MEMORY_LIMIT"
 BASE_NUMPY = 92e6  # measured 92 MB: a 10 x 10 case on the NumPy kernels [B]
 BASE_NUMBA = 202e6  # measured 201 MB: the same case on the Numba kernels [B]
 QP_BYTES = 48.0  # per enriched-cell quadrature point: xy, w, triangle share [B]
-QP_SLOT_BYTES = 28.0  # per point and slot: F, grad F (24 B), vertex values [B]
+QP_SLOT_BYTES = 24.0  # per used slot and point of its cell: F, grad F [B]
+QP_PAD_BYTES = 4.0  # per point and slot of the widest cell: vertex values [B]
 TRIPLET_BYTES = 48.0  # per COO entry: rows, cols, values and the CSR copy [B]
 # per grid node while the intact cells are summed into the grid's CSR
 # (assembly.grid_stiffness: 36 values per node in planes, their read-out with
@@ -138,6 +144,9 @@ class Footprint:
     entries: float = 0.0  # COO entries of all cells, sum of (8 + 2 s)^2
     enriched_entries: float = 0.0  # of them, those of the enriched cells
     qp: float = 0.0  # enriched-cell quadrature points
+    # F values stored: the points of each enriched cell times its used slots
+    # (None: every point with S slots, an upper bound)
+    qp_slots: float | None = None
     patches: float = 0.0  # contact patches
     block: float = 0.0  # dofs of the widest patch's tangent block (2 J)
     contact_entries: float = 0.0  # non-empty entries of the tangent blocks
@@ -149,10 +158,17 @@ class Footprint:
 def estimate_terms(fp: Footprint) -> dict[str, float]:
     """The terms of the module docstring [B] and their ``total``."""
     base = BASE_NUMBA if fp.numba else BASE_NUMPY
-    enriched = fp.qp * (QP_BYTES + QP_SLOT_BYTES * fp.slots)
-    gradients = 0.0 if fp.numba else NUMPY_QP_FUNCTION_BYTES * fp.qp * (4 + fp.slots)
+    qp_slots = fp.qp * fp.slots if fp.qp_slots is None else fp.qp_slots
+    enriched = fp.qp * (QP_BYTES + QP_PAD_BYTES * fp.slots) + QP_SLOT_BYTES * qp_slots
+    from xfemslip.fem.assembly import ENRICHED_CHUNK
+
+    chunk = min(fp.enriched_cells, ENRICHED_CHUNK)
+    share = chunk / fp.enriched_cells if fp.enriched_cells else 1.0
+    gradients = (
+        0.0 if fp.numba else NUMPY_QP_FUNCTION_BYTES * share * fp.qp * (4 + fp.slots)
+    )
     triplets = GRID_BYTES * fp.n_nodes + TRIPLET_BYTES * fp.enriched_entries
-    assembly = fp.enriched_cells * (8 + 2 * fp.slots) ** 2 * 8.0
+    assembly = chunk * (8 + 2 * fp.slots) ** 2 * 8.0
     assembly += max(gradients, triplets)  # one after the other
     if fp.linear == "amg":
         from xfemslip.solve.guess import KEEP
@@ -161,12 +177,15 @@ def estimate_terms(fp: Footprint) -> dict[str, float]:
         solver = fp.nnz * (MATRIX_BYTES + AMG_BYTES)
         solver += (AMG_RESTART + 1 + KEEP) * 8.0 * fp.n_dofs
     elif fp.linear == "pardiso":
+        from xfemslip.solve.lowrank import MAX_ROWS as LOWRANK_MAX_ROWS
         from xfemslip.solve.pardiso import SCHUR_MAX_DOFS
 
         log_n = math.log2(max(fp.n_dofs, 2))
         solver = fp.nnz * (MATRIX_BYTES + PARDISO_BYTES * log_n)
         if fp.contact_dofs <= SCHUR_MAX_DOFS:
             solver += 16.0 * fp.contact_dofs**2
+        elif 2.0 * fp.patches <= LOWRANK_MAX_ROWS:
+            solver += 16.0 * (2.0 * fp.patches) ** 2
     else:
         log_n = math.log2(max(fp.n_dofs, 2))
         solver = fp.nnz * (MATRIX_BYTES + LU_FACTORS * LU_BYTES * log_n)
@@ -268,9 +287,9 @@ def enriched_footprint(spec, mesh, fractures, cand) -> Footprint:
         np.add.at(pieces, np.unique(fr.piece_cell), 1.0)
     enr = slots > 0
     p = pieces[enr]
-    qp = float(
-        np.sum(QP_CELL + QP_PIECE * p + QP_PIECE2 * p * p + QP_BRANCH * branch[enr])
-    )
+    qp_cell = QP_CELL + QP_PIECE * p + QP_PIECE2 * p * p + QP_BRANCH * branch[enr]
+    qp = float(np.sum(qp_cell))
+    qp_slots = float(np.sum(qp_cell * slots[enr]))
     S = int(slots.max(initial=0))
     enriched_entries = float(np.sum((8.0 + 2.0 * slots[enr]) ** 2))
     entries = 64.0 * (mesh.n_cells - enr.sum()) + enriched_entries
@@ -296,6 +315,7 @@ def enriched_footprint(spec, mesh, fractures, cand) -> Footprint:
         entries=entries,
         enriched_entries=enriched_entries,
         qp=qp,
+        qp_slots=qp_slots,
         patches=patches,
         block=2.0 * S,
         # a patch's block holds the slots of about one cut cell
@@ -337,6 +357,7 @@ def model_footprint(model) -> Footprint:
         entries=entries,
         enriched_entries=enriched_entries,
         qp=float(ec.qp_w.size),
+        qp_slots=float(ec.slot_F.size),
         patches=float(contact.dofs.shape[0]),
         block=float(contact.dofs.shape[1]),
         contact_entries=float(np.sum(dofs.astype(float) ** 2)),

@@ -132,8 +132,13 @@ def build_model(spec) -> Model:
     mat = spec.material
     D = elasticity_matrix(mat.E, mat.nu, mat.model)
     cand = find_candidates(mesh, fractures)
-    check_memory(spec, enriched_footprint(spec, mesh, fractures, cand))
-    ec = build_enriched_cells(mesh, fractures, cand)
+    estimate = enriched_footprint(spec, mesh, fractures, cand)
+    check_memory(spec, estimate)
+    # the sub-cells are cut by the backend the estimate expects the model
+    # to take (kernels.choose on the estimated kernel work)
+    ec = build_enriched_cells(
+        mesh, fractures, cand, "numba" if estimate.numba else "numpy"
+    )
     kernel_backend = kernels.choose(spec.solver.kernels, kernel_work(ec))
     zones = build_zones(spec)
     eps = FACE_OFFSET * mesh.h_min

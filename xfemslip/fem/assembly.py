@@ -138,8 +138,10 @@ def add_to_grid(mesh, K_grid, rows, cols, vals, n) -> sp.csr_matrix:
     every row's columns increasing."""
     nx = mesh.nx
     n_std = K_grid.shape[0]
-    rows = np.asarray(rows, dtype=np.int64)
-    cols = np.asarray(cols, dtype=np.int64)
+    rows = np.asarray(rows)
+    cols = np.asarray(cols)
+    if rows.dtype.kind != "i" or cols.dtype.kind != "i":
+        rows, cols = rows.astype(np.int64), cols.astype(np.int64)
     vals = np.asarray(vals, dtype=np.float64)
     std = (rows < n_std) & (cols < n_std)
     if vals.size == 0 and n == n_std:
@@ -162,7 +164,9 @@ def add_to_grid(mesh, K_grid, rows, cols, vals, n) -> sp.csr_matrix:
             data += np.bincount(pos, weights=vals[std], minlength=data.size)
         else:
             np.add.at(data, pos, vals[std])
-    tail = sp.coo_matrix((vals[~std], (rows[~std], cols[~std])), shape=(n, n)).tocsr()
+    tail = sp.coo_matrix((vals[~std], (rows[~std], cols[~std])), shape=(n, n))
+    del rows, cols, vals, std  # the caller's entries: freed here if it holds none
+    tail = tail.tocsr()
     tail.sum_duplicates()
     indptr = np.zeros(n + 1, dtype=np.int64)
     indptr[: n_std + 1] = K_grid.indptr
@@ -231,28 +235,26 @@ def _rect_stiffness_shared(hx, hy, D, material, backend):
 
 
 def _part_matrices(mesh, ec, rows, qp_w, D, backend):
-    """K_e, Bbar of the enriched cells ``rows`` (indices into ec.cells; None =
-    all) integrated with the weights qp_w (nq,) [m^2] in place of ec.qp_w (0
-    on the QPs left out; every row keeps some weight)."""
+    """K_e, Bbar of the enriched cells ``rows`` (indices into ec.cells or a
+    slice of them; None = all) integrated with the weights qp_w (nq,) [m^2]
+    in place of ec.qp_w (0 on the QPs left out; every row keeps some
+    weight)."""
     if rows is None:
-        cells, off, idx = ec.cells, ec.qp_offsets, slice(None)
-        slot_node, slot_fnode = ec.slot_node, ec.slot_fnode
-    else:
-        counts = np.diff(ec.qp_offsets)[rows]
-        off = np.concatenate([[0], np.cumsum(counts)]).astype(np.int64)
-        idx = np.arange(off[-1]) + np.repeat(ec.qp_offsets[rows] - off[:-1], counts)
-        cells, slot_node, slot_fnode = (
-            ec.cells[rows],
-            ec.slot_node[rows],
-            ec.slot_fnode[rows],
-        )
+        rows = slice(0, ec.cells.size)
+    off, idx, v_off, slot_F, slot_gradF = ec.part(rows)
+    cells, slot_node, slot_fnode = (
+        ec.cells[rows],
+        ec.slot_node[rows],
+        ec.slot_fnode[rows],
+    )
     return kernels.backend(backend).enriched_cell_matrices(
         np.ascontiguousarray(mesh.bounds[cells]),
         off,
         np.ascontiguousarray(ec.qp_xy[idx]),
         np.ascontiguousarray(qp_w[idx], dtype=np.float64),
-        np.ascontiguousarray(ec.qp_F[idx]),
-        np.ascontiguousarray(ec.qp_gradF[idx]),
+        v_off,
+        np.ascontiguousarray(slot_F),
+        np.ascontiguousarray(slot_gradF),
         np.ascontiguousarray(slot_node),
         np.ascontiguousarray(slot_fnode),
         np.ascontiguousarray(D, dtype=np.float64),
@@ -267,37 +269,116 @@ def enriched_part_bbar(mesh, ec, rows, qp_w, backend) -> np.ndarray:
     return _part_matrices(mesh, ec, rows, qp_w, np.eye(3), backend)[1]
 
 
-def _enriched_matrices(mesh, ec, D, material, qp_material=None, *, backend):
-    """K_e, Bbar of the enriched cells, each with its own material's D.
+def _enriched_matrices(mesh, ec, D, material, qp_material=None, *, backend, rows=None):
+    """K_e, Bbar of the enriched cells ``rows`` (indices into ec.cells or a
+    slice of them; None: all), each with its own material's D.
 
-    material : (nc,) material index of each cell, or None (D[0] everywhere);
-    qp_material : (nq,) material index of each QP (overrides ``material``):
-    K_e = K_e(D_0) + sum_k sum_{q in k} B_q^T (D_k - D_0) B_q w_q, the second
-    term on the cells holding QPs of material k only.  With several materials
-    by cell every material's matrices are computed for all enriched cells and
-    each cell keeps its own (the enriched cells are few).
+    material : (nc,) material index of each enriched cell, or None (D[0]
+    everywhere); qp_material : (nq,) material index of each QP (overrides
+    ``material``): K_e = K_e(D_0) + sum_k sum_{q in k} B_q^T (D_k - D_0) B_q
+    w_q, the second term on the cells holding QPs of material k only.  With
+    several materials by cell every material's matrices are computed for all
+    the cells and each cell keeps its own (the enriched cells are few).
     """
     D = np.asarray(D, float).reshape(-1, 3, 3)
+    if rows is None:
+        rows = slice(0, ec.cells.size)
+    index = np.arange(ec.cells.size)[rows]  # the rows as indices
     if qp_material is not None:
-        K, Bbar = _part_matrices(mesh, ec, None, ec.qp_w, D[0], backend)
-        cell_of_qp = np.repeat(np.arange(ec.cells.size), np.diff(ec.qp_offsets))
+        K, Bbar = _part_matrices(mesh, ec, rows, ec.qp_w, D[0], backend)
+        _, q_idx, *_ = ec.part(rows)
+        cell_of_qp = np.repeat(np.arange(index.size), np.diff(ec.qp_offsets)[index])
         for k in range(1, D.shape[0]):
-            rows = np.unique(cell_of_qp[qp_material == k])
-            if rows.size:
+            sub = np.unique(cell_of_qp[qp_material[q_idx] == k])
+            if sub.size:
                 w = np.where(qp_material == k, ec.qp_w, 0.0)
-                K[rows] += _part_matrices(mesh, ec, rows, w, D[k] - D[0], backend)[0]
+                K_k = _part_matrices(mesh, ec, index[sub], w, D[k] - D[0], backend)
+                K[sub] += K_k[0]
         return K, Bbar
     out = None
     for k in range(D.shape[0]):
-        mine = np.ones(ec.cells.size, bool) if material is None else material == k
+        mine = np.ones(index.size, bool) if material is None else material[index] == k
         if not mine.any():
             continue
-        K_k, B_k = _part_matrices(mesh, ec, None, ec.qp_w, D[k], backend)
+        K_k, B_k = _part_matrices(mesh, ec, rows, ec.qp_w, D[k], backend)
         if out is None:
             out = (K_k, B_k)
         else:
             out[0][mine] = K_k[mine]
     return out
+
+
+# Enriched cells per call of the cell kernel: their padded element matrices,
+# (8 + 2S)^2 doubles each, are reduced to their diagonal and entries chunk by
+# chunk (all at once: 1.1 GB on a 100-fracture network of 13k enriched cells
+# with S = 48).
+ENRICHED_CHUNK = 2048
+
+
+def _candidate_dofs(mesh, ec):
+    """(nc, 8+2S) dofs of the enriched cells with each slot numbered by its
+    candidate, n_std + 2 k + c (-1 for an empty slot): the entries can be
+    gathered before the sliver rule has chosen the kept enrichments."""
+    n_std = 2 * mesh.n_nodes
+    S = ec.slot_cand.shape[1]
+    out = -np.ones((ec.cells.size, 8 + 2 * S), np.int64)
+    out[:, :8] = std_cell_dofs(mesh.cells[ec.cells])
+    k = ec.slot_cand
+    out[:, 8::2] = np.where(k >= 0, n_std + 2 * k, -1)
+    out[:, 9::2] = np.where(k >= 0, n_std + 2 * k + 1, -1)
+    return out
+
+
+def _enriched_entries(mesh, ec, D, material, qp_material, backend):
+    """Chunk by chunk of ENRICHED_CHUNK cells: the diagonal (nc, 8+2S) and
+    Bbar (nc, 3, 8+2S) of the enriched-cell matrices and their entries (rows,
+    cols, values) in candidate numbering (_candidate_dofs; int32 where the
+    numbers fit), in the order of kernels.block_triplets over all the cells."""
+    nc = ec.cells.size
+    nd = 8 + 2 * ec.slot_cand.shape[1]
+    diag = np.zeros((nc, nd))
+    Bbar = np.zeros((nc, 3, nd))
+    dofs = _candidate_dofs(mesh, ec)
+    live = np.count_nonzero(dofs >= 0, axis=1).astype(np.int64)
+    total = int(np.sum(live**2))
+    index_type = np.int32 if dofs.max(initial=0) < 2**31 - 1 else np.int64
+    rows = np.empty(total, index_type)
+    cols = np.empty(total, index_type)
+    vals = np.empty(total)
+    p = 0
+    for lo in range(0, nc, ENRICHED_CHUNK):
+        part = slice(lo, min(lo + ENRICHED_CHUNK, nc))
+        K_e, Bbar[part] = _enriched_matrices(
+            mesh, ec, D, material, qp_material, backend=backend, rows=part
+        )
+        diag[part] = np.diagonal(K_e, axis1=1, axis2=2)
+        r, c, v = _triplets(dofs[part], K_e, backend)
+        del K_e
+        rows[p : p + r.size] = r
+        cols[p : p + r.size] = c
+        vals[p : p + r.size] = v
+        p += r.size
+    assert p == total
+    return diag, Bbar, [rows, cols, vals]
+
+
+def _kept_entries(entries, to_dof, step=1 << 20):
+    """The entries [rows, cols, vals] (emptied: the caller keeps no
+    reference) renumbered by to_dof, those with a -1 left out, in place and
+    in order, as (rows, cols, vals) views."""
+    rows, cols, vals = entries
+    entries.clear()
+    w = 0
+    for a in range(0, vals.size, step):
+        b = min(a + step, vals.size)
+        r, c = to_dof[rows[a:b]], to_dof[cols[a:b]]
+        keep = (r >= 0) & (c >= 0)
+        k = int(np.count_nonzero(keep))
+        rows[w : w + k] = r[keep]
+        cols[w : w + k] = c[keep]
+        vals[w : w + k] = vals[a:b][keep]
+        w += k
+    return rows[:w], cols[:w], vals[:w]
 
 
 def assemble_bulk(
@@ -327,26 +408,22 @@ def assemble_bulk(
         b[:, 1] - b[:, 0], b[:, 3] - b[:, 2], D, mat_std, backend
     )
 
-    if ec.cells.size:
-        K_e, Bbar = _enriched_matrices(
-            mesh,
-            ec,
-            D,
-            None if cell_material is None else cell_material[ec.cells],
-            qp_material,
-            backend=backend,
-        )
-    else:
-        K_e = np.zeros((0, 8, 8))
-        Bbar = np.zeros((0, 3, 8))
+    diag_e, Bbar, entries = _enriched_entries(
+        mesh,
+        ec,
+        D,
+        None if cell_material is None else cell_material[ec.cells],
+        qp_material,
+        backend,
+    )
     enr_std = std_cell_dofs(mesh.cells[ec.cells])
 
     n_std = 2 * mesh.n_nodes
     K_grid = grid_stiffness(mesh, std_cells, K_u, which)
     std_diag = K_grid.diagonal()
-    np.add.at(std_diag, enr_std, np.diagonal(K_e[:, :8, :8], axis1=1, axis2=2))
+    np.add.at(std_diag, enr_std, diag_e[:, :8])
     jumps = carries_jump(mesh, cand, ip) if ip is not None else None
-    dofmap = select_enrichment(mesh, cand, ec, K_e, std_diag, jumps)
+    dofmap = select_enrichment(mesh, cand, ec, diag_e, std_diag, jumps)
 
     S = ec.slot_cand.shape[1]
     enr_dofs = -np.ones((ec.cells.size, 8 + 2 * S), np.int64)
@@ -357,11 +434,23 @@ def assemble_bulk(
         enr_dofs[:, 8 + 2 * s] = np.where(base >= 0, base, -1)
         enr_dofs[:, 9 + 2 * s] = np.where(base >= 0, base + 1, -1)
 
-    # the enriched cells' entries without their empty slots
-    # (kernels.block_triplets), added to the grid's (rows of the enriched
-    # dofs appended, empty)
+    # the enriched cells' entries on the kept enrichments (candidate numbers
+    # to dofs, the dropped candidates' entries left out, the order kept: the
+    # entries block_triplets gives on enr_dofs), added to the grid's (rows of
+    # the enriched dofs appended, empty); no name here keeps the entries, so
+    # add_to_grid frees them once it has summed them
     n = dofmap.n_dofs
-    K = add_to_grid(mesh, K_grid, *_triplets(enr_dofs, K_e, backend), n)
+    to_dof = np.concatenate(
+        [
+            np.arange(n_std),
+            np.where(
+                dofmap.cand_dof[:, None] >= 0,
+                dofmap.cand_dof[:, None] + np.arange(2),
+                -1,
+            ).ravel(),
+        ]
+    )
+    K = add_to_grid(mesh, K_grid, *_kept_entries(entries, to_dof), n)
     logger.info(
         "bulk: %d cells (%d enriched), %d dofs (%d enriched)",
         mesh.n_cells,

@@ -43,8 +43,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from xfemslip import kernels
 from xfemslip.fem.branch import branch_functions
-from xfemslip.fem.quadrature import cell_subtriangles, duffy_rule, triangle_rule
+from xfemslip.fem.quadrature import DUFFY_POINTS, TRI_BARY, duffy_rule, triangle_rule
 from xfemslip.geometry.fracture import GEOMETRY_TOL
 
 logger = logging.getLogger(__name__)
@@ -71,11 +72,63 @@ class EnrichedCells:
     qp_offsets: np.ndarray  # (nc+1,) int64
     qp_xy: np.ndarray  # (nq, 2) [m]
     qp_w: np.ndarray  # (nq,) [m^2]
-    qp_F: np.ndarray  # (nq, S)
-    qp_gradF: np.ndarray  # (nq, S, 2) [1/m]
+    # F and grad F of the used slots only (slots are filled from 0): cell e's
+    # value of slot s at its point q (q0 = qp_offsets[e], nq its points) is
+    # at slot_offsets[e] + s * nq + (q - q0), so each slot's values over its
+    # cell are one run (a padded (points, S) layout was 3.4 times larger on
+    # a 100-fracture network: 1.6M points x 48 slots, mostly zeros)
+    slot_offsets: np.ndarray  # (nc+1,) int64
+    slot_F: np.ndarray  # (nv,) [-]
+    slot_gradF: np.ndarray  # (nv, 2) [1/m]
     tri_offsets: np.ndarray  # (nc+1,) int64 sub-triangles of each cell
     tris: np.ndarray  # (nt, 3, 2) [m]
     tri_F: np.ndarray  # (nt, 3, S) F at the triangle's vertices, from its own side
+
+    def qp_values(self, q) -> tuple[np.ndarray, np.ndarray]:
+        """F (n, S) and grad F (n, S, 2) [1/m] at the points q (n,) int,
+        each slot in its column (0 in empty slots)."""
+        q = np.asarray(q, dtype=np.int64)
+        S = self.slot_cand.shape[1]
+        e = np.searchsorted(self.qp_offsets, q, side="right") - 1
+        nq = np.diff(self.qp_offsets)[e]
+        used = self.slot_cand[e] >= 0  # (n, S)
+        v = (
+            self.slot_offsets[e][:, None]
+            + np.arange(S)[None, :] * nq[:, None]
+            + (q - self.qp_offsets[e])[:, None]
+        )
+        F = np.zeros((q.size, S))
+        gF = np.zeros((q.size, S, 2))
+        F[used] = self.slot_F[v[used]]
+        gF[used] = self.slot_gradF[v[used]]
+        return F, gF
+
+    def part(self, rows) -> tuple[np.ndarray, ...]:
+        """The points and slot values of the cells ``rows`` (indices into
+        cells, or a slice of them: then views, no copy), as the cell kernels
+        take them: (qp_offsets, points (index array or slice), slot_offsets,
+        slot_F, slot_gradF), offsets from 0."""
+        if isinstance(rows, slice):
+            lo, hi, _ = rows.indices(self.cells.size)
+            q0, v0 = self.qp_offsets[lo], self.slot_offsets[lo]
+            v1 = self.slot_offsets[hi]
+            return (
+                self.qp_offsets[lo : hi + 1] - q0,
+                slice(q0, self.qp_offsets[hi]),
+                self.slot_offsets[lo : hi + 1] - v0,
+                self.slot_F[v0:v1],
+                self.slot_gradF[v0:v1],
+            )
+        rows = np.asarray(rows, dtype=np.int64)
+        counts = np.diff(self.qp_offsets)[rows]
+        q_off = np.zeros(rows.size + 1, np.int64)
+        np.cumsum(counts, out=q_off[1:])
+        q_idx = ranges(self.qp_offsets[rows], counts)
+        v_counts = np.diff(self.slot_offsets)[rows]
+        v_off = np.zeros(rows.size + 1, np.int64)
+        np.cumsum(v_counts, out=v_off[1:])
+        v_idx = ranges(self.slot_offsets[rows], v_counts)
+        return q_off, q_idx, v_off, self.slot_F[v_idx], self.slot_gradF[v_idx]
 
 
 @dataclass(frozen=True)
@@ -150,35 +203,6 @@ def group_values(fractures, fi, tip, pts, side, tol, probe=None):
     return branch_functions(fr.tips[tip], pts, side, tol)
 
 
-def _cell_lines(fr, b, tol):
-    """Kink lines of fracture fr that can cross the cell with bounds b."""
-    lo = np.minimum(fr.points[:-1], fr.points[1:]) - tol
-    hi = np.maximum(fr.points[:-1], fr.points[1:]) + tol
-    near = (
-        (lo[:, 0] <= b[1])
-        & (hi[:, 0] >= b[0])
-        & (lo[:, 1] <= b[3])
-        & (hi[:, 1] >= b[2])
-    )
-    out = [(fr.points[k], fr.normal[k]) for k in np.nonzero(near)[0]]
-    for tip in fr.tips:
-        # the ramp's kink lines are infinite: they cross every cell of the strip
-        # -l <= psi <= 0, not only the cells near the tip
-        for point in (tip.point, tip.point - tip.ramp_length * tip.direction):
-            psi = (
-                np.array([[b[0], b[2]], [b[1], b[2]], [b[1], b[3]], [b[0], b[3]]])
-                - point
-            ) @ tip.direction
-            if psi.min() < -tol and psi.max() > tol:
-                out.append((point, tip.direction))
-    corners = np.array([[b[0], b[2]], [b[1], b[2]], [b[1], b[3]], [b[0], b[3]]])
-    for point, normal in fr.cut_lines():
-        d = (corners - point) @ normal
-        if d.min() < -tol and d.max() > tol:
-            out.append((point, normal))
-    return out
-
-
 def _listing_free_key(fr):
     """Key of a fracture that depends neither on its position in the case file
     nor on its point order: its two end points, sorted."""
@@ -203,27 +227,122 @@ def _candidate_node_values(fractures, mesh, cand, tol):
     return out
 
 
-def _cell_rule(mesh, c, fractures, frs, has_branch, tol):
-    """Sub-triangles, quadrature points and weights of one enriched cell."""
-    b = mesh.bounds[c]
-    # the fractures of the cell in a listing-free order, each with its own
-    # lines in its own order: the sub-cells do not depend on the order the
-    # fractures are listed in (and a single fracture's are as before)
-    frs = sorted(frs, key=lambda fi: _listing_free_key(fractures[fi]))
-    lines = [ln for fi in frs for ln in _cell_lines(fractures[fi], b, tol)]
-    if not has_branch:
-        tris = cell_subtriangles(b, lines, tol)
-        return (tris, *triangle_rule(tris))
-    apexes = [t.point for fi in frs for t in fractures[fi].tips]
-    tris = cell_subtriangles(b, lines, tol, apexes=apexes)
-    return (tris, *duffy_rule(tris))
+def _cell_lines_table(mesh, fractures, cells, pair_cell, pair_frac, branch, tol):
+    """The cut lines and apexes of every enriched cell, as the sub-cell
+    kernel takes them (kernels.cell_subtriangles).
+
+    cells : (nc,) enriched cell ids; (pair_cell, pair_frac) : the (row in
+    cells, fracture) pairs of the fractures with a slot in each cell;
+    branch : (nc,) bool, cells with a branch slot (their apexes are the tips
+    of their fractures).  A cell's lines are those of its fractures in a
+    listing-free order (the sub-cells do not depend on the order the
+    fractures are listed in), each fracture's in its own order: the segments
+    whose box (grown by tol) meets the cell, the two ramp kink lines of each
+    tip and its junction lines wherever they cross the cell (the ramp's kink
+    lines are infinite: they cross every cell of the strip -l <= psi <= 0).
+    Returns (line_offsets, line_point, line_normal, apex_offsets, apex_xy).
+    """
+    order = sorted(range(len(fractures)), key=lambda f: _listing_free_key(fractures[f]))
+    rank = np.empty(len(fractures), np.int64)
+    rank[order] = np.arange(len(fractures))
+    b = mesh.bounds[cells]  # (nc, 4)
+    corners = np.stack(
+        [b[:, [0, 2]], b[:, [1, 2]], b[:, [1, 3]], b[:, [0, 3]]], axis=1
+    )  # (nc, 4, 2)
+    keys, pts, nrms, akeys, axy = [], [], [], [], []
+    for fi, fr in enumerate(fractures):
+        rows = pair_cell[pair_frac == fi]
+        if rows.size == 0:
+            continue
+        lines = [(fr.points[k], fr.normal[k]) for k in range(fr.normal.shape[0])]
+        n_seg = len(lines)
+        for tip in fr.tips:
+            lines.append((tip.point, tip.direction))
+            lines.append((tip.point - tip.ramp_length * tip.direction, tip.direction))
+        lines += list(fr.cut_lines())
+        P = np.array([p for p, _ in lines], float)
+        N = np.array([n for _, n in lines], float)
+        lo = np.minimum(fr.points[:-1], fr.points[1:]) - tol
+        hi = np.maximum(fr.points[:-1], fr.points[1:]) + tol
+        br = b[rows]
+        seg = (
+            (lo[None, :, 0] <= br[:, 1:2])
+            & (hi[None, :, 0] >= br[:, 0:1])
+            & (lo[None, :, 1] <= br[:, 3:4])
+            & (hi[None, :, 1] >= br[:, 2:3])
+        )
+        d = (corners[rows][:, None, :, :] - P[None, n_seg:, None, :]) @ N[
+            n_seg:, :, None
+        ]
+        d = d[..., 0]  # (r, lines after the segments, 4)
+        cross = (d.min(axis=2) < -tol) & (d.max(axis=2) > tol)
+        use = np.concatenate([seg, cross], axis=1)  # (r, lines)
+        r_i, l_i = np.nonzero(use)
+        keys.append(np.column_stack([rows[r_i], np.full(r_i.size, rank[fi]), l_i]))
+        pts.append(P[l_i])
+        nrms.append(N[l_i])
+        tips = np.array([t.point for t in fr.tips], float).reshape(-1, 2)
+        brows = rows[branch[rows]]
+        if tips.size and brows.size:
+            t_i = np.tile(np.arange(tips.shape[0]), brows.size)
+            akeys.append(
+                np.column_stack(
+                    [
+                        np.repeat(brows, tips.shape[0]),
+                        np.full(t_i.size, rank[fi]),
+                        t_i,
+                    ]
+                )
+            )
+            axy.append(tips[t_i])
+
+    def table(keys, values):
+        nc = cells.size
+        if not keys:
+            return np.zeros(nc + 1, np.int64), np.zeros((0, 2)), np.zeros((0, 2))
+        k = np.concatenate(keys)
+        o = np.lexsort((k[:, 2], k[:, 1], k[:, 0]))
+        offsets = np.zeros(nc + 1, np.int64)
+        offsets[1:] = np.cumsum(np.bincount(k[:, 0], minlength=nc))
+        return offsets, *(np.ascontiguousarray(np.concatenate(v)[o]) for v in values)
+
+    line_off, line_pt, line_n = table(keys, (pts, nrms))
+    apex_off, apex_xy, _ = table(akeys, (axy, axy))
+    return line_off, line_pt, line_n, apex_off, apex_xy
 
 
-def build_enriched_cells(mesh, fractures, cand: Candidates) -> EnrichedCells:
+def _cell_rules(tri_off, tris, branch):
+    """Quadrature points (nq, 2), weights (nq,) and offsets (nc + 1,) of the
+    sub-triangles of each cell, and the points per triangle (nt,): the Duffy
+    rule on the triangles of cells with a branch slot (the tip is vertex 0),
+    the 7-point rule elsewhere; points in the order of the triangles."""
+    tri_cell = np.repeat(np.arange(branch.size), np.diff(tri_off))
+    on = branch[tri_cell]
+    per_tri = np.where(on, DUFFY_POINTS**2, TRI_BARY.shape[0]).astype(np.int64)
+    start = np.cumsum(per_tri) - per_tri
+    xy = np.empty((int(per_tri.sum()), 2))
+    w = np.empty(xy.shape[0])
+    for mask, rule in ((on, duffy_rule), (~on, triangle_rule)):
+        if mask.any():
+            pxy, pw = rule(tris[mask])
+            dest = ranges(start[mask], per_tri[mask])
+            xy[dest] = pxy
+            w[dest] = pw
+    qp_off = np.zeros(branch.size + 1, np.int64)
+    qp_off[1:] = np.cumsum(
+        np.bincount(tri_cell, weights=per_tri, minlength=branch.size)
+    )
+    return xy, w, qp_off, per_tri
+
+
+def build_enriched_cells(
+    mesh, fractures, cand: Candidates, backend: str = "numpy"
+) -> EnrichedCells:
     """Slots, sub-cell quadrature and enrichment values of every enriched cell.
 
-    Two passes: the sub-cells of each cell (its own cut lines), then the
-    enrichment functions of each (fracture, tip or arm) group evaluated once
+    Two passes: the sub-cells of every cell (its own cut lines, all cells in
+    one call of the kernel ``backend``'s cell_subtriangles, "numba" or
+    "numpy"), then the enrichment functions of each (fracture, tip or arm) group evaluated once
     on the quadrature points and sub-triangle vertices of all the cells the
     group reaches (the functions are point-wise, so the values are those of a
     cell-by-cell evaluation; measured in docs/performance.md, "Fracture
@@ -239,7 +358,7 @@ def build_enriched_cells(mesh, fractures, cand: Candidates) -> EnrichedCells:
         split = np.searchsorted(mesh.cells.ravel()[order], np.arange(mesh.n_nodes + 1))
         count = np.diff(split)[cand.node]
         k_all = np.repeat(np.arange(cand.node.size), count)
-        c_all = order[_ranges(split[cand.node], count)] // 4
+        c_all = order[ranges(split[cand.node], count)] // 4
     pair = np.lexsort((k_all, c_all))
     k_all, c_all = k_all[pair], c_all[pair]
     cand_cells, first, n_slots = np.unique(c_all, return_index=True, return_counts=True)
@@ -248,7 +367,7 @@ def build_enriched_cells(mesh, fractures, cand: Candidates) -> EnrichedCells:
     S = int(n_slots.max(initial=0))
     slot_cand = -np.ones((nc, S), np.int64)
     slot_cand[
-        np.repeat(np.arange(nc), n_slots), _ranges(np.zeros(nc, np.int64), n_slots)
+        np.repeat(np.arange(nc), n_slots), ranges(np.zeros(nc, np.int64), n_slots)
     ] = k_all
     used = slot_cand >= 0
     k_used = slot_cand[used]
@@ -261,37 +380,27 @@ def build_enriched_cells(mesh, fractures, cand: Candidates) -> EnrichedCells:
     slot_node[used] = np.argmax(local, axis=1)
     slot_fnode[used] = cand_fnode[k_used]
 
-    # pass 1: sub-cells and quadrature of each cell
-    parts = {key: [] for key in ("xy", "w", "tris")}
-    per_tri = []  # quadrature points of each sub-triangle
-    frac_of, func_of = cand.fracture.tolist(), cand.func.tolist()
-    for e, c in enumerate(cand_cells):
-        ks = slot_cand[e, : n_slots[e]].tolist()
-        frs = sorted({frac_of[k] for k in ks})
-        has_branch = any(func_of[k] != HEAVISIDE for k in ks)
-        tris, xy, w = _cell_rule(mesh, c, fractures, frs, has_branch, tol)
-        parts["xy"].append(xy)
-        parts["w"].append(w)
-        parts["tris"].append(tris)
-        per_tri.append(np.full(tris.shape[0], xy.shape[0] // tris.shape[0]))
-
-    def cat(key, shape):
-        p = parts[key]
-        return np.ascontiguousarray(np.concatenate(p)) if p else np.zeros(shape)
-
-    qp_xy, qp_w, tris = cat("xy", (0, 2)), cat("w", (0,)), cat("tris", (0, 3, 2))
-    qp_off = np.zeros(nc + 1, np.int64)
-    tri_off = np.zeros(nc + 1, np.int64)
-    qp_off[1:] = np.cumsum([x.shape[0] for x in parts["xy"]])
-    tri_off[1:] = np.cumsum([t.shape[0] for t in parts["tris"]])
-    per_tri = np.concatenate(per_tri) if per_tri else np.zeros(0, np.int64)
+    # pass 1: sub-cells and quadrature of every cell (one kernel call)
+    e_used, s_used = np.nonzero(used)
+    pair = np.unique(np.column_stack([e_used, cand.fracture[k_used]]), axis=0)
+    branch = np.zeros(nc, bool)
+    branch[e_used[cand.func[k_used] != HEAVISIDE]] = True
+    lines = _cell_lines_table(
+        mesh, fractures, cand_cells, pair[:, 0], pair[:, 1], branch, tol
+    )
+    tri_off, tris = kernels.backend(backend).cell_subtriangles(
+        np.ascontiguousarray(mesh.bounds[cand_cells]), *lines, float(tol)
+    )
+    qp_xy, qp_w, qp_off, per_tri = _cell_rules(tri_off, tris, branch)
     centroids = tris.mean(axis=1)
 
     # pass 2: each enrichment group on every cell it reaches
-    F = np.zeros((qp_xy.shape[0], S))
-    gF = np.zeros((qp_xy.shape[0], S, 2))
+    nq_cell = np.diff(qp_off)
+    slot_off = np.zeros(nc + 1, np.int64)
+    np.cumsum(nq_cell * n_slots, out=slot_off[1:])
+    F = np.zeros(slot_off[-1])
+    gF = np.zeros((slot_off[-1], 2))
     Fv = np.zeros((tris.shape[0], 3, S))
-    e_used, s_used = np.nonzero(used)
     group = cand.fracture[k_used] * (1 << 32) + (cand.tip[k_used] + (1 << 31))
     # the slots of each group as one slice of a stable sort (in the order a
     # mask `group == g` gives) rather than a mask over all slots per group:
@@ -304,8 +413,8 @@ def build_enriched_cells(mesh, fractures, cand: Candidates) -> EnrichedCells:
         k0 = k_used[mine][0]
         fi, tip = int(cand.fracture[k0]), int(cand.tip[k0])
         cells = np.unique(e_used[mine])  # rows of the cells the group reaches
-        ti = _ranges(tri_off[cells], np.diff(tri_off)[cells])
-        qi = _ranges(qp_off[cells], np.diff(qp_off)[cells])
+        ti = ranges(tri_off[cells], np.diff(tri_off)[cells])
+        qi = ranges(qp_off[cells], np.diff(qp_off)[cells])
         st = fractures[fi].side(centroids[ti])
         Fq, gq = group_values(
             fractures,
@@ -332,16 +441,15 @@ def build_enriched_cells(mesh, fractures, cand: Candidates) -> EnrichedCells:
         pos = np.searchsorted(cells, es)
         g_qp = np.concatenate([[0], np.cumsum(np.diff(qp_off)[cells])])
         g_tri = np.concatenate([[0], np.cumsum(np.diff(tri_off)[cells])])
-        nq_s = np.diff(qp_off)[es]
-        rows_q = _ranges(qp_off[es], nq_s)
-        rows_g = _ranges(g_qp[pos], nq_s)
-        cols = np.repeat(ss, nq_s)
+        nq_s = nq_cell[es]
+        rows_v = ranges(slot_off[es] + ss * nq_s, nq_s)
+        rows_g = ranges(g_qp[pos], nq_s)
         jj = np.repeat(js, nq_s)
-        F[rows_q, cols] = Fq[rows_g, jj]
-        gF[rows_q, cols] = gq[rows_g, jj]
+        F[rows_v] = Fq[rows_g, jj]
+        gF[rows_v] = gq[rows_g, jj]
         nt_s = np.diff(tri_off)[es]
-        rows_t = _ranges(tri_off[es], nt_s)
-        rows_gt = _ranges(g_tri[pos], nt_s)
+        rows_t = ranges(tri_off[es], nt_s)
+        rows_gt = ranges(g_tri[pos], nt_s)
         Fv[rows_t, :, np.repeat(ss, nt_s)] = Fvert[rows_gt, :, np.repeat(js, nt_s)]
 
     return EnrichedCells(
@@ -352,15 +460,16 @@ def build_enriched_cells(mesh, fractures, cand: Candidates) -> EnrichedCells:
         qp_offsets=qp_off,
         qp_xy=qp_xy,
         qp_w=qp_w,
-        qp_F=F,
-        qp_gradF=gF,
+        slot_offsets=slot_off,
+        slot_F=F,
+        slot_gradF=gF,
         tri_offsets=tri_off,
         tris=tris,
         tri_F=Fv,
     )
 
 
-def _ranges(starts, counts):
+def ranges(starts, counts):
     """Concatenation of arange(s, s + n) for each (s, n), int64."""
     starts = np.asarray(starts, np.int64)
     counts = np.asarray(counts, np.int64)
@@ -397,13 +506,14 @@ def select_enrichment(
     mesh,
     cand: Candidates,
     ec: EnrichedCells,
-    K_enr: np.ndarray,
+    enr_diag: np.ndarray,
     std_diag: np.ndarray,
     jumps: np.ndarray | None = None,
 ) -> DofMap:
     """Apply the jump and sliver rules and number the kept enriched dofs.
 
-    K_enr : (nc, 8+2S, 8+2S) enriched-cell stiffness with every candidate slot.
+    enr_diag : (nc, 8+2S) diagonal of the enriched-cell stiffness with every
+    candidate slot.
     std_diag : (n_std,) diagonal of the standard-dof bulk stiffness.
     jumps : (k,) bool from ``carries_jump`` (None: not applied).
     """
@@ -417,7 +527,7 @@ def select_enrichment(
             np.add.at(
                 diag[:, comp],
                 ec.slot_cand[m, s],
-                K_enr[m, 8 + 2 * s + comp, 8 + 2 * s + comp],
+                enr_diag[m, 8 + 2 * s + comp],
             )
     ref = np.stack([std_diag[2 * cand.node], std_diag[2 * cand.node + 1]], axis=1)
     ratio = (diag / ref).min(axis=1) if k else np.zeros(0)

@@ -3,11 +3,15 @@
 Enriched cells are cut into convex sub-polygons along every line across which
 an enrichment function is not smooth (the fracture segments, the two kink
 lines of each tip ramp and the junction lines, see ``Fracture.kink_lines``
-and ``enrichment._cell_lines``), each sub-polygon is
+and ``enrichment._cell_lines_table``; the kernel kernels.cell_subtriangles
+cuts every cell at once), each sub-polygon is
 fan-triangulated and integrated with the 7-point degree-5 Dunavant rule, which
 is exact for the degree-4 integrand of B^T D B inside a sub-cell (bilinear N
 times linear F).  The side of the fracture (H in eq. 12) is taken at each
 sub-cell's centroid, never at a point on the fracture.
+
+split_polygon, polygon_area and fan_triangles are the kernels' NumPy
+functions (xfemslip.kernels.vectorized), named here for their callers.
 """
 
 from __future__ import annotations
@@ -17,6 +21,19 @@ from dataclasses import dataclass
 import numpy as np
 
 from xfemslip.geometry.fracture import GEOMETRY_TOL
+from xfemslip.kernels import vectorized
+from xfemslip.kernels.vectorized import fan_triangles, polygon_area, split_polygon
+
+__all__ = [
+    "InterfacePoints",
+    "cell_subtriangles",
+    "duffy_rule",
+    "fan_triangles",
+    "interface_points",
+    "polygon_area",
+    "split_polygon",
+    "triangle_rule",
+]
 
 # Dunavant (1985) degree-5 rule on the reference triangle: barycentric points and
 # weights (summing to 1).
@@ -40,75 +57,27 @@ TRI_W = np.array([0.225] + [0.132394152788506] * 3 + [0.125939180544827] * 3)
 LINE_POINTS, LINE_WEIGHTS = np.polynomial.legendre.leggauss(4)
 
 
-def split_polygon(poly: np.ndarray, point: np.ndarray, normal: np.ndarray, tol: float):
-    """Split a convex polygon (k, 2) by a line; returns a list of 1 or 2 polygons.
-
-    Vertices within tol of the line count as on it, so a line through a vertex
-    or along an edge never makes a sliver.
-    """
-    d = (poly - point) @ normal
-    d[np.abs(d) <= tol] = 0.0
-    if np.all(d >= 0.0) or np.all(d <= 0.0):
-        return [poly]
-    pos, neg = [], []
-    k = poly.shape[0]
-    for i in range(k):
-        p, q = poly[i], poly[(i + 1) % k]
-        dp, dq = d[i], d[(i + 1) % k]
-        if dp >= 0.0:
-            pos.append(p)
-        if dp <= 0.0:
-            neg.append(p)
-        if dp * dq < 0.0:
-            x = p + dp / (dp - dq) * (q - p)
-            pos.append(x)
-            neg.append(x)
-    # a line within tol of a corner can leave a degenerate piece (3 coincident
-    # points): keep only pieces with area
-    pieces = [np.array(v) for v in (pos, neg) if len(v) >= 3]
-    pieces = [v for v in pieces if polygon_area(v) > tol * tol]
-    return pieces or [poly]
-
-
-def polygon_area(poly: np.ndarray) -> float:
-    x, y = poly[:, 0], poly[:, 1]
-    return 0.5 * float(np.dot(x, np.roll(y, -1)) - np.dot(y, np.roll(x, -1)))
-
-
-def fan_triangles(poly: np.ndarray, min_area: float) -> np.ndarray:
-    """Triangles (t, 3, 2) of a convex polygon, dropping degenerate ones."""
-    tris = np.array(
-        [[poly[0], poly[i], poly[i + 1]] for i in range(1, poly.shape[0] - 1)]
-    )
-    if tris.size == 0:
-        return np.zeros((0, 3, 2))
-    e1 = tris[:, 1] - tris[:, 0]
-    e2 = tris[:, 2] - tris[:, 0]
-    area = 0.5 * (e1[:, 0] * e2[:, 1] - e1[:, 1] * e2[:, 0])
-    return tris[area > min_area]
-
-
 def cell_subtriangles(bounds: np.ndarray, lines, tol: float, apexes=()) -> np.ndarray:
-    """Sub-triangles (t, 3, 2) of a rectangle cut along the given lines.
+    """Sub-triangles (t, 3, 2) of a rectangle cut along the given lines
+    ((point, normal) pairs, applied in order).
 
     A sub-polygon with a vertex at one of the ``apexes`` (crack tips) is fanned
     from that vertex, so the tip is vertex 0 of its triangles (Duffy rule).
+    The rule is the kernel's (xfemslip.kernels.subcells, its NumPy twin
+    here for one cell).
     """
-    x0, x1, y0, y1 = bounds
-    polys = [np.array([[x0, y0], [x1, y0], [x1, y1], [x0, y1]])]
-    for point, normal in lines:
-        polys = [
-            piece for poly in polys for piece in split_polygon(poly, point, normal, tol)
-        ]
-    for i, poly in enumerate(polys):
-        for apex in apexes:
-            dist = np.linalg.norm(poly - apex, axis=1)
-            j = int(np.argmin(dist))
-            if dist[j] <= tol:
-                polys[i] = np.roll(poly, -j, axis=0)
-                break
-    min_area = (tol * tol) * 1e-3
-    return np.concatenate([fan_triangles(p, min_area) for p in polys], axis=0)
+    pts = np.array([p for p, _ in lines], float).reshape(-1, 2)
+    nrm = np.array([n for _, n in lines], float).reshape(-1, 2)
+    apx = np.array(list(apexes), float).reshape(-1, 2)
+    return vectorized.cell_subtriangles(
+        np.asarray(bounds, float)[None, :],
+        np.array([0, len(pts)], np.int64),
+        pts,
+        nrm,
+        np.array([0, len(apx)], np.int64),
+        apx,
+        tol,
+    )[1]
 
 
 # Collapsed (Duffy) product rule for triangles with a 1/sqrt(r) gradient

@@ -1,6 +1,6 @@
 """The kernels: loops over cells and contact points, in two backends.
 
-- ``"numba"``: bulk.py, contact.py, scatter.py, shape.py (gathered in
+- ``"numba"``: bulk.py, contact.py, scatter.py, shape.py, subcells.py (gathered in
   jit.py), compiled by Numba (``cache=True``: once per install).  All Numba
   code of xfemslip lives in this subpackage, and only here.
 - ``"numpy"``: vectorized.py, the same functions as whole-array NumPy code.
@@ -28,6 +28,7 @@ logger = logging.getLogger(__name__)
 BACKENDS = ("auto", "numba", "numpy")
 KERNELS = (
     "block_triplets",
+    "cell_subtriangles",
     "contact_response",
     "coulomb_return_map",
     "enriched_cell_matrices",

@@ -118,7 +118,16 @@ def _enriched_B(x, y, x0, x1, y0, y1, slot_node, slot_fnode, F, gradF, N, dN, ou
 
 @njit(cache=NUMBA_CACHE)
 def enriched_cell_matrices(
-    bounds, qp_offsets, qp_xy, qp_w, qp_F, qp_gradF, slot_node, slot_fnode, D
+    bounds,
+    qp_offsets,
+    qp_xy,
+    qp_w,
+    slot_offsets,
+    slot_F,
+    slot_gradF,
+    slot_node,
+    slot_fnode,
+    D,
 ):
     """Stiffness and area-averaged strain operator of enriched cells.
 
@@ -127,9 +136,12 @@ def enriched_cell_matrices(
     bounds : (nc, 4) float64, [x0, x1, y0, y1] of each cell [m]
     qp_offsets : (nc + 1,) int64, qp range of each cell in the flat arrays
     qp_xy : (nq, 2) float64 [m]; qp_w : (nq,) float64 [m^2] (sub-cell rules)
-    qp_F : (nq, S) float64, enrichment function F of each slot's fracture [-]
-    qp_gradF : (nq, S, 2) float64 [1/m]
+    slot_offsets : (nc + 1,) int64; slot_F : (nv,) float64 [-]; slot_gradF :
+        (nv, 2) float64 [1/m]: enrichment function F of each used slot at each
+        point of its cell, slot s of cell e at point q at slot_offsets[e] + s
+        * nq_e + (q - qp_offsets[e]) (enrichment.EnrichedCells)
     slot_node : (nc, S) int64, local node (0..3) of each slot, -1 = empty
+        (slots are filled from 0)
     slot_fnode : (nc, S) float64, F at the slot's node (the shift of eq. 11)
     D : (3, 3) float64 [Pa]
 
@@ -147,16 +159,27 @@ def enriched_cell_matrices(
     dN = np.empty((4, 2))
     B = np.zeros((3, nd))
     DB = np.zeros((3, nd))
+    F = np.zeros(S)
+    gradF = np.zeros((S, 2))
     for e in range(nc):
         x0, x1, y0, y1 = bounds[e, 0], bounds[e, 1], bounds[e, 2], bounds[e, 3]
         area = 0.0
+        q0 = qp_offsets[e]
+        nq = qp_offsets[e + 1] - q0
         # columns in use: slots are filled from 0, so only up to the last
         # occupied one (networks pad most cells far below S)
         m = 8
+        n_used = 0
         for s in range(S):
             if slot_node[e, s] >= 0:
                 m = 10 + 2 * s
-        for q in range(qp_offsets[e], qp_offsets[e + 1]):
+                n_used = s + 1
+        for q in range(q0, q0 + nq):
+            for s in range(n_used):
+                v = slot_offsets[e] + s * nq + (q - q0)
+                F[s] = slot_F[v]
+                gradF[s, 0] = slot_gradF[v, 0]
+                gradF[s, 1] = slot_gradF[v, 1]
             _enriched_B(
                 qp_xy[q, 0],
                 qp_xy[q, 1],
@@ -166,8 +189,8 @@ def enriched_cell_matrices(
                 y1,
                 slot_node[e],
                 slot_fnode[e],
-                qp_F[q],
-                qp_gradF[q],
+                F,
+                gradF,
                 N,
                 dN,
                 B,

@@ -4,9 +4,11 @@ NumPy backend (vectorized.py) also has.  Importing it imports Numba."""
 from xfemslip.kernels.bulk import enriched_cell_matrices, rectangle_stiffness
 from xfemslip.kernels.contact import contact_response, coulomb_return_map
 from xfemslip.kernels.scatter import block_triplets
+from xfemslip.kernels.subcells import cell_subtriangles
 
 __all__ = [
     "block_triplets",
+    "cell_subtriangles",
     "contact_response",
     "coulomb_return_map",
     "enriched_cell_matrices",

@@ -1,6 +1,6 @@
 """The kernels as NumPy array code: the same functions, signatures and results
-(to round-off) as the Numba kernels of bulk.py, contact.py and scatter.py,
-without importing Numba.
+(to round-off) as the Numba kernels of bulk.py, contact.py, scatter.py and
+subcells.py, without importing Numba.
 
 Why two implementations: a warm ``xfemslip run`` of a small case paid about
 0.2 s to import Numba and 0.3 s for its target set-up at the first cached
@@ -94,8 +94,36 @@ def function_gradients(qp_xy, bounds, slot_node, slot_fnode, qp_F, qp_gradF):
     return np.concatenate([dN[:, :, 0], gx], 1), np.concatenate([dN[:, :, 1], gy], 1)
 
 
+def padded_slot_values(qp_offsets, slot_offsets, slot_F, slot_gradF, S):
+    """F (nq, S) and grad F (nq, S, 2) of every point, each slot in its
+    column (0 in empty slots), from the per-slot layout of
+    enrichment.EnrichedCells."""
+    nq_cell = np.diff(qp_offsets)
+    nv_cell = np.diff(slot_offsets)
+    nq = int(qp_offsets[-1]) if qp_offsets.size else 0
+    F = np.zeros((nq, S))
+    gF = np.zeros((nq, S, 2))
+    if slot_F.size:
+        cell = np.repeat(np.arange(nq_cell.size), nv_cell)
+        j = np.arange(slot_F.size) - np.repeat(slot_offsets[:-1], nv_cell)
+        s, local = np.divmod(j, nq_cell[cell])
+        q = qp_offsets[cell] + local
+        F[q, s] = slot_F
+        gF[q, s] = slot_gradF
+    return F, gF
+
+
 def enriched_cell_matrices(
-    bounds, qp_offsets, qp_xy, qp_w, qp_F, qp_gradF, slot_node, slot_fnode, D
+    bounds,
+    qp_offsets,
+    qp_xy,
+    qp_w,
+    slot_offsets,
+    slot_F,
+    slot_gradF,
+    slot_node,
+    slot_fnode,
+    D,
 ):
     """K (nc, 8 + 2S, 8 + 2S) = sum_qp B^T D B w and Bbar (nc, 3, 8 + 2S) =
     (1/A) sum_qp B w of enriched cells (bulk.enriched_cell_matrices).
@@ -105,6 +133,9 @@ def enriched_cell_matrices(
     gradient products sum_qp w b_f b_g: four small products per cell instead
     of one over the 3 x (8 + 2S) B.
     """
+    qp_F, qp_gradF = padded_slot_values(
+        qp_offsets, slot_offsets, slot_F, slot_gradF, slot_node.shape[1]
+    )
     nc = bounds.shape[0]
     S = slot_node.shape[1]
     nf = 4 + S
@@ -331,3 +362,87 @@ def block_triplets(dofs, blocks):
     rows = np.broadcast_to(dofs[:, :, None], (dofs.shape[0], k, k))[pair]
     cols = np.broadcast_to(dofs[:, None, :], (dofs.shape[0], k, k))[pair]
     return rows.astype(np.int64), cols.astype(np.int64), blocks[pair]
+
+
+# ----------------------------------------------------------- sub-cells
+def split_polygon(poly: np.ndarray, point: np.ndarray, normal: np.ndarray, tol: float):
+    """Split a convex polygon (k, 2) by a line; returns a list of 1 or 2 polygons.
+
+    Vertices within tol of the line count as on it, so a line through a vertex
+    or along an edge never makes a sliver.
+    """
+    # the two products written out, as in the Numba kernel (bit for bit)
+    d = (poly[:, 0] - point[0]) * normal[0] + (poly[:, 1] - point[1]) * normal[1]
+    d[np.abs(d) <= tol] = 0.0
+    if np.all(d >= 0.0) or np.all(d <= 0.0):
+        return [poly]
+    pos, neg = [], []
+    k = poly.shape[0]
+    for i in range(k):
+        p, q = poly[i], poly[(i + 1) % k]
+        dp, dq = d[i], d[(i + 1) % k]
+        if dp >= 0.0:
+            pos.append(p)
+        if dp <= 0.0:
+            neg.append(p)
+        if dp * dq < 0.0:
+            x = p + dp / (dp - dq) * (q - p)
+            pos.append(x)
+            neg.append(x)
+    # a line within tol of a corner can leave a degenerate piece (3 coincident
+    # points): keep only pieces with area
+    pieces = [np.array(v) for v in (pos, neg) if len(v) >= 3]
+    pieces = [v for v in pieces if polygon_area(v) > tol * tol]
+    return pieces or [poly]
+
+
+def polygon_area(poly: np.ndarray) -> float:
+    x, y = poly[:, 0], poly[:, 1]
+    return 0.5 * float(np.dot(x, np.roll(y, -1)) - np.dot(y, np.roll(x, -1)))
+
+
+def fan_triangles(poly: np.ndarray, min_area: float) -> np.ndarray:
+    """Triangles (t, 3, 2) of a convex polygon, dropping degenerate ones."""
+    tris = np.array(
+        [[poly[0], poly[i], poly[i + 1]] for i in range(1, poly.shape[0] - 1)]
+    )
+    if tris.size == 0:
+        return np.zeros((0, 3, 2))
+    e1 = tris[:, 1] - tris[:, 0]
+    e2 = tris[:, 2] - tris[:, 0]
+    area = 0.5 * (e1[:, 0] * e2[:, 1] - e1[:, 1] * e2[:, 0])
+    return tris[area > min_area]
+
+
+def cell_subtriangles(
+    bounds, line_offsets, line_point, line_normal, apex_offsets, apex_xy, tol
+):
+    """Sub-triangles of rectangles cut along their lines
+    (subcells.cell_subtriangles): (tri_offsets (nc + 1,), tris (nt, 3, 2))."""
+    nc = bounds.shape[0]
+    out = []
+    offsets = np.zeros(nc + 1, np.int64)
+    min_area = (tol * tol) * 1e-3
+    for e in range(nc):
+        x0, x1, y0, y1 = bounds[e]
+        polys = [np.array([[x0, y0], [x1, y0], [x1, y1], [x0, y1]])]
+        for li in range(line_offsets[e], line_offsets[e + 1]):
+            point, normal = line_point[li], line_normal[li]
+            polys = [
+                piece
+                for poly in polys
+                for piece in split_polygon(poly, point, normal, tol)
+            ]
+        apexes = apex_xy[apex_offsets[e] : apex_offsets[e + 1]]
+        for i, poly in enumerate(polys):
+            for apex in apexes:
+                dist = np.linalg.norm(poly - apex, axis=1)
+                j = int(np.argmin(dist))
+                if dist[j] <= tol:
+                    polys[i] = np.roll(poly, -j, axis=0)
+                    break
+        tris = [fan_triangles(p, min_area) for p in polys]
+        out.extend(tris)
+        offsets[e + 1] = offsets[e] + sum(t.shape[0] for t in tris)
+    tris = np.concatenate(out, axis=0) if out else np.zeros((0, 3, 2))
+    return offsets, tris

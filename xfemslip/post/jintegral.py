@@ -187,7 +187,7 @@ def _stiffness_points(model, enr):
     ec = model.ec
     q = np.concatenate([np.arange(ec.qp_offsets[e], ec.qp_offsets[e + 1]) for e in enr])
     e_of_q = np.repeat(enr, np.diff(ec.qp_offsets)[enr])
-    return ec.qp_xy[q], ec.qp_w[q], e_of_q, ec.qp_F[q], ec.qp_gradF[q]
+    return ec.qp_xy[q], ec.qp_w[q], e_of_q, *ec.qp_values(q)
 
 
 def displacement_gradient(model, u, cells):

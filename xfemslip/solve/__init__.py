@@ -9,9 +9,11 @@ Modules:
   and the automatic choice among them;
 - ``pardiso``: the MKL PARDISO path (the mkl extra): one SPD factorization
   with the Schur complement on the contact dofs, or a fixed pattern;
+- ``lowrank``: the PARDISO path of networks: the stuck matrix factored once,
+  each Newton system a low-rank change of it;
 - ``backward``: the backward error every solve is checked against.
 
 The subpackage imports nothing itself: import the module you need (``from
 xfemslip.solve.newton import ...``)."""
 
-__all__ = ["backward", "linear", "newton", "pardiso"]
+__all__ = ["backward", "linear", "lowrank", "newton", "pardiso"]

@@ -42,7 +42,10 @@ them; PARDISO's own machinery is in pardiso.py.
   stats["amg_fallbacks"], stats["amg_fallback_time"].
 - ``"pardiso"``: MKL PARDISO (the mkl extra), xfemslip.solve.pardiso: one SPD
   factorization of K_ff for the run with the contact dofs eliminated last,
-  and a dense LU of their Schur complement per contact tangent.  A PARDISO
+  and a dense LU of their Schur complement per contact tangent; with more
+  contact dofs than that allows (networks), xfemslip.solve.lowrank: one SPD
+  factorization of the stuck matrix with the Schur complement on the patch
+  jumps, and per contact tangent a dense LU of its low-rank change.  A PARDISO
   failure sends the run to SuperLU (warning, stats["pardiso_fallbacks"]).
 - ``"auto"`` (default): ``"pardiso"`` from AUTO_PARDISO_MIN_DOFS free dofs
   when the mkl extra is installed; otherwise ``"amg"`` from
@@ -77,7 +80,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from xfemslip.fem.assembly import coo_block
-from xfemslip.solve import pardiso
+from xfemslip.solve import lowrank, pardiso
 from xfemslip.solve.backward import backward_error
 from xfemslip.solve.guess import PreviousSolutions
 
@@ -399,6 +402,8 @@ class LinearSolver:
         node_xy=None,
         contact_dofs=None,
         kernels="numpy",
+        contact_coef=None,
+        contact_stick=None,
     ):
         if method not in LINEAR_SOLVERS:
             raise ValueError(f"linear solver must be one of {LINEAR_SOLVERS}")
@@ -411,6 +416,11 @@ class LinearSolver:
         self.contact_dofs = (
             np.zeros((0, 0), np.int64) if contact_dofs is None else contact_dofs
         )
+        # the patches' jump coefficients (m, J) on contact_dofs and their
+        # stuck tangents (m, 2, 2) (lowrank.stick_tangents): with both, a
+        # network's PARDISO systems are low-rank changes of the stuck matrix
+        self.contact_coef = contact_coef
+        self.contact_stick = contact_stick
         # the kernel backend that gathers the contact blocks (the model's)
         self.kernels = kernels
         self.facts = {"n_free": n}
@@ -452,6 +462,9 @@ class LinearSolver:
             "pardiso_schur": 0,
             "schur_factorizations": 0,
             "pardiso_fallbacks": 0,
+            "pardiso_lowrank": 0,
+            "lowrank_updates": 0,
+            "lowrank_rank": 0,
         }
         # pardiso.SchurSystems or PardisoSystems, made on the first solve, and
         # the pattern of the sparse Kc they were made for (None: the blocks')
@@ -497,17 +510,10 @@ class LinearSolver:
         if self.method == "pardiso":
             start = time.perf_counter()
             if self._pardiso is None:
-                dofs = np.asarray(self.contact_dofs, dtype=np.int64)
-                if dofs.ndim != 2:  # (m, k): m = 0 without a fracture
-                    dofs = dofs.reshape(len(dofs), -1)
-                k = dofs.shape[1]
-                shape = (dofs.shape[0], k, k)
-                self._make_pardiso(
-                    np.broadcast_to(dofs[:, :, None], shape),
-                    np.broadcast_to(dofs[:, None, :], shape),
-                    None,
-                )
-            x = self._solve_pardiso(blocks, pardiso.symmetric_blocks(blocks), r)
+                self._make_pardiso_contact()
+            x = self._solve_pardiso(blocks, self._symmetric(blocks), r)
+            if x is None and self.method == "pardiso":  # low-rank failed
+                x = self._solve_pardiso(blocks, self._symmetric(blocks), r)
             if x is not None:
                 self.stats["solves"] += 1
                 self.stats["solve_time"] += time.perf_counter() - start
@@ -516,6 +522,55 @@ class LinearSolver:
         if blocks is not None and np.size(blocks):
             Kc = coo_block(self.contact_dofs, blocks, self.K.shape[0], self.kernels)
         return self.solve(Kc, r)
+
+    def _symmetric(self, blocks) -> bool:
+        """Whether the contact blocks are symmetric (pardiso.symmetric_blocks;
+        not needed by the low-rank systems, whose dense LU takes either)."""
+        if isinstance(self._pardiso, lowrank.LowRankSystems):
+            return False
+        return pardiso.symmetric_blocks(blocks)
+
+    def _make_pardiso_contact(self, lowrank_ok=True):
+        """The PARDISO systems for the contact blocks: pardiso.make_systems
+        (the Schur complement on up to SCHUR_MAX_DOFS contact dofs, else a
+        fixed pattern), or, for more contact dofs with the patches' jump
+        coefficients known and at most lowrank.MAX_ROWS jump rows, the
+        low-rank changes of the stuck matrix (lowrank.LowRankSystems)."""
+        dofs = np.asarray(self.contact_dofs, dtype=np.int64)
+        if dofs.ndim != 2:  # (m, k): m = 0 without a fracture
+            dofs = dofs.reshape(len(dofs), -1)
+        if lowrank_ok and self._lowrank_applies(dofs):
+            self._release_pardiso()
+            self._pardiso = lowrank.LowRankSystems(
+                self.K,
+                dofs,
+                self.contact_coef,
+                self.contact_stick,
+                LU_BACKWARD_ERROR,
+                self.stats,
+            )
+            return
+        k = dofs.shape[1]
+        shape = (dofs.shape[0], k, k)
+        self._make_pardiso(
+            np.broadcast_to(dofs[:, :, None], shape),
+            np.broadcast_to(dofs[:, None, :], shape),
+            None,
+        )
+
+    def _lowrank_applies(self, dofs) -> bool:
+        """Whether the contact blocks go to lowrank.LowRankSystems."""
+        if self.contact_coef is None or self.contact_stick is None:
+            return False
+        m = dofs.shape[0]
+        if m == 0 or 2 * m > lowrank.MAX_ROWS:
+            return False
+        if np.unique(dofs[dofs >= 0]).size <= pardiso.SCHUR_MAX_DOFS:
+            return False  # the Schur complement on the contact dofs is smaller
+        D0 = np.asarray(self.contact_stick)
+        return bool(
+            np.all(np.isfinite(D0)) and np.all(np.linalg.eigvalsh(D0)[:, 0] > 0.0)
+        )
 
     def _make_pardiso(self, rows, cols, key):
         """The PARDISO systems for contact entries at (rows, cols); `key`: the
@@ -533,6 +588,17 @@ class LinearSolver:
         try:
             return self._pardiso.solve(self._pardiso.values(entries), symmetric, r)
         except pardiso.PardisoError as exc:
+            if isinstance(self._pardiso, lowrank.LowRankSystems):
+                # the general PARDISO path solves this and the later systems
+                logger.warning(
+                    "%s after %.2f s; PARDISO on the whole matrix solves this "
+                    "and the later systems of the run",
+                    exc,
+                    time.perf_counter() - t,
+                )
+                self.stats["pardiso_fallbacks"] += 1
+                self._make_pardiso_contact(lowrank_ok=False)
+                return None
             self.stats["pardiso_fallbacks"] += 1
             logger.warning(
                 "%s after %.2f s; SuperLU solves this and the later systems of the run",

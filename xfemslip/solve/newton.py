@@ -56,6 +56,7 @@ from xfemslip.conventions import (
 from xfemslip.errors import ConvergenceError
 from xfemslip.solve import remedies
 from xfemslip.solve.linear import LinearSolver
+from xfemslip.solve.lowrank import stick_tangents
 
 logger = logging.getLogger(__name__)
 
@@ -170,6 +171,8 @@ class NewtonSolver:
             problem.node_xy,
             self.c_dofs,
             kernels=c.kernels,
+            contact_coef=c.coef,
+            contact_stick=stick_tangents(c.weight, c.kn, c.kt, c.normal, c.tangent),
         )
         # tangent blocks of the contact evaluations whose tangent is never
         # used (_scratch_blocks)

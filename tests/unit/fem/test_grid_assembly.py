@@ -77,3 +77,51 @@ def test_entries_added_keep_the_pattern_and_sort_the_rows():
         + cols[(rows >= n_std) | (cols >= n_std)]
     )
     assert K.nnz == stored + new_pairs.size
+
+
+def test_bulk_of_a_network_is_the_coo_sum_of_its_cell_matrices(monkeypatch):
+    """assemble_bulk on a crossing network (enriched cells taken in chunks of
+    7, their entries gathered before the sliver rule in candidate numbering
+    and renumbered) equals the COO sum of the intact cells' and the enriched
+    cells' whole matrices on the kept dofs, and the same with one chunk."""
+    from pathlib import Path
+
+    from xfemslip import simulation
+    from xfemslip.case import build, loads_case
+    from xfemslip.fem import assembly
+    from xfemslip.fem.enrichment import build_enriched_cells, find_candidates
+    from xfemslip.fem.material import elasticity_matrix
+    from xfemslip.fem.quadrature import interface_points
+
+    root = Path(__file__).resolve().parents[3]
+    case = build.file_case(
+        root / "cases" / "fracture_network.toml", **{"mesh.elements": [30, 30]}
+    )
+    spec = loads_case(build.case_text(case), root / "cases" / "net.toml")
+    mesh, fractures = simulation._geometry(spec)
+    cand = find_candidates(mesh, fractures)
+    ec = build_enriched_cells(mesh, fractures, cand)
+    ip = interface_points(fractures, mesh.h_min)
+    D = elasticity_matrix(spec.material.E, spec.material.nu, "plane_strain")
+    out = {}
+    for chunk in (7, 10**6):
+        monkeypatch.setattr(assembly, "ENRICHED_CHUNK", chunk)
+        out[chunk] = assembly.assemble_bulk(mesh, D, cand, ec, ip, backend="numpy")
+    bulk = out[7]
+    assert bulk.dofmap.n_enriched_functions < cand.node.size  # some dropped
+    assert (abs(bulk.K - out[10**6].K)).max() == 0.0
+    K_e, _ = assembly._enriched_matrices(mesh, ec, D, None, backend="numpy")
+    K_u, which = assembly._rect_stiffness_shared(
+        *(np.diff(mesh.bounds[bulk.std_cells].reshape(-1, 2, 2), axis=2)[:, :, 0].T),
+        D,
+        None,
+        "numpy",
+    )
+    n = bulk.dofmap.n_dofs
+    ref = _coo_sum(std_cell_dofs(mesh.cells[bulk.std_cells]), K_u[which], n)
+    dofs = bulk.enr_dofs
+    ok = (dofs[:, :, None] >= 0) & (dofs[:, None, :] >= 0)
+    rows = np.broadcast_to(dofs[:, :, None], K_e.shape)[ok]
+    cols = np.broadcast_to(dofs[:, None, :], K_e.shape)[ok]
+    ref = ref + sp.coo_matrix((K_e[ok], (rows, cols)), shape=(n, n)).tocsr()
+    assert abs(bulk.K - ref).max() <= 1e-13 * abs(ref).max()

@@ -191,7 +191,8 @@ def _junction_cell_basis(mesh, fractures, point):
     cols = [N]
     for s in np.nonzero(ec.slot_cand[e] >= 0)[0]:
         a = ec.slot_node[e, s]
-        cols.append((N[:, a] * (ec.qp_F[q0:q1, s] - ec.slot_fnode[e, s]))[:, None])
+        F = ec.qp_values(np.arange(q0, q1))[0][:, s]
+        cols.append((N[:, a] * (F - ec.slot_fnode[e, s]))[:, None])
     tris = ec.tris[ec.tri_offsets[e] : ec.tri_offsets[e + 1]]
     centroid = np.repeat(tris.mean(axis=1), xy.shape[0] // tris.shape[0], axis=0)
     return np.hstack(cols), xy, N, centroid, cand, ec, e

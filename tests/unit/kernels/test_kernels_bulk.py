@@ -14,7 +14,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from tests.support.bulk_reference import ETA, XI, enriched_reference
+from tests.support.bulk_reference import ETA, XI, compact_slots, enriched_reference
 from tests.support.casegen import fracture_case
 from xfemslip.fem.enrichment import HEAVISIDE, find_candidates
 from xfemslip.fem.material import elasticity_matrix
@@ -225,8 +225,7 @@ def _kernel_inputs(m, cells):
                 m.mesh.bounds[ec.cells[e]],
                 ec.qp_xy[q0:q1],
                 ec.qp_w[q0:q1],
-                ec.qp_F[q0:q1],
-                ec.qp_gradF[q0:q1],
+                *ec.qp_values(np.arange(q0, q1)),
                 ec.slot_node[e],
                 ec.slot_fnode[e],
             )
@@ -239,12 +238,15 @@ def _run_kernel(rows, D):
     offsets = np.concatenate([[0], np.cumsum([r[1].shape[0] for r in rows])]).astype(
         np.int64
     )
-    cat = [
+    xy, w, F, gradF = (
         np.ascontiguousarray(np.concatenate([r[k] for r in rows])) for k in (1, 2, 3, 4)
-    ]
+    )
     slot_node = np.ascontiguousarray(np.array([r[5] for r in rows]))
     slot_fnode = np.ascontiguousarray(np.array([r[6] for r in rows]))
-    return enriched_cell_matrices(bounds, offsets, *cat, slot_node, slot_fnode, D)
+    slots = compact_slots(offsets, F, gradF, slot_node)
+    return enriched_cell_matrices(
+        bounds, offsets, xy, w, *slots, slot_node, slot_fnode, D
+    )
 
 
 @pytest.mark.parametrize("key", sorted(MODELS))
@@ -291,8 +293,9 @@ def test_uncut_cell_without_slots_reproduces_the_q4(n_slots):
         np.array([0, nq], np.int64),
         xy,
         w,
-        np.zeros((nq, n_slots)),
-        np.zeros((nq, n_slots, 2)),
+        np.zeros(2, np.int64),
+        np.zeros(0),
+        np.zeros((0, 2)),
         -np.ones((1, n_slots), np.int64),
         np.zeros((1, n_slots)),
         D_STRAIN,

@@ -92,7 +92,7 @@ def test_solver_weighs_the_band(monkeypatch):
 
 
 # the shipped DFN sweep's seed-1 case (30 fractures) on 30 x 30 cells
-NETWORK = sweep_member(**{"mesh.elements": [30, 30]})
+NETWORK = sweep_member(**{"mesh.elements": [30, 30], "network.tip": "ramp"})
 
 
 def test_auto_picks_per_case_end_to_end(tmp_path, monkeypatch, caplog):

@@ -1,0 +1,234 @@
+"""The network path of PARDISO (xfemslip.solve.lowrank): the stuck matrix
+factored once with the Schur complement on the patch jumps, each Newton
+system a low-rank change of it.  Checked against SuperLU and against the
+general PARDISO path on the same systems and whole runs."""
+
+from __future__ import annotations
+
+import logging
+from pathlib import Path
+
+import numpy as np
+import pytest
+import scipy.sparse as sp
+import scipy.sparse.linalg as spla
+
+from xfemslip.case import loads_case
+from xfemslip.fem.assembly import coo_block
+from xfemslip.simulation import build_model, newton_solver
+from xfemslip.solve import linear, lowrank, pardiso
+from xfemslip.solve.linear import LU_BACKWARD_ERROR, LinearSolver, backward_error
+from xfemslip.solve.newton import NewtonSolver
+
+ROOT = Path(__file__).resolve().parents[3]
+CASE = ROOT / "cases" / "reservoir_depletion.toml"
+NETWORK = ROOT / "cases" / "fracture_network.toml"
+needs_mkl = pytest.mark.skipif(not pardiso.available(), reason="pypardiso missing")
+
+
+def _reservoir(n=20, steps=3, friction=0.1):
+    text = CASE.read_text().replace("elements = [50, 50]", f"elements = [{n}, {n}]")
+    text = text.replace("steps = 1", f"steps = {steps}")
+    return text.replace("friction = 0.1", f"friction = {friction}")
+
+
+def _systems(text, path, steps):
+    """The Newton systems (blocks, r) of a run, in order, solved by SuperLU,
+    and its solver."""
+    model = build_model(loads_case(text, path))
+    solver = NewtonSolver(
+        model.problem, 1e-10, 30, "consistent", "superlu", predictor=False
+    )
+    systems = []
+    solve = solver._solve
+
+    def record(res, r, k, it, eta):
+        systems.append((res.blocks.copy(), r.copy()))
+        return solve(res, r, k, it, eta)
+
+    solver._solve = record
+    solver.run(steps)
+    return solver, systems
+
+
+def _stick(newton):
+    c = newton.p.contact
+    return lowrank.stick_tangents(c.weight, c.kn, c.kt, c.normal, c.tangent)
+
+
+def _lowrank_solver(newton):
+    c = newton.p.contact
+    return LinearSolver(
+        newton.K_ff,
+        "pardiso",
+        newton.free,
+        None,
+        newton.c_dofs,
+        contact_coef=c.coef,
+        contact_stick=_stick(newton),
+    )
+
+
+def test_patch_tangents_reads_each_blocks_2x2():
+    """Blocks c c^T (x) D (as the contact kernel forms them) give back D to
+    round-off, whichever coefficients have fixed dofs; a block that is not
+    such a product is refused."""
+    rng = np.random.default_rng(2)
+    m, J = 7, 5
+    coef = rng.standard_normal((m, J))
+    coef[3, 2:] = 0.0  # a patch with fewer live coefficients
+    dofs = rng.integers(0, 100, size=(m, 2 * J))
+    dofs[1, 0:2] = -1  # its largest coefficient may sit on fixed dofs
+    D = rng.standard_normal((m, 2, 2))
+    blocks = np.einsum("mk,ml,mab->mkalb", coef, coef, D).reshape(m, 2 * J, 2 * J)
+    got = lowrank.patch_tangents(blocks, coef, dofs)
+    np.testing.assert_allclose(got, D, rtol=1e-14, atol=0)
+    bad = blocks.copy()
+    bad[4, 0, 3] += 1e-6 * np.abs(bad[4]).max()
+    assert lowrank.patch_tangents(bad, coef, dofs) is None
+
+
+def test_stick_tangent_is_the_kernels():
+    """D0 = w (k_N n n^T + k_T t t^T) is the block of a stuck patch as the
+    contact kernel gives it (read back with patch_tangents)."""
+    newton, seq = _systems(_reservoir(friction=10.0, steps=1), CASE, 1)
+    c = newton.p.contact
+    D = lowrank.patch_tangents(seq[0][0], c.coef, newton.c_dofs)
+    np.testing.assert_allclose(D, _stick(newton), rtol=1e-13, atol=0)
+
+
+@needs_mkl
+def test_schur_block_is_the_jump_compliance(monkeypatch):
+    """G = M R^-1 M^T from PARDISO's Schur complement of the augmented
+    matrix equals the product computed with SuperLU's solves of the stuck
+    matrix R = K_ff + M^T M."""
+    newton, _ = _systems(_reservoir(n=12, steps=1), CASE, 1)
+    c = newton.p.contact
+    stats = dict.fromkeys(("factorizations", "pardiso_analyses"), 0)
+    stats["factor_time"] = 0.0
+    systems = lowrank.LowRankSystems(
+        newton.K_ff, newton.c_dofs, c.coef, _stick(newton), LU_BACKWARD_ERROR, stats
+    )
+    systems._factor()
+    M = systems.M.toarray()
+    R = (newton.K_ff + sp.csr_matrix(M.T @ M)).tocsc()
+    ref = M @ spla.splu(R).solve(M.T)
+    np.testing.assert_allclose(systems.G, ref, rtol=0, atol=1e-10 * abs(ref).max())
+    # eigenvalues in [0, 1]: the Schur block 2 I - G is well conditioned
+    lam = np.linalg.eigvalsh(0.5 * (ref + ref.T))
+    assert lam.min() > -1e-12 and lam.max() < 1.0 + 1e-12
+    systems.release()
+
+
+@needs_mkl
+@pytest.mark.parametrize(
+    ("friction", "slips"), [(0.1, True), (10.0, False)], ids=["sliding", "stuck"]
+)
+def test_newton_systems_match_superlu(friction, slips, monkeypatch):
+    """Every Newton system of a 3-step run (the reservoir case, its contact
+    dofs sent past the Schur mode's limit) through the low-rank path: the
+    backward error bound against the assembled matrix and spsolve's answer
+    to 1e-8; one factorization for the run, a dense LU per new tangent."""
+    monkeypatch.setattr(pardiso, "SCHUR_MAX_DOFS", 0)
+    newton, seq = _systems(_reservoir(friction=friction), CASE, 3)
+    ls = _lowrank_solver(newton)
+    changes, last = 0, None
+    for blocks, r in seq:
+        A = (
+            newton.K_ff + coo_block(newton.c_dofs, blocks, newton.free.size, "numpy")
+        ).tocsc()
+        changes += last is None or not np.array_equal(blocks, last)
+        last = blocks
+        x = ls.solve_contact(blocks, r)
+        assert backward_error(A, x, r) <= LU_BACKWARD_ERROR
+        x_ref = spla.spsolve(A, r)
+        assert np.linalg.norm(x - x_ref) <= 1e-8 * np.linalg.norm(x_ref)
+    st = ls.stats
+    assert isinstance(ls._pardiso, lowrank.LowRankSystems)
+    assert st["pardiso_lowrank"] == len(seq) and st["pardiso_fallbacks"] == 0
+    assert st["factorizations"] == 1 and st["pardiso_analyses"] == 1
+    assert st["lowrank_updates"] == changes
+    # stuck: nothing changes from the factored matrix; sliding: rank 1 per
+    # slipping patch
+    assert (st["lowrank_rank"] > 0) == slips
+
+
+@needs_mkl
+def test_open_patches_are_a_rank_two_change(monkeypatch):
+    """Patches with no contact stiffness (open: zero blocks) next to stuck
+    and slipping ones: the same answer as spsolve, rank 2 per open patch."""
+    monkeypatch.setattr(pardiso, "SCHUR_MAX_DOFS", 0)
+    newton, seq = _systems(_reservoir(friction=0.1, steps=1), CASE, 1)
+    blocks, r = seq[-1]
+    blocks = blocks.copy()
+    blocks[::3] = 0.0
+    ls = _lowrank_solver(newton)
+    x = ls.solve_contact(blocks, r)
+    A = (
+        newton.K_ff + coo_block(newton.c_dofs, blocks, newton.free.size, "numpy")
+    ).tocsc()
+    x_ref = spla.spsolve(A, r)
+    assert np.linalg.norm(x - x_ref) <= 1e-8 * np.linalg.norm(x_ref)
+    assert ls.stats["lowrank_rank"] >= 2 * len(blocks[::3])
+
+
+@needs_mkl
+def test_blocks_of_another_form_go_to_the_general_path(monkeypatch, caplog):
+    """A block that is not c c^T (x) D: one warning, that system and the
+    later ones on PARDISO's general path, the same answer."""
+    monkeypatch.setattr(pardiso, "SCHUR_MAX_DOFS", 0)
+    newton, seq = _systems(_reservoir(n=16, steps=1), CASE, 1)
+    blocks, r = seq[0]
+    blocks = blocks.copy()
+    blocks[0] += np.diag(np.arange(blocks.shape[1], dtype=float)) * abs(blocks).max()
+    ls = _lowrank_solver(newton)
+    with caplog.at_level(logging.WARNING, logger="xfemslip.solve.linear"):
+        x = ls.solve_contact(blocks, r)
+    A = (
+        newton.K_ff + coo_block(newton.c_dofs, blocks, newton.free.size, "numpy")
+    ).tocsc()
+    x_ref = spla.spsolve(A, r)
+    assert np.linalg.norm(x - x_ref) <= 1e-8 * np.linalg.norm(x_ref)
+    assert "not of the patch form" in caplog.text
+    assert ls.method == "pardiso" and ls.stats["pardiso_fallbacks"] == 1
+    assert isinstance(ls._pardiso, pardiso.PardisoSystems)
+
+
+@needs_mkl
+def test_network_run_matches_the_general_path(monkeypatch):
+    """The shipped 15-fracture network (crossings, T's, branch tips, 4
+    load steps) solved through the low-rank path and through PARDISO on the
+    whole matrix: the same Newton iterations and the same slip to 1e-7 of
+    its maximum (the Newton tolerance is 1e-8 on the residual)."""
+    monkeypatch.setattr(pardiso, "SCHUR_MAX_DOFS", 0)
+    text = NETWORK.read_text().replace("elements = [80, 80]", "elements = [40, 40]")
+    text = text.replace("[solver]", '[solver]\nlinear_solver = "pardiso"', 1)
+    assert "elements = [40, 40]" in text and 'linear_solver = "pardiso"' in text
+    out = {}
+    for path in ("lowrank", "general"):
+        if path == "general":
+            monkeypatch.setattr(lowrank, "MAX_ROWS", 0)
+        model = build_model(loads_case(text, NETWORK))
+        solver = newton_solver(model)
+        steps = solver.run(model.spec.loading.steps)
+        st = solver.linear.stats
+        assert (st["pardiso_lowrank"] > 0) == (path == "lowrank")
+        assert st["pardiso_fallbacks"] == 0
+        out[path] = (
+            [s.iterations for s in steps],
+            np.concatenate([s.contact.point_gt for s in steps]),
+            st["factorizations"],
+        )
+    assert out["lowrank"][0] == out["general"][0]
+    ref = np.abs(out["general"][1]).max()
+    assert ref > 0.0
+    assert np.abs(out["lowrank"][1] - out["general"][1]).max() <= 1e-7 * ref
+    assert out["lowrank"][2] == 1 < out["general"][2]
+
+
+def test_without_coefficients_the_paths_are_as_before(monkeypatch):
+    """No jump coefficients given: never the low-rank path."""
+    monkeypatch.setattr(pardiso, "SCHUR_MAX_DOFS", 0)
+    ls = LinearSolver(sp.identity(4, format="csr"), "superlu")
+    assert not ls._lowrank_applies(np.array([[0, 1, 2, 3]]))
+    assert linear.lowrank is lowrank
