@@ -9,7 +9,6 @@ import numpy as np
 
 from xfemslip.case.options import SOLVER_OPTIONS
 from xfemslip.case.specs import (
-    AUTO_PENALTY,
     EDGES,
     CaseSpec,
     EdgeSpec,
@@ -22,6 +21,7 @@ from xfemslip.case.specs import (
     SolverSpec,
 )
 from xfemslip.case.tables import fmt
+from xfemslip.contact.defaults import AUTO_PENALTY
 from xfemslip.fem.zones import build_zones, in_situ_stress, initial_pressure
 from xfemslip.reference.screen import coulomb_margin, plane_stresses
 

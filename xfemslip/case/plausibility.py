@@ -10,7 +10,8 @@ the value and why it looks wrong:
   (the faces open instead of slipping; the paper's problems are in
   compression, signs in docs/output-format.md: compression negative);
 - a penalty stiffness kn h/E or kt h/E outside the range where Newton was
-  measured to converge (specs.PENALTY_RATIO_LOWEST to PENALTY_RATIO_MEASURED);
+  measured to converge (xfemslip.contact.defaults: PENALTY_RATIO_LOWEST to
+  PENALTY_RATIO_MEASURED);
 - a fracture that reaches outside the domain (it is clipped at the boundary,
   so its tip there becomes an edge crossing);
 - a unit's edge that was moved onto a fracture it lay within 0.1 cell of
@@ -21,7 +22,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from xfemslip.case.specs import PENALTY_RATIO_LOWEST, PENALTY_RATIO_MEASURED
+from xfemslip.contact.defaults import PENALTY_RATIO_LOWEST, PENALTY_RATIO_MEASURED
 
 __all__ = ["E_RANGE", "plausibility_warnings"]
 

@@ -17,7 +17,7 @@ from functools import cached_property
 import numpy as np
 
 from xfemslip import kernels
-from xfemslip.case.specs import AUTO_PENALTY, CONTACT_PATCH_CELLS
+from xfemslip.contact.defaults import AUTO_PENALTY, CONTACT_PATCH_CELLS
 from xfemslip.conventions import OPEN, STICK
 from xfemslip.fem.assembly import coo_block, scatter_vector
 from xfemslip.fem.enrichment import HEAVISIDE, group_values

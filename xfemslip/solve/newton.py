@@ -41,8 +41,8 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.sparse as sp
 
-from xfemslip.case.specs import AUTO_PENALTY, PENALTY_RATIO_MEASURED
 from xfemslip.contact.branches import force_branches
+from xfemslip.contact.defaults import AUTO_PENALTY, PENALTY_RATIO_MEASURED
 from xfemslip.contact.interface import ContactResult, ContactSet
 from xfemslip.contact.predictor import predict_state, predicted_law
 from xfemslip.conventions import (

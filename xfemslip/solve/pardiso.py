@@ -44,6 +44,7 @@ error.
 from __future__ import annotations
 
 import ctypes
+import importlib.util
 import logging
 import os
 from pathlib import Path
@@ -51,7 +52,6 @@ from pathlib import Path
 import numpy as np
 import scipy.sparse as sp
 
-from xfemslip.case.options import pardiso_installed
 from xfemslip.solve.backward import backward_error, backward_error_of
 
 logger = logging.getLogger(__name__)
@@ -70,9 +70,13 @@ UNSYMMETRIC_MTYPE = 11
 SYMMETRY_RTOL = 1.0e-12
 
 
+# the package that linear_solver = "pardiso" needs (the mkl extra)
+PARDISO_PACKAGE = "pypardiso"
+
+
 def available() -> bool:
-    """Whether the mkl extra (pypardiso) is installed."""
-    return pardiso_installed()
+    """Whether MKL PARDISO (the mkl extra: pypardiso) is installed."""
+    return importlib.util.find_spec(PARDISO_PACKAGE) is not None
 
 
 class PardisoError(RuntimeError):
