@@ -33,7 +33,6 @@ from xfemslip.fem.poro import (
     body_load,
     build_materials,
     build_pore_pressure,
-    domain_box,
     fracture_load,
     make_contact_effective,
 )
@@ -91,9 +90,8 @@ def _geometry(spec):
     allocated for a case that would not fit)."""
     check_memory(spec)
     mesh = build_mesh(spec.mesh.x, spec.mesh.y)
-    box = np.array(domain_box(mesh))
     with _naming_the_file(spec):
-        return mesh, build_fractures(mesh, spec.fractures, box)
+        return mesh, build_fractures(mesh, spec.fractures, mesh.box)
 
 
 def _contact_in_situ(spec, zones, ip, eps):
@@ -136,7 +134,7 @@ def build_model(spec) -> Model:
     kernel_backend = kernels.choose(spec.solver.kernels, kernel_work(ec))
     zones = build_zones(spec)
     eps = FACE_OFFSET * mesh.h_min
-    breaks = loading_breaks(zones, fractures, domain_box(mesh), eps)
+    breaks = loading_breaks(zones, fractures, mesh.box, eps)
     ip = interface_points(fractures, mesh.h_min, breaks)
     materials = build_materials(spec, mesh, ec, fractures)
     if not spec.units:

@@ -344,8 +344,7 @@ def _check_polyline(table: Table, points: np.ndarray, grid: Grid | None) -> None
         )
     if grid is None:
         return
-    lo = grid.origin
-    hi = (lo[0] + grid.size[0], lo[1] + grid.size[1])
+    lo, hi = grid.box.lo, grid.box.hi
     if not any(
         segment_meets_box(a, b, lo, hi)
         for a, b in zip(points[:-1], points[1:], strict=True)

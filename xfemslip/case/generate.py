@@ -20,6 +20,7 @@ from xfemslip.case.tables import (
     show,
 )
 from xfemslip.geometry import dfn
+from xfemslip.geometry.box import Box
 
 GENERATE_KEYS = (
     "seed",
@@ -216,8 +217,8 @@ def _read_sets(table: Table) -> tuple[dfn.FractureSet, ...] | None:
     return (dfn.FractureSet(weight=1.0, orientation=orientation, length=length),)
 
 
-def _read_region(table: Table) -> tuple[float, float, float, float] | None | bool:
-    """``region = [[x0, y0], [x1, y1]]`` (lower-left, upper-right) -> (x0, x1, y0, y1);
+def _read_region(table: Table) -> Box | None | bool:
+    """``region = [[x0, y0], [x1, y1]]`` (lower-left, upper-right) -> a Box;
     None when not given, False when invalid."""
     if not table.has("region"):
         return None
@@ -247,7 +248,7 @@ def _read_region(table: Table) -> tuple[float, float, float, float] | None | boo
             f"upper-right corner must be above and right of lower-left, got {value}",
         )
         return False
-    return (float(x0), float(x1), float(y0), float(y1))
+    return Box.from_corners(x0, y0, x1, y1)
 
 
 def _read_count(table: Table) -> dict | None:
@@ -295,13 +296,12 @@ def read_generate(table: Table) -> dfn.DfnParams | None:
     )
 
 
-def _expected_count(params: dfn.DfnParams, box) -> float:
+def _expected_count(params: dfn.DfnParams, box: Box) -> float:
     """The count ``dfn.resolve_count`` rounds, as a float that may be inf or
     NaN (p21 = 1e308), so that it is checked before it is converted."""
     if params.count is not None:
         return float(params.count)
-    x0, x1, y0, y1 = params.region or box
-    area = (x1 - x0) * (y1 - y0)
+    area = (params.region or box).area
     if params.p20 is not None:
         return params.p20 * area
     total = sum(s.weight for s in params.sets)
@@ -313,8 +313,7 @@ def realize(
     table: Table, params: dfn.DfnParams, grid: Grid, existing: np.ndarray
 ) -> dfn.Network | None:
     """The network of ``params`` in the domain; a problem if it does not fit."""
-    (x0, y0), (w, h) = grid.origin, grid.size
-    box = (x0, x0 + w, y0, y0 + h)
+    box = grid.box
     expected = _expected_count(params, box)
     if not expected <= MAX_NETWORK_FRACTURES + 0.5:  # NaN and inf too
         key = next(k for k in ("count", "p20", "p21") if table.has(k))

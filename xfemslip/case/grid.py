@@ -29,6 +29,7 @@ from xfemslip.case.tables import (
     frozen,
     show,
 )
+from xfemslip.geometry.box import Box
 
 # Memory guard: a Q4 element adds 64 stiffness triplets (8 B value + 2 x 8 B
 # indices = 1.5 kB) before CSR conversion and factorisation; 2 kB per element
@@ -57,6 +58,11 @@ class Grid(NamedTuple):
     size: tuple[float, float]
     mesh: MeshSpec | None
     grading: GradingSpec | None = None
+
+    @property
+    def box(self) -> Box:
+        """The domain [m]."""
+        return Box.from_origin_size(self.origin, self.size)
 
 
 def _int_text(n: int) -> str:

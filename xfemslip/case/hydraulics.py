@@ -114,8 +114,7 @@ def _read_block(table: Table, grid) -> tuple[float, float, float, float] | None:
     if block is None or grid is None:
         return None
     x0, y0, x1, y1 = block
-    lo, size = grid.origin, grid.size
-    hi = (lo[0] + size[0], lo[1] + size[1])
+    lo, hi, size = grid.box.lo, grid.box.hi, grid.size
     if not (x0 < x1 and y0 < y1):
         table.error(
             "block",
@@ -155,8 +154,7 @@ def read_permeability(root: Table, grid, fractures) -> PermeabilitySpec | None:
     if table.has("block"):
         block = _read_block(table, grid)
     elif grid is not None:
-        (x0, y0), (w, h) = grid.origin, grid.size
-        block = (x0, y0, x0 + w, y0 + h)
+        block = grid.box.corners
     else:
         block = None
     if len(root.problems) > start or fractures is None or block is None:

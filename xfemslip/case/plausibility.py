@@ -78,8 +78,7 @@ def plausibility_warnings(spec) -> list[str]:
                 "and is moved onto it (within 0.1 cell of a fracture, an edge is "
                 "taken to follow it)"
             )
-    x0, y0 = spec.origin
-    x1, y1 = x0 + spec.size[0], y0 + spec.size[1]
+    x0, x1, y0, y1 = spec.box
     tol = 1e-9 * max(spec.size)
     for fr in spec.fractures:
         p = fr.points

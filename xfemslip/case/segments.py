@@ -257,8 +257,7 @@ def _shape_problem(points: np.ndarray, grid: Grid | None) -> str | None:
         return f"self-intersecting polyline: segments {i} and {j} touch or cross"
     if grid is None:
         return None
-    lo = grid.origin
-    hi = (lo[0] + grid.size[0], lo[1] + grid.size[1])
+    lo, hi = grid.box.lo, grid.box.hi
     if not any(
         segment_meets_box(a, b, lo, hi)
         for a, b in zip(points[:-1], points[1:], strict=True)

@@ -9,6 +9,7 @@ from typing import ClassVar
 import numpy as np
 
 from xfemslip.contact.defaults import CONTACT_PATCH_CELLS
+from xfemslip.geometry.box import Box
 
 EDGES = ("bottom", "top", "left", "right")
 
@@ -383,3 +384,8 @@ class CaseSpec:
     units: tuple[UnitSpec, ...] = ()
     events: EventsSpec | None = None  # None: no [events] table
     permeability: PermeabilitySpec | None = None  # None: no [permeability] table
+
+    @property
+    def box(self) -> Box:
+        """The domain ([domain] origin and size) [m]."""
+        return Box.from_origin_size(self.origin, self.size)

@@ -12,6 +12,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from xfemslip.geometry.box import Box
+
 logger = logging.getLogger(__name__)
 
 
@@ -38,6 +40,11 @@ class Mesh:
     @property
     def n_cells(self) -> int:
         return self.cells.shape[0]
+
+    @property
+    def box(self) -> Box:
+        """The domain the mesh covers [m]."""
+        return Box.from_lines(self.x, self.y)
 
     @property
     def h_min(self) -> float:

@@ -38,6 +38,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from xfemslip.geometry.box import Box
 from xfemslip.geometry.regions import edges, fault_side, in_region
 
 __all__ = [
@@ -310,7 +311,7 @@ def _crossings(p, q, a, b, tol) -> list[float]:
     return [float(t)] if -1e-12 <= u <= 1.0 + 1e-12 else []
 
 
-def loading_breaks(zones: Zones, fractures, box, eps: float) -> list[np.ndarray]:
+def loading_breaks(zones: Zones, fractures, box: Box, eps: float) -> list[np.ndarray]:
     """Per fracture, the arc lengths [m] where the zone on one of its faces
     changes (a unit boundary meets it: a reservoir corner on a fault).
 

@@ -19,6 +19,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from xfemslip.errors import GeometryError
+from xfemslip.geometry.box import Box
 from xfemslip.geometry.polyline import first_meeting, simplify
 
 logger = logging.getLogger(__name__)
@@ -246,11 +247,12 @@ def clip_segment(p0, p1, boxes):
     return ta, tb
 
 
-def clip_to_domain(points, box, tol, key):
+def clip_to_domain(points, box: Box, tol, key):
     """Clip a polyline to the domain box; it must stay in one connected piece."""
+    boxes = np.asarray(box, float)[None, :]
     kept = []
     for p0, p1 in zip(points[:-1], points[1:], strict=True):
-        ta, tb = clip_segment(p0, p1, box[None, :])
+        ta, tb = clip_segment(p0, p1, boxes)
         if tb[0] - ta[0] <= 0.0:
             kept.append(None)
             continue
@@ -320,7 +322,7 @@ def at_mesh_resolution(mesh, pts, key):
     return out
 
 
-def on_boundary(p, box, tol):
+def on_boundary(p, box: Box, tol):
     return (
         min(
             abs(p[0] - box[0]),
@@ -380,9 +382,9 @@ def _check_pieces_per_cell(mesh, piece_cell, key) -> None:
 
 
 def build_fracture(
-    mesh, spec, box, points=None, s_offset=0.0, junction_ends=(), reach=None
+    mesh, spec, box: Box, points=None, s_offset=0.0, junction_ends=(), reach=None
 ) -> Fracture:
-    """Fracture from a FractureSpec on a mesh; box = [x0, x1, y0, y1] of the domain.
+    """Fracture from a FractureSpec on a mesh; box: the domain.
 
     points / s_offset : the polyline already clipped (and snapped to its
     junctions, build_fractures); junction_ends : ends lying on another fracture

@@ -18,6 +18,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from xfemslip.errors import GeometryError
+from xfemslip.geometry.box import Box
 from xfemslip.geometry.fracture import (
     GEOMETRY_TOL,
     Fracture,
@@ -550,9 +551,9 @@ def _split_pieces(fr, s_values, tol):
     )
 
 
-def build_fractures(mesh, specs, box) -> tuple[Fracture, ...]:
-    """All fractures of a case, with their junctions (X, T/Y, V)."""
-    box = np.asarray(box, float)
+def build_fractures(mesh, specs, box: Box) -> tuple[Fracture, ...]:
+    """All fractures of a case, with their junctions (X, T/Y, V), in the
+    domain ``box``."""
     tol = GEOMETRY_TOL * mesh.h_min
     names = [f"fractures[{s.index}]" for s in specs]
     clipped, offsets, free = [], [], []

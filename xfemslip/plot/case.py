@@ -46,13 +46,13 @@ MAX_MESH_LINES = 160  # per direction; more are thinned (every k-th drawn)
 
 def _edge_points(spec, name: str, n: int) -> np.ndarray:
     """n points spread along an edge (not at the corners)."""
-    (x0, y0), (w, h) = spec.origin, spec.size
+    box, (w, h) = spec.box, spec.size
     t = (np.arange(n) + 0.5) / n
     if name in ("bottom", "top"):
-        y = y0 if name == "bottom" else y0 + h
-        return np.column_stack([x0 + t * w, np.full(n, y)])
-    x = x0 if name == "left" else x0 + w
-    return np.column_stack([np.full(n, x), y0 + t * h])
+        y = box.y0 if name == "bottom" else box.y1
+        return np.column_stack([box.x0 + t * w, np.full(n, y)])
+    x = box.x0 if name == "left" else box.x1
+    return np.column_stack([np.full(n, x), box.y0 + t * h])
 
 
 def _colours(n: int) -> list:
@@ -86,9 +86,9 @@ def _regions(ax, spec) -> list[str]:
     pore = spec.pore_pressure
     if spec.units:
         zones = build_zones(spec)
-        (x0, y0), (w, h) = spec.origin, spec.size
-        gx = np.linspace(x0, x0 + w, ZONE_RASTER)
-        gy = np.linspace(y0, y0 + h, ZONE_RASTER)
+        box = spec.box
+        gx = np.linspace(box.x0, box.x1, ZONE_RASTER)
+        gy = np.linspace(box.y0, box.y1, ZONE_RASTER)
         X, Y = np.meshgrid(gx, gy)
         Z = zones.at(np.column_stack([X.ravel(), Y.ravel()])).reshape(X.shape)
         colours = matplotlib.colormaps["Pastel1"](np.arange(zones.n) % 9)
@@ -96,12 +96,11 @@ def _regions(ax, spec) -> list[str]:
         ax.imshow(
             colours[Z],
             origin="lower",
-            extent=(x0, x0 + w, y0, y0 + h),
+            extent=box,
             interpolation="nearest",
             aspect="auto",
             zorder=0,
         )
-        box = (x0, x0 + w, y0, y0 + h)
         for k in range(1, zones.n):
             label = (
                 f"{zones.names[k]}: E = {zones.E[k] / 1e9:g} GPa, "

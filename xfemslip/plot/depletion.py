@@ -10,7 +10,6 @@ from pathlib import Path
 import numpy as np
 
 from xfemslip.conventions import SLIP
-from xfemslip.fem.poro import domain_box
 from xfemslip.geometry.regions import edges
 
 
@@ -88,7 +87,7 @@ def plot_field(model, result, out_dir: Path, dpi: float = 110.0) -> Path:
         )
         fig.colorbar(im, ax=ax, shrink=0.85)
         for unit in model.spec.units:
-            for _, p, q in edges(unit.region, domain_box(mesh)):
+            for _, p, q in edges(unit.region, mesh.box):
                 ax.plot([p[0], q[0]], [p[1], q[1]], "k--", lw=0.8)
         for fr in f.fractures:
             slip = fr.state == SLIP

@@ -28,7 +28,8 @@ PANEL = 4.2  # inches
 
 def _domain_frame(ax, spec) -> None:
     (x0, y0), (w, h) = spec.origin, spec.size
-    ax.plot([x0, x0 + w, x0 + w, x0, x0], [y0, y0, y0 + h, y0 + h, y0], "k-", lw=0.8)
+    frame = np.vstack([spec.box.vertices(), spec.box.vertices()[:1]])
+    ax.plot(*frame.T, "k-", lw=0.8)
     ax.set_aspect("equal")
     ax.set_xlim(x0 - 0.02 * w, x0 + 1.02 * w)
     ax.set_ylim(y0 - 0.02 * h, y0 + 1.02 * h)

@@ -35,6 +35,7 @@ import numpy as np
 from xfemslip.conventions import OPEN
 from xfemslip.fem.poro import FACE_OFFSET
 from xfemslip.fem.zones import build_zones, in_situ_stress, initial_pressure
+from xfemslip.geometry.box import Box
 from xfemslip.post.metrics import arc_extent, fracture_ends, point_stretches
 from xfemslip.post.permeability import ApertureLaw, oda_tensor, transmissivity
 from xfemslip.post.result import PermeabilityHistory, Result
@@ -117,11 +118,6 @@ def block_stretches(s, domain_ends, block_ends) -> np.ndarray:
     return np.maximum(inside, 0.0)
 
 
-def _box(x0, y0, x1, y1) -> tuple[float, float, float, float]:
-    """(x0, x1, y0, y1), the order of ``arc_extent``."""
-    return (x0, x1, y0, y1)
-
-
 def add_permeability(result: Result, spec) -> None:
     """Fill, for a case with ``[permeability]``, the ``aperture`` and
     ``transmissivity`` of every fracture of every step of ``result`` and
@@ -129,8 +125,8 @@ def add_permeability(result: Result, spec) -> None:
     p = spec.permeability
     if p is None or not result.steps:
         return
-    block = _box(*p.block)
-    area = (p.block[2] - p.block[0]) * (p.block[3] - p.block[1])
+    block = Box.from_corners(*p.block)
+    area = block.area
     laws = [aperture_law(law) for law in p.laws]
     geometry = []  # per fracture: tangents, sigma_n0', block stretches
     ends = fracture_ends(result, spec)
@@ -211,7 +207,7 @@ def permeability_lines(result: Result, index: int = -1) -> list[str]:
             f"{i:>8}  {a0 * 1e3:>8.4g}  {mean_a * 1e3:>11.4g}  "
             f"{float(np.max(ff.aperture)) * 1e3:>10.4g}  {ratio:>8.4g}"
         )
-    x0, y0, x1, y1 = history.block
+    x0, x1, y0, y1 = Box.from_corners(*history.block)
     k0, k = history.in_situ, history.tensors[index]
     lines.append(
         f"block [{x0:g}, {x1:g}] x [{y0:g}, {y1:g}] m, permeability [m^2] in situ "

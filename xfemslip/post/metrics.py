@@ -13,6 +13,7 @@ import math
 import numpy as np
 
 from xfemslip.conventions import SLIP
+from xfemslip.geometry.box import Box
 from xfemslip.geometry.fracture import clip_segment
 from xfemslip.post.result import Result
 
@@ -40,8 +41,8 @@ METRICS = (
 )
 
 
-def arc_extent(points: np.ndarray, box: tuple) -> tuple[float, float]:
-    """Arc-length range [s_lo, s_hi] of a polyline inside box (x0, x1, y0, y1)."""
+def arc_extent(points: np.ndarray, box: Box) -> tuple[float, float]:
+    """Arc-length range [s_lo, s_hi] of a polyline inside the box."""
     points = np.asarray(points, dtype=float)
     seg = np.linalg.norm(np.diff(points, axis=0), axis=1)
     start = np.concatenate([[0.0], np.cumsum(seg)[:-1]])
@@ -77,13 +78,7 @@ def fracture_ends(result: Result, spec) -> list[tuple[float, float]]:
     case ``spec`` (a result written before the ends were kept)."""
     if result.fracture_properties is not None:
         return [p.ends for p in result.fracture_properties]
-    box = (
-        spec.origin[0],
-        spec.origin[0] + spec.size[0],
-        spec.origin[1],
-        spec.origin[1] + spec.size[1],
-    )
-    return [arc_extent(fracture.points, box) for fracture in spec.fractures]
+    return [arc_extent(fracture.points, spec.box) for fracture in spec.fractures]
 
 
 def result_metrics(result: Result, spec) -> dict:
