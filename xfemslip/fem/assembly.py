@@ -379,7 +379,7 @@ def assemble_bulk(
     )
 
 
-def _triplets(dofs, blocks, backend):
+def _triplets(dofs, blocks, backend) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Rows, columns and values of the entries of per-item blocks (m, k, k)
     whose dofs (m, k) are both >= 0 (kernels.block_triplets)."""
     return kernels.backend(backend).block_triplets(

@@ -262,8 +262,8 @@ def build_enriched_cells(mesh, fractures, cand: Candidates) -> EnrichedCells:
     slot_fnode[used] = cand_fnode[k_used]
 
     # pass 1: sub-cells and quadrature of each cell
-    parts = {key: [] for key in ("xy", "w", "tris")}
-    per_tri = []  # quadrature points of each sub-triangle
+    parts: dict[str, list[np.ndarray]] = {key: [] for key in ("xy", "w", "tris")}
+    per_cell: list[np.ndarray] = []  # quadrature points of each sub-triangle
     frac_of, func_of = cand.fracture.tolist(), cand.func.tolist()
     for e, c in enumerate(cand_cells):
         ks = slot_cand[e, : n_slots[e]].tolist()
@@ -273,7 +273,7 @@ def build_enriched_cells(mesh, fractures, cand: Candidates) -> EnrichedCells:
         parts["xy"].append(xy)
         parts["w"].append(w)
         parts["tris"].append(tris)
-        per_tri.append(np.full(tris.shape[0], xy.shape[0] // tris.shape[0]))
+        per_cell.append(np.full(tris.shape[0], xy.shape[0] // tris.shape[0]))
 
     def cat(key, shape):
         p = parts[key]
@@ -284,7 +284,7 @@ def build_enriched_cells(mesh, fractures, cand: Candidates) -> EnrichedCells:
     tri_off = np.zeros(nc + 1, np.int64)
     qp_off[1:] = np.cumsum([x.shape[0] for x in parts["xy"]])
     tri_off[1:] = np.cumsum([t.shape[0] for t in parts["tris"]])
-    per_tri = np.concatenate(per_tri) if per_tri else np.zeros(0, np.int64)
+    per_tri = np.concatenate(per_cell) if per_cell else np.zeros(0, np.int64)
     centroids = tris.mean(axis=1)
 
     # pass 2: each enrichment group on every cell it reaches

@@ -130,8 +130,8 @@ class Materials:
     cell: np.ndarray  # (n_cells,) int64 zone of each cell (by centre;
     # enriched cells: the zone covering most of their area)
     model: str
+    zones: Zones
     qp: np.ndarray | None = None  # (nq,) int64 zone of each enriched-cell QP
-    zones: Zones | None = None
 
     @property
     def several(self) -> bool:
@@ -206,7 +206,7 @@ def cell_centres(mesh) -> np.ndarray:
     return np.column_stack([0.5 * (b[:, 0] + b[:, 1]), 0.5 * (b[:, 2] + b[:, 3])])
 
 
-def _on_fracture(fractures, p, q, tol) -> bool:
+def _on_fracture(fractures, p: np.ndarray, q: np.ndarray, tol: float) -> bool:
     """Whether one fracture segment covers the segment p-q (within tol [m])."""
     for fr in fractures:
         for a, b in zip(fr.points[:-1], fr.points[1:], strict=True):
@@ -234,7 +234,9 @@ def _on_mesh_line(mesh, p, q) -> bool:
     return False
 
 
-def _clip_to_domain(mesh, p, q):
+def _clip_to_domain(
+    mesh, p: np.ndarray, q: np.ndarray
+) -> tuple[np.ndarray, np.ndarray] | None:
     """The part of p-q inside the domain's bounding box, or None."""
     lo, hi = mesh.box.lo, mesh.box.hi
     t0, t1 = 0.0, 1.0

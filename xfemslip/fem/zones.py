@@ -129,7 +129,7 @@ def build_zones(spec) -> Zones:
             0.0,
         )
     ]
-    unit_zones = []
+    unit_zones: list[tuple[int, ...]] = []
     for unit in spec.units:
         base = (
             unit.E,
@@ -323,7 +323,7 @@ def loading_breaks(zones: Zones, fractures, box: Box, eps: float) -> list[np.nda
     out = []
     segments = [e for unit in zones.units for e in edges(unit.region, box)]
     for fr in fractures:
-        found = []
+        found: list[float] = []
         for k, (a, b) in enumerate(zip(fr.points[:-1], fr.points[1:], strict=True)):
             L = float(np.hypot(*(b - a)))
             for _, p, q in segments:

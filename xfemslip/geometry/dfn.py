@@ -87,6 +87,13 @@ class LengthLaw:
         "sigma": "-",
     }
 
+    @property
+    def bounds(self) -> tuple[float, float]:
+        """(lmin, lmax) [m] of a power law (both required)."""
+        if self.lmin is None or self.lmax is None:
+            raise ValueError(f"a {self.kind!r} length law without lmin and lmax")
+        return self.lmin, self.lmax
+
 
 @dataclass(frozen=True, kw_only=True)
 class FractureSet:
@@ -174,7 +181,7 @@ def sample_lengths(rng: np.random.Generator, law: LengthLaw, n: int) -> np.ndarr
     if law.kind == "constant":
         return np.full(n, law.value)
     if law.kind == "power_law":
-        return power_law_ppf(rng.random(n), law.exponent, law.lmin, law.lmax)
+        return power_law_ppf(rng.random(n), law.exponent, *law.bounds)
     if law.kind == "lognormal":
         lo = law.lmin if law.lmin is not None else 0.0
         hi = law.lmax if law.lmax is not None else math.inf
@@ -195,7 +202,7 @@ def mean_length(law: LengthLaw) -> float:
     if law.kind == "constant":
         return law.value
     if law.kind == "power_law":
-        a, lo, hi = law.exponent, law.lmin, law.lmax
+        a, (lo, hi) = law.exponent, law.bounds
         if abs(a - 1.0) < 1e-12:
             return (hi - lo) / math.log(hi / lo)
         if abs(a - 2.0) < 1e-12:
@@ -233,6 +240,7 @@ def resolve_count(params: DfnParams, box: Box) -> int:
     area = Box(*(params.region or box)).area
     if params.p20 is not None:
         return int(round(params.p20 * area))
+    assert params.p21 is not None  # exactly one of count, p20, p21
     weights = np.array([s.weight for s in params.sets])
     mean = float(
         np.dot(weights / weights.sum(), [mean_length(s.length) for s in params.sets])
@@ -325,7 +333,9 @@ def _draw_block(rng, params: DfnParams, region: Box, n: int) -> tuple:
     return which, centers, angles, lengths
 
 
-def _fit(p0, p1, params: DfnParams, box: Box):
+def _fit(
+    p0: np.ndarray, p1: np.ndarray, params: DfnParams, box: Box
+) -> tuple[np.ndarray, np.ndarray] | None:
     """End points kept in the domain, or None if the candidate is redrawn."""
     ta, tb = clip_to_box(p0, p1, box)
     if params.outside == "reject":

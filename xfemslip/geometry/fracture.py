@@ -250,7 +250,8 @@ def clip_segment(p0, p1, boxes):
 def clip_to_domain(points, box: Box, tol, key):
     """Clip a polyline to the domain box; it must stay in one connected piece."""
     boxes = np.asarray(box, float)[None, :]
-    kept = []
+    # per segment: (start, end, t_start, t_end) of its part inside, or None
+    kept: list[tuple[np.ndarray, np.ndarray, float, float] | None] = []
     for p0, p1 in zip(points[:-1], points[1:], strict=True):
         ta, tb = clip_segment(p0, p1, boxes)
         if tb[0] - ta[0] <= 0.0:
@@ -258,20 +259,20 @@ def clip_to_domain(points, box: Box, tol, key):
             continue
         kept.append((p0 + ta[0] * (p1 - p0), p0 + tb[0] * (p1 - p0), ta[0], tb[0]))
     idx = [k for k, piece in enumerate(kept) if piece is not None]
+    inside = [piece for piece in kept if piece is not None]  # those of idx
     if not idx:
         raise GeometryError(f"{key}: the fracture misses the domain")
     if idx != list(range(idx[0], idx[-1] + 1)) or any(
-        (kept[k][3] < 1.0 and k != idx[-1]) or (kept[k][2] > 0.0 and k != idx[0])
-        for k in idx
+        (piece[3] < 1.0 and k != idx[-1]) or (piece[2] > 0.0 and k != idx[0])
+        for k, piece in zip(idx, inside, strict=True)
     ):
         raise GeometryError(
             f"{key}: the fracture leaves and re-enters the domain; "
             "split it into separate fractures"
         )
-    pts = [kept[idx[0]][0]] + [kept[k][1] for k in idx]
-    pts = np.array(pts)
+    pts = np.array([inside[0][0]] + [piece[1] for piece in inside])
     seg_len = np.linalg.norm(np.diff(points, axis=0), axis=1)
-    s_offset = float(seg_len[: idx[0]].sum() + kept[idx[0]][2] * seg_len[idx[0]])
+    s_offset = float(seg_len[: idx[0]].sum() + inside[0][2] * seg_len[idx[0]])
     # drop segments that became (nearly) zero length by clipping
     keep = np.concatenate([[True], np.linalg.norm(np.diff(pts, axis=0), axis=1) > tol])
     if keep.sum() < 2:
