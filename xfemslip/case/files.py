@@ -151,7 +151,8 @@ def _regular_size(fd: int) -> int:
 
 def _read_capped(fd: int, limit: int) -> bytes:
     """Read to the end in chunks; refuse once more than ``limit`` bytes came."""
-    chunks, total = [], 0
+    chunks: list[bytes] = []
+    total = 0
     while True:
         try:
             chunk = os.read(fd, READ_CHUNK)

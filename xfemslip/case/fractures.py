@@ -21,6 +21,7 @@ from xfemslip.case.tables import (
     Table,
     check_number,
     check_vector,
+    complete,
     exact,
     fmt,
     frozen,
@@ -280,7 +281,7 @@ def read_fractures(root: Table, grid: Grid | None) -> tuple[FractureSpec, ...] |
             f"{show(value)} (write [[fractures]], not [fractures])",
         )
         return None
-    specs = []
+    specs: list[FractureSpec | None] = []
     for i, item in enumerate(value):
         if not isinstance(item, dict):
             root.error(f"fractures[{i}]", f"expected a table, got {show(item)}")
@@ -288,7 +289,8 @@ def read_fractures(root: Table, grid: Grid | None) -> tuple[FractureSpec, ...] |
             continue
         table = Table(item, f"fractures[{i}]", root.problems, FRACTURE_KEYS)
         specs.append(_read_fracture(table, i, grid))
-    return None if any(s is None for s in specs) else tuple(specs)
+    read = complete(specs)
+    return None if read is None else tuple(read)
 
 
 # --------------------------------------------------------------------------- #

@@ -5,6 +5,7 @@ and its realization in the domain (read by :mod:`xfemslip.case.network`).
 from __future__ import annotations
 
 import math
+from typing import Literal
 
 import numpy as np
 
@@ -16,6 +17,7 @@ from xfemslip.case.tables import (
     POSITIVE,
     Range,
     Table,
+    complete,
     fmt,
     show,
 )
@@ -134,9 +136,7 @@ def _drawable(table: Table, law: dfn.LengthLaw) -> dfn.LengthLaw | None:
         with np.errstate(all="ignore"):  # an overflow is the answer, not a warning
             mean = dfn.mean_length(law)
             ends = (
-                dfn.power_law_ppf(
-                    np.array([0.0, 1.0]), law.exponent, law.lmin, law.lmax
-                )
+                dfn.power_law_ppf(np.array([0.0, 1.0]), law.exponent, *law.bounds)
                 if law.kind == "power_law"
                 else np.array([mean, mean])
             )
@@ -195,7 +195,7 @@ def _read_sets(table: Table) -> tuple[dfn.FractureSet, ...] | None:
                 "sets", f"expected a non-empty array of tables, got {show(value)}"
             )
             return None
-        out = []
+        out: list[dfn.FractureSet | None] = []
         for i, item in enumerate(value):
             if not isinstance(item, dict):
                 table.error(f"sets[{i}]", f"expected a table, got {show(item)}")
@@ -204,20 +204,21 @@ def _read_sets(table: Table) -> tuple[dfn.FractureSet, ...] | None:
             sub = Table(item, table.key(f"sets[{i}]"), table.problems, SET_KEYS)
             weight = sub.number("weight", rule=POSITIVE)
             orientation, length = _read_orientation(sub), _read_length(sub)
-            ok = None not in (weight, orientation, length)
+            if weight is None or orientation is None or length is None:
+                out.append(None)
+                continue
             out.append(
                 dfn.FractureSet(weight=weight, orientation=orientation, length=length)
-                if ok
-                else None
             )
-        return None if any(s is None for s in out) else tuple(out)
+        sets = complete(out)
+        return None if sets is None else tuple(sets)
     orientation, length = _read_orientation(table), _read_length(table)
     if orientation is None or length is None:
         return None
     return (dfn.FractureSet(weight=1.0, orientation=orientation, length=length),)
 
 
-def _read_region(table: Table) -> Box | None | bool:
+def _read_region(table: Table) -> Box | Literal[False] | None:
     """``region = [[x0, y0], [x1, y1]]`` (lower-left, upper-right) -> a Box;
     None when not given, False when invalid."""
     if not table.has("region"):
@@ -282,7 +283,7 @@ def read_generate(table: Table) -> dfn.DfnParams | None:
         table.error("min_spacing", 'only used with intersections = "avoid"')
     outside = table.choice("outside", dfn.OUTSIDE, "clip")
     min_length = table.number("min_length", 0.0, NON_NEGATIVE)
-    if len(table.problems) > start or region is False:
+    if len(table.problems) > start or region is False or count is None or sets is None:
         return None
     return dfn.DfnParams(
         seed=seed,
@@ -306,6 +307,7 @@ def _expected_count(params: dfn.DfnParams, box: Box) -> float:
         return params.p20 * area
     total = sum(s.weight for s in params.sets)
     mean = sum(s.weight / total * dfn.mean_length(s.length) for s in params.sets)
+    assert params.p21 is not None  # exactly one of count, p20, p21
     return params.p21 * area / mean
 
 

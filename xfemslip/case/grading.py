@@ -164,6 +164,7 @@ def box_refinement(boxes) -> Refinement:
 def case_refinement(grid: Grid, fractures, reservoir) -> Refinement:
     """The features of a case: its fractures (FractureSpec), its
     ``[reservoir]`` (ReservoirSpec or None) and the ``mesh.refine`` boxes."""
+    assert grid.grading is not None  # a graded mesh waiting for its features
     parts = [
         fracture_refinement([f.points for f in fractures], grid.origin, grid.size),
         box_refinement(grid.grading.refine),
@@ -185,6 +186,7 @@ def graded_grid(
     coordinates that do not resolve).  The element count is checked before
     a node is placed."""
     g = grid.grading
+    assert g is not None  # a graded mesh waiting for its features
     if refinement.empty:
         problems.append(
             (

@@ -18,7 +18,8 @@ from __future__ import annotations
 import math
 
 from xfemslip.case.specs import HydraulicSpec, PermeabilitySpec
-from xfemslip.case.tables import NON_NEGATIVE, POSITIVE, Range, Table, fmt
+from xfemslip.case.tables import NON_NEGATIVE, POSITIVE, Range, Table, complete, fmt
+from xfemslip.geometry.box import Box
 
 __all__ = ["HYDRAULIC_KEYS", "PERMEABILITY_KEYS", "read_hydraulic", "read_permeability"]
 
@@ -159,12 +160,12 @@ def read_permeability(root: Table, grid, fractures) -> PermeabilitySpec | None:
         block = None
     if len(root.problems) > start or fractures is None or block is None:
         return None
-    laws = [_resolve(defaults, f, root) for f in fractures]
-    if any(law is None for law in laws):
+    laws = complete([_resolve(defaults, f, root) for f in fractures])
+    if laws is None:
         return None
     return PermeabilitySpec(
         laws=tuple(laws),
         matrix=matrix,
-        block=tuple(float(v) for v in block),
+        block=Box.from_corners(*block).corners,
         block_given=table.has("block"),
     )

@@ -22,6 +22,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from xfemslip.case.specs import CaseSpec
 from xfemslip.contact.defaults import PENALTY_RATIO_LOWEST, PENALTY_RATIO_MEASURED
 
 __all__ = ["E_RANGE", "plausibility_warnings"]
@@ -32,7 +33,7 @@ __all__ = ["E_RANGE", "plausibility_warnings"]
 E_RANGE = (1.0e6, 1.0e12)
 
 
-def plausibility_warnings(spec) -> list[str]:
+def plausibility_warnings(spec: CaseSpec) -> list[str]:
     """The warnings of a validated ``CaseSpec``, one line each."""
     out: list[str] = []
     moduli = [("material.E", spec.material.E)]

@@ -7,6 +7,7 @@ from __future__ import annotations
 import math
 from collections import Counter
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
@@ -107,12 +108,13 @@ def _csv_rows(lines: list[str], columns: list[str], file: Path):
                 f"({','.join(columns)}), got {len(fields)}: {quote(line)}"
             )
             continue
-        row, problems = {}, []
+        row: dict[str, Any] = {}
+        problems: list[str] = []
         for name, text in zip(columns, fields, strict=True):
             row[name], problem = _csv_cell(name, text)
             if problem:
                 problems.append(problem)
-        p0, p1 = (row.get("x0"), row.get("y0")), (row.get("x1"), row.get("y1"))
+        p0, p1 = (row["x0"], row["y0"]), (row["x1"], row["y1"])
         if not problems and p0 == p1:
             problems.append(
                 f"zero-length segment: (x0, y0) = (x1, y1) = "
@@ -145,7 +147,7 @@ def _fracture_count(lines: list[str], columns: list[str]) -> int:
     return len(ids) + single
 
 
-def _group_rows(rows: list) -> list[tuple[str, list]]:
+def _group_rows(rows: list) -> list[tuple[str | None, list]]:
     """Rows grouped by the ``fracture`` column in order of first appearance; a
     row without a fracture id is a fracture of its own."""
     groups: dict[object, list] = {}

@@ -322,6 +322,28 @@ class RegionSpec:
         "throw": "m",
     }
 
+    @property
+    def horizons(self) -> tuple[float, float]:
+        """(base, top) [m] of a layer, or of a displaced layer on the side that
+        is not lowered."""
+        if self.base is None or self.top is None:
+            raise ValueError(f"a {self.kind!r} region has no horizons")
+        return self.base, self.top
+
+    @property
+    def vertices(self) -> np.ndarray:
+        """(k, 2) vertices [m] of a polygon region."""
+        if self.polygon is None:
+            raise ValueError(f"a {self.kind!r} region has no polygon")
+        return self.polygon
+
+    @property
+    def box_array(self) -> np.ndarray:
+        """(k, 4) boxes [x0, y0, x1, y1] [m] of a boxes region."""
+        if self.boxes is None:
+            raise ValueError(f"a {self.kind!r} region has no boxes")
+        return self.boxes
+
 
 @dataclass(frozen=True, kw_only=True)
 class UnitSpec:
