@@ -70,6 +70,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from xfemslip.case.specs import CaseSpec
 from xfemslip.errors import MeshError, UsageError
 
 logger = logging.getLogger(__name__)
@@ -162,7 +163,7 @@ def estimate_terms(fp: Footprint) -> dict[str, float]:
     }
 
 
-def estimate_dofs(spec) -> int:
+def estimate_dofs(spec: CaseSpec) -> int:
     """Upper estimate of the number of dofs of a validated case."""
     nx, ny = spec.mesh.x.size - 1, spec.mesh.y.size - 1
     h = float(min(np.diff(spec.mesh.x).min(), np.diff(spec.mesh.y).min()))
@@ -174,7 +175,7 @@ def estimate_dofs(spec) -> int:
     return int(2 * (nx + 1) * (ny + 1) + enriched)
 
 
-def case_footprint(spec) -> Footprint:
+def case_footprint(spec: CaseSpec) -> Footprint:
     """From the case alone (before the mesh): the standard part exactly, the
     enrichment from the fracture lengths (no slots, no quadrature: a lower
     estimate for crowded fractures, which enriched_footprint refines)."""
@@ -208,13 +209,13 @@ def case_footprint(spec) -> Footprint:
     )
 
 
-def _patches(spec, length, h, points) -> float:
+def _patches(spec: CaseSpec, length: float, h: float, points: float) -> float:
     """Contact patches: one per contact_patch cells of fracture, or per point."""
     cells = spec.solver.contact_patch
     return points if cells <= 0 else min(points, length / (cells * h) + 2.0)
 
 
-def enriched_footprint(spec, mesh, fractures, cand) -> Footprint:
+def enriched_footprint(spec: CaseSpec, mesh, fractures, cand) -> Footprint:
     """From the built fractures and their node enrichments (enrichment.
     Candidates), before the enriched cells are cut: the enriched cells and
     their slots exactly (the cells around each enriched node, as
@@ -352,7 +353,7 @@ def configure_allocator() -> bool:
     if "glibc.malloc." in os.environ.get("GLIBC_TUNABLES", ""):
         return False
     try:
-        if not os.confstr("CS_GNU_LIBC_VERSION").startswith("glibc"):
+        if not (os.confstr("CS_GNU_LIBC_VERSION") or "").startswith("glibc"):
             return False
         mallopt = ctypes.CDLL(None).mallopt
     except (ValueError, OSError, AttributeError):  # not glibc
@@ -367,7 +368,7 @@ def configure_allocator() -> bool:
     return True
 
 
-def _linear(spec, x, y, n_dofs, band_share=None) -> str:
+def _linear(spec: CaseSpec, x, y, n_dofs, band_share=None) -> str:
     """The linear solver the run will take (linsolve.planned_solver) on a
     mesh with grid lines x, y and about n_dofs free dofs; ``band_share()``
     gives the share of them in the AMG band (None: not known yet)."""
@@ -427,7 +428,7 @@ def _gb(value: float) -> str:
     return f"{value / 1e9:.3g} GB"
 
 
-def check_memory(spec, footprint: Footprint | None = None) -> None:
+def check_memory(spec: CaseSpec, footprint: Footprint | None = None) -> None:
     """Refuse a case whose memory estimate exceeds the limit (MeshError, one
     line naming the estimate, its largest terms and the limit).
 

@@ -19,6 +19,7 @@ from matplotlib.colors import Normalize
 from matplotlib.figure import Figure
 from matplotlib.ticker import MaxNLocator
 
+from xfemslip.case.specs import CaseSpec
 from xfemslip.conventions import SLIP
 from xfemslip.errors import OutputError, UsageError
 from xfemslip.io.read import read_result
@@ -26,7 +27,7 @@ from xfemslip.io.read import read_result
 PANEL = 4.2  # inches
 
 
-def _domain_frame(ax, spec) -> None:
+def _domain_frame(ax, spec: CaseSpec) -> None:
     (x0, y0), (w, h) = spec.origin, spec.size
     frame = np.vstack([spec.box.vertices(), spec.box.vertices()[:1]])
     ax.plot(*frame.T, "k-", lw=0.8)
@@ -61,14 +62,16 @@ def _draw_slip(fig, ax, fields) -> None:
         pieces = np.stack([points[:-1], points[1:]], axis=1)
         value = 0.5 * (np.abs(slip[:-1]) + np.abs(slip[1:]))
         width = 2.6 if np.any(state == SLIP) else 1.0
-        collection = LineCollection(pieces, cmap="viridis", norm=norm, linewidths=width)
+        collection = LineCollection(
+            list(pieces), cmap="viridis", norm=norm, linewidths=width
+        )
         collection.set_array(value)
         ax.add_collection(collection)
     if collection is not None:
         fig.colorbar(collection, ax=ax, label="|slip| (m)", shrink=0.8)
 
 
-def _draw_plain(ax, spec) -> None:
+def _draw_plain(ax, spec: CaseSpec) -> None:
     """Fractures coloured by where they come from (inline, file, generated)."""
     colours = {"": "tab:red", "network.file": "tab:blue", "network.generate": "k"}
     for fracture in spec.fractures:
@@ -126,7 +129,9 @@ def _draw_counts(ax, counts: np.ndarray, totals: np.ndarray) -> None:
         )
 
 
-def figure_network(spec, result: Path | None = None, summary: Path | None = None):
+def figure_network(
+    spec: CaseSpec, result: Path | None = None, summary: Path | None = None
+):
     """The network of ``spec`` (slip from ``result``), plus the slipping-count
     histogram of a sweep ``summary`` when given."""
     n = 2 if summary is not None else 1

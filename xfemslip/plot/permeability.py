@@ -61,7 +61,7 @@ def figure_permeability(path: str | Path, label: str | None = None) -> Figure:
     history = result.permeability
     fig = Figure(figsize=(12.0, 3.8), layout="constrained")
     ax_a, ax_t, ax_k = fig.subplots(1, 3)
-    for i, ff in enumerate(result.final.fractures):
+    for i, ff in enumerate(result.fractures):
         if ff.aperture is None or not np.size(ff.s):
             continue
         s = ff.s - ff.s.min()

@@ -390,6 +390,7 @@ def step_fields(model, r) -> StepFields:
     extra = {}
     fluid = None
     if pore is not None:
+        assert biot_p is not None  # set with the pore pressure above
         extra = {
             "effective_stress": stress + biot_p[1][:, None] * [1.0, 1.0, 0.0],
             "pore_pressure": p,

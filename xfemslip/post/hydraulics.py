@@ -32,6 +32,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from xfemslip.case.specs import CaseSpec
 from xfemslip.conventions import OPEN
 from xfemslip.fem.poro import FACE_OFFSET
 from xfemslip.fem.zones import build_zones, in_situ_stress, initial_pressure
@@ -73,7 +74,7 @@ def polyline_tangents(points, s) -> np.ndarray:
     return d[k] / length[k, None]
 
 
-def in_situ_normal(spec, tangents, points=None) -> np.ndarray:
+def in_situ_normal(spec: CaseSpec, tangents, points=None) -> np.ndarray:
     """sigma_n0' = n . sigma0 . n + p0 [Pa] at points of the given unit
     tangents (K, 2): the effective normal traction of the in-situ state;
     ``points`` (K, 2) [m] where it varies with depth (the mean of the two
@@ -92,7 +93,9 @@ def in_situ_normal(spec, tangents, points=None) -> np.ndarray:
             face = xy + 2.0 * sign * eps * n
             zone = zones.at(face)
             p = initial_pressure(spec, zones, xy, zone)
-            S += 0.5 * in_situ_stress(spec, zones, face, zone, p)
+            face_stress = in_situ_stress(spec, zones, face, zone, p)
+            assert face_stress is not None  # the case has an in-situ stress
+            S += 0.5 * face_stress
             p0 += 0.5 * p
         sn = S[:, 0] * n[:, 0] ** 2 + S[:, 1] * n[:, 1] ** 2
         return sn + 2.0 * S[:, 2] * n[:, 0] * n[:, 1] + p0
@@ -118,7 +121,7 @@ def block_stretches(s, domain_ends, block_ends) -> np.ndarray:
     return np.maximum(inside, 0.0)
 
 
-def add_permeability(result: Result, spec) -> None:
+def add_permeability(result: Result, spec: CaseSpec) -> None:
     """Fill, for a case with ``[permeability]``, the ``aperture`` and
     ``transmissivity`` of every fracture of every step of ``result`` and
     ``result.permeability`` (module doc); nothing without the table."""
@@ -160,7 +163,7 @@ def add_permeability(result: Result, spec) -> None:
             parts.append((wk, t, ff.aperture))
         tensors.append(oda_tensor(parts, area, p.matrix))
     result.permeability = PermeabilityHistory(
-        block=tuple(p.block),
+        block=p.block,
         matrix=float(p.matrix),
         in_situ=in_situ,
         tensors=np.array(tensors).reshape(-1, 2, 2),
@@ -202,6 +205,7 @@ def permeability_lines(result: Result, index: int = -1) -> list[str]:
         s = np.asarray(ff.s, float)
         w = point_stretches(s, s[0], s[-1]) if s.size > 1 else np.ones(1)
         mean_a = float(np.sum(w * ff.aperture) / np.sum(w))
+        assert ff.transmissivity is not None  # filled with the aperture
         ratio = float(np.sum(w * ff.transmissivity) / np.sum(w)) / (a0**3 / 12.0)
         lines.append(
             f"{i:>8}  {a0 * 1e3:>8.4g}  {mean_a * 1e3:>11.4g}  "

@@ -12,6 +12,7 @@ import math
 
 import numpy as np
 
+from xfemslip.case.specs import CaseSpec
 from xfemslip.conventions import SLIP
 from xfemslip.geometry.box import Box
 from xfemslip.geometry.fracture import clip_segment
@@ -72,7 +73,7 @@ def slipping_length(s, state, s_lo: float, s_hi: float) -> float:
     return float(np.sum(stretch[np.asarray(state) == SLIP]))
 
 
-def fracture_ends(result: Result, spec) -> list[tuple[float, float]]:
+def fracture_ends(result: Result, spec: CaseSpec) -> list[tuple[float, float]]:
     """The arc-length range [m] of each fracture of ``result`` inside the
     domain: as the result stores it (``fracture_properties``), else from the
     case ``spec`` (a result written before the ends were kept)."""
@@ -81,12 +82,12 @@ def fracture_ends(result: Result, spec) -> list[tuple[float, float]]:
     return [arc_extent(fracture.points, spec.box) for fracture in spec.fractures]
 
 
-def result_metrics(result: Result, spec) -> dict:
+def result_metrics(result: Result, spec: CaseSpec) -> dict:
     """The METRICS of a result (final step) of the case ``spec``; the slip is
     the one that slid (``FractureFields.slid``)."""
     slip_max, length, n_slip, n_points = 0.0, 0.0, 0, 0
     slipping_means = []  # mean |slip| of each fracture with a point in slip
-    fields = result.final.fractures if result.steps else []
+    fields = result.final.fractures if result.final is not None else []
     for ends, ff in zip(fracture_ends(result, spec), fields, strict=False):
         s, slip, state = ff.s, ff.slid, ff.state
         if slip.size:
