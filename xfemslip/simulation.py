@@ -350,7 +350,7 @@ class Written:
 
 
 def solve_and_write(
-    spec, out_dir, overwrite, drive, finish=None, step_time=None
+    spec, out_dir, overwrite, drive, finish=None, step_time=None, annotate=None
 ) -> Written:
     """The frame of every command that solves a case: take the output folder
     (:func:`xfemslip.io.results.run_folder`: locked, refused when it holds
@@ -360,7 +360,9 @@ def solve_and_write(
     which is returned, not raised, with converged = False in result.h5).
     ``finish(written, folder)`` may add files of its own to the set in
     ``folder``; the set replaces the folder's content whole.  ``step_time``
-    maps a load factor to the time of the ParaView series (default: itself)."""
+    maps a load factor to the time of the ParaView series (default: itself).
+    ``annotate(result, model)`` may add to the result before it is written
+    (what ``deplete`` found: ``Result.depletion``)."""
     start = time.perf_counter()
     folder = (
         run_folder(out_dir, overwrite)
@@ -385,6 +387,8 @@ def solve_and_write(
                 wall=time.perf_counter() - start,
             )
             failure = bad or failure
+            if annotate is not None:
+                annotate(result, model)
             if stage is None:
                 return Written(None, model, results, value, failure, result)
             write_results(

@@ -120,8 +120,9 @@ def test_return_map_lands_in_the_cone_and_is_idempotent(
     gn, gt, slip_old, pn0, kn, kt, friction, cohesion
 ):
     pn, pt, state, slip, *_ = coulomb_return_map(
-        gn, gt, slip_old, pn0, kn, kt, friction, cohesion
-    )
+        gn, gt, slip_old, 0.0, pn0, kn, kt, friction, cohesion, friction, cohesion,
+        math.inf,
+    )  # fmt: skip
     assert state in (OPEN, STICK, SLIP)
     if state == OPEN:
         assert kn * gn + pn0 > 0.0
@@ -138,8 +139,9 @@ def test_return_map_lands_in_the_cone_and_is_idempotent(
             assert math.isclose(abs(pt), bound, rel_tol=1e-12, abs_tol=1e-300)
     # returning from the returned state does nothing
     pn2, pt2, state2, slip2, *_ = coulomb_return_map(
-        gn, gt, slip, pn0, kn, kt, friction, cohesion
-    )
+        gn, gt, slip, 0.0, pn0, kn, kt, friction, cohesion, friction, cohesion,
+        math.inf,
+    )  # fmt: skip
     assert pn2 == pn
     assert math.isclose(pt2, pt, rel_tol=1e-9, abs_tol=1e-6)
     assert math.isclose(slip2, slip, rel_tol=1e-9, abs_tol=1e-18)

@@ -7,6 +7,7 @@ from typing import Any
 
 import numpy as np
 
+from xfemslip.case.friction import describe_strength
 from xfemslip.case.options import SOLVER_OPTIONS
 from xfemslip.case.specs import (
     EDGES,
@@ -52,6 +53,11 @@ def _describe_network_fracture(spec: FractureSpec) -> list[str]:
         f"{k} {fmt(getattr(spec, k))}" if getattr(spec, k) is not None else f"{k} auto"
         for k in ("friction", "cohesion", "kn", "kt")
     )
+    if spec.weakening is not None:
+        friction, cohesion = describe_strength(
+            spec.friction, spec.cohesion, spec.weakening
+        )
+        params += f" (friction {friction}, cohesion {cohesion})"
     ends = (
         f"({fmt(float(p[0, 0]))}, {fmt(float(p[0, 1]))}) -> "
         + (f"{len(p) - 2} more -> " if len(p) > 2 else "")
@@ -72,12 +78,18 @@ def _describe_fracture(spec: FractureSpec) -> list[str]:
     angles = np.degrees(np.arctan2(seg[:, 1], seg[:, 0]))
     units = FractureSpec.UNITS
     points = " -> ".join(f"({fmt(float(x))}, {fmt(float(y))})" for x, y in p)
-    params = ", ".join(
+    given = [
         f"{k} = {_with_unit(getattr(spec, k), units[k])}"
         if getattr(spec, k) is not None
         else f"{k} = {fmt(AUTO_PENALTY)} E/h (automatic)"
         for k in ("friction", "cohesion", "kn", "kt")
-    )
+    ]
+    if spec.weakening is not None:
+        friction, cohesion = describe_strength(
+            spec.friction, spec.cohesion, spec.weakening
+        )
+        given[:2] = [f"friction = {friction}", f"cohesion = {cohesion}"]
+    params = ", ".join(given)
     tip = spec.tip + (
         f", radius {_with_unit(spec.tip_radius, units['tip_radius'])}"
         if spec.tip_radius is not None

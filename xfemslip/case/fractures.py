@@ -1,5 +1,6 @@
 """``[[fractures]]`` -> ``FractureSpec`` tuple: polyline (``points`` or
-``center``/``length``/``angle``), contact parameters and tip treatment, and
+``center``/``length``/``angle``), contact parameters (friction and cohesion:
+:mod:`xfemslip.case.friction`) and tip treatment, and
 the checks of a polyline (zero-length segments, self-intersection, a fracture
 that misses the domain) that ``network.file`` shares.
 """
@@ -10,6 +11,7 @@ import math
 
 import numpy as np
 
+from xfemslip.case.friction import read_strength
 from xfemslip.case.grid import Grid
 from xfemslip.case.hydraulics import read_hydraulic
 from xfemslip.case.specs import FractureSpec
@@ -203,8 +205,7 @@ def _read_fracture(table: Table, index: int, grid: Grid | None) -> FractureSpec 
     """One [[fractures]] entry."""
     start = len(table.problems)
     points = _fracture_points(table)
-    friction = table.number("friction", rule=NON_NEGATIVE)
-    cohesion = table.number("cohesion", 0.0, rule=NON_NEGATIVE)
+    strength = read_strength(table)
     kn = table.number("kn", None, rule=POSITIVE)
     kt = table.number("kt", None, rule=POSITIVE)
     tip, radius = read_tip(table)
@@ -224,8 +225,9 @@ def _read_fracture(table: Table, index: int, grid: Grid | None) -> FractureSpec 
     return FractureSpec(
         index=index,
         points=frozen(points),
-        friction=friction,
-        cohesion=cohesion,
+        friction=strength.friction,
+        cohesion=strength.cohesion,
+        weakening=strength.weakening(),
         kn=kn,
         kt=kt,
         tip=tip,

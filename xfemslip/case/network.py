@@ -15,6 +15,7 @@ from pathlib import Path
 import numpy as np
 
 from xfemslip.case.fractures import read_tip
+from xfemslip.case.friction import read_strength
 from xfemslip.case.generate import GENERATE_KEYS, read_generate, realize
 from xfemslip.case.grid import Grid
 from xfemslip.case.hydraulics import read_hydraulic
@@ -50,8 +51,12 @@ def read_network(
     if not table.present:
         return ()
     start = len(table.problems)
-    defaults = {
-        name: table.number(name, None, rule) for name, rule in PROPERTY_RULES.items()
+    strength = read_strength(table, friction_default=None, cohesion_default=None)
+    defaults = {"friction": strength.friction, "cohesion": strength.cohesion}
+    defaults |= {
+        name: table.number(name, None, rule)
+        for name, rule in PROPERTY_RULES.items()
+        if name not in defaults
     }
     tip, radius = read_tip(table)
     hydraulic = read_hydraulic(table)
@@ -99,6 +104,17 @@ def read_network(
             tip_radius=radius,
             source=source,
             hydraulic=hydraulic,
+            weakening=_weakening(strength, props),
         )
         for k, (points, props, source) in enumerate(found)
+    )
+
+
+def _weakening(strength, props):
+    """The [network] friction law of one of its fractures: a friction or
+    cohesion that its CSV rows give replaces the law's values of it."""
+    given = props.get("given", ())
+    return strength.weakening(
+        friction=props["friction"] if "friction" in given else None,
+        cohesion=props["cohesion"] if "cohesion" in given else None,
     )

@@ -188,10 +188,15 @@ def _chain(group: list, fid, file: Path, tol: float) -> tuple[np.ndarray | None,
 
 def _group_properties(group: list, fid, file: Path, defaults: dict):
     """(properties, problems): per-row values (equal across a fracture's rows),
-    else the [network] defaults; friction must come from one or the other."""
-    props, bad = {}, []
+    else the [network] defaults; friction must come from one or the other.
+    ``properties["given"]`` names those the rows give (a [network] friction
+    law applies to a fracture only where they do not: case.friction)."""
+    props: dict[str, Any] = {"given": set()}
+    bad: list[str] = []
     for name in PROPERTY_RULES:
         given = [(n, r[name]) for n, r in group if r.get(name) is not None]
+        if given:
+            props["given"].add(name)
         values = {v for _, v in given}
         if len(values) > 1:
             (n1, v1), (n2, v2) = given[0], next(g for g in given if g[1] != given[0][1])

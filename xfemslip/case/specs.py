@@ -94,6 +94,24 @@ class PermeabilitySpec:
 
 
 @dataclass(frozen=True, kw_only=True)
+class SlipWeakeningSpec:
+    """Linear slip weakening of a fracture's friction and cohesion
+    (``friction = { law = "slip_weakening", ... }``; kernels.contact): from
+    the static values of ``FractureSpec.friction`` and ``cohesion`` at zero
+    accumulated slip to these dynamic ones at ``slip_distance`` of it and
+    beyond."""
+
+    dynamic_friction: float  # f_d [-], 0 <= f_d <= f_s
+    dynamic_cohesion: float  # c_d [Pa], 0 <= c_d <= c_s (= c_s: no weakening)
+    slip_distance: float  # D_c [m] > 0
+    UNITS: ClassVar[dict[str, str]] = {
+        "dynamic_friction": "-",
+        "dynamic_cohesion": "Pa",
+        "slip_distance": "m",
+    }
+
+
+@dataclass(frozen=True, kw_only=True)
 class FractureSpec:
     index: int  # [[fractures]] position; [network] ones follow (network.py)
     points: np.ndarray  # (k, 2) float64 polyline vertices, k >= 2 [m]
@@ -109,6 +127,9 @@ class FractureSpec:
     # faces (xfemslip.fem.zones.FLUID_RULES): "mean" | "higher" | "lower",
     # or a number [Pa] (a sealing fracture holding a pressure of its own)
     fluid_pressure: str | float = "mean"
+    # slip weakening of friction (and cohesion); None: constant Coulomb with
+    # friction and cohesion above (which are then the static values)
+    weakening: SlipWeakeningSpec | None = None
     UNITS: ClassVar[dict[str, str]] = {
         "points": "m",
         "tip_radius": "m",

@@ -30,12 +30,24 @@ from xfemslip.cli.common import (
     "solver.tolerance, what the load steps resolve, is raised to it].",
 )
 @click.option(
+    "--patch-length",
+    type=FiniteFloat(min=0.0, min_open=True),
+    default=None,
+    metavar="M",
+    help="Also find, per fracture, the pore-pressure change at which its "
+    "slipping length first reaches M metres (bisection): the growth of slip, "
+    "which converges under mesh refinement where the first slip at a corner "
+    "does not.",
+)
+@click.option(
     "--plot",
     is_flag=True,
     help="Also draw slip_vs_depletion.png and depletion_field.png.",
 )
 @debug_option
-def deplete(case, output, tolerance, plot, overwrite, verbose, quiet, debug) -> None:
+def deplete(
+    case, output, tolerance, patch_length, plot, overwrite, verbose, quiet, debug
+) -> None:
     """Critical depletion of every fracture of CASE: the pore-pressure change
     at which it first slips (bisection on the load), and slip vs depletion
     (result.h5, critical_depletion.csv, slip_vs_depletion.csv)."""
@@ -46,7 +58,12 @@ def deplete(case, output, tolerance, plot, overwrite, verbose, quiet, debug) -> 
         from xfemslip.studies.depletion import format_report
 
         report = run_deplete(
-            spec, output, tolerance=tolerance, plot=plot, overwrite=overwrite
+            spec,
+            output,
+            tolerance=tolerance,
+            plot=plot,
+            overwrite=overwrite,
+            patch_length=patch_length,
         )
         click.echo(format_report(report))
         for path in report.written:

@@ -80,6 +80,11 @@ def summary(result_path: Path, every_step: bool, debug: bool) -> None:
             click.echo("no converged load step: nothing to report on the fractures")
         for line in event_report(result, every_step=every_step):
             click.echo(line)
+        if result.depletion is not None:
+            from xfemslip.studies.depletion import depletion_lines
+
+            for line in depletion_lines(result.depletion):
+                click.echo(line)
 
 
 def _case_name(text: str) -> str:

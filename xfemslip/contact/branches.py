@@ -180,12 +180,16 @@ def force_branches(c, *, open_at=None, stick_at=None, slip_at=None, sign=None):
     branch differ:
 
     - ``open_at``: k_N = 0 and p_N0 > 0, so zero traction and tangent;
-    - ``stick_at``: an infinite cohesion, so the trial traction is always
-      inside the bound; the normal law stays free (a patch may still open);
+    - ``stick_at``: an infinite cohesion, static and dynamic (so it does
+      not weaken), so the trial traction is always inside the bound; the
+      normal law stays free (a patch may still open);
     - ``slip_at``: a committed plastic slip of -sign * inf (``sign`` +-1 per
       selected patch), so the trial traction is infinite with that sign and
       is returned onto sign * (c - f p_N); the plastic slip g_T - p_T / k_T
-      it reports does not depend on it.
+      it reports does not depend on it.  On a slip-weakening patch the
+      infinite trial passes the whole weakening range and lands on the
+      dynamic bound sign * (c_d - f_d p_N): the predictor and the local
+      search therefore leave weakening patches to the true law.
 
     A closed branch whose normal jump is open at the evaluation point stays
     open (the normal test comes first).  Never committed: the true law is
@@ -200,7 +204,9 @@ def force_branches(c, *, open_at=None, stick_at=None, slip_at=None, sign=None):
     if stick_at is not None:
         cohesion = c.cohesion.copy()
         cohesion[stick_at] = math.inf
-        changes["cohesion"] = cohesion
+        dynamic = c.cohesion_dynamic.copy()
+        dynamic[stick_at] = math.inf
+        changes |= {"cohesion": cohesion, "cohesion_dynamic": dynamic}
     if slip_at is not None:
         committed = c.slip_committed.copy()
         committed[slip_at] = -np.asarray(sign) * math.inf

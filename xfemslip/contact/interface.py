@@ -34,6 +34,7 @@ COMMITTED = (
     "state_committed",
     "gt_committed",
     "pt_committed",
+    "accumulated_committed",
 )
 
 
@@ -59,6 +60,8 @@ class ContactResult:
     slip_plastic: np.ndarray  # (m,) [m]
     # ContactSet.slip_reference when it was evaluated (m,) [m]
     slip_reference: np.ndarray = field(repr=False)
+    # accumulated frictional slip delta = int |d g_T^p| (kernels.contact)
+    accumulated: np.ndarray = field(repr=False)  # (m,) [m]
     # the displacement it was evaluated at (a reference, not a copy: the solver
     # never changes an array in place once it has been evaluated)
     u: np.ndarray = field(repr=False)  # (n_dofs,) [m]
@@ -110,6 +113,17 @@ class ContactResult:
     def point_plastic_slip(self) -> np.ndarray:  # (n,) [m]
         return self.plastic_slip[self.contact.patch]
 
+    @property
+    def point_accumulated(self) -> np.ndarray:  # (n,) [m]
+        return self.accumulated[self.contact.patch]
+
+    @property
+    def point_friction(self) -> np.ndarray:  # (n,) [-]
+        """The friction coefficient f(delta) of each point's patch after this
+        evaluation's slip (the static one where it has not slipped)."""
+        c = self.contact
+        return c.friction_at(self.accumulated)[c.patch]
+
 
 @dataclass
 class ContactSet:
@@ -133,8 +147,8 @@ class ContactSet:
     pn0: np.ndarray  # (m,) in-situ normal traction [Pa]
     kn: np.ndarray
     kt: np.ndarray
-    friction: np.ndarray
-    cohesion: np.ndarray
+    friction: np.ndarray  # static f_s [-]
+    cohesion: np.ndarray  # static c_s [Pa]
     n_dofs: int
     fracture: np.ndarray  # (m,) fracture of each patch
     patch: np.ndarray  # (n,) patch of each interface point
@@ -152,10 +166,48 @@ class ContactSet:
     pt_committed: np.ndarray
     # kernel backend of the model ("numba" | "numpy", kernels.choose)
     kernels: str = field(kw_only=True)
+    # slip weakening (kernels.contact): dynamic friction f_d [-] and cohesion
+    # c_d [Pa], reached after slip_distance D_c [m] of accumulated slip; for
+    # constant friction f_d = f_s, c_d = c_s and D_c = inf (_weakening_arrays)
+    friction_dynamic: np.ndarray = field(kw_only=True)
+    cohesion_dynamic: np.ndarray = field(kw_only=True)
+    slip_distance: np.ndarray = field(kw_only=True)
+    # committed accumulated slip delta of each patch [m], like slip_committed
+    accumulated_committed: np.ndarray = field(kw_only=True)
 
     @property
     def n(self) -> int:
         return self.weight.size
+
+    @property
+    def weakens(self) -> np.ndarray:
+        """(m,) bool: patches whose friction or cohesion weakens with slip."""
+        return (self.friction != self.friction_dynamic) | (
+            self.cohesion != self.cohesion_dynamic
+        )
+
+    def friction_at(self, accumulated) -> np.ndarray:
+        """(m,) friction coefficient f(delta) of every patch at the
+        accumulated slip ``accumulated`` (m,) [m] (kernels.contact.weakened)."""
+        return kernels.backend("numpy").weakened(
+            self.friction, self.friction_dynamic, accumulated, self.slip_distance
+        )
+
+    def cohesion_at(self, accumulated) -> np.ndarray:
+        """(m,) cohesion c(delta) [Pa] of every patch at the accumulated slip
+        ``accumulated`` (m,) [m]."""
+        return kernels.backend("numpy").weakened(
+            self.cohesion, self.cohesion_dynamic, accumulated, self.slip_distance
+        )
+
+    def history(self) -> tuple:
+        """Copy of the committed history (what ``restore`` takes back)."""
+        return tuple(getattr(self, name).copy() for name in COMMITTED)
+
+    def restore(self, history: tuple) -> None:
+        """Set the committed history to ``history`` (from ``history()``)."""
+        for name, value in zip(COMMITTED, history, strict=True):
+            setattr(self, name, value.copy())
 
     def evaluate(
         self, u, tangent_mode, pt_prev, gt_prev, scratch=None
@@ -173,7 +225,7 @@ class ContactSet:
         J2 = self.dofs.shape[1]
         out_f = np.zeros((n, J2))
         out_K = np.zeros((n, J2, J2)) if scratch is None else scratch
-        gn, gt, pn, pt, slip = (np.zeros(n) for _ in range(5))
+        gn, gt, pn, pt, slip, accumulated = (np.zeros(n) for _ in range(6))
         state = np.zeros(n, np.int8)
         kernels.backend(self.kernels).contact_response(
             np.ascontiguousarray(u, dtype=np.float64),
@@ -184,10 +236,14 @@ class ContactSet:
             self.weight,
             self.pn0,
             self.slip_committed,
+            self.accumulated_committed,
             self.kn,
             self.kt,
             self.friction,
             self.cohesion,
+            self.friction_dynamic,
+            self.cohesion_dynamic,
+            self.slip_distance,
             int(tangent_mode),
             pt_prev,
             gt_prev,
@@ -199,6 +255,7 @@ class ContactSet:
             pt,
             state,
             slip,
+            accumulated,
         )
         return ContactResult(
             force=scatter_vector(self.dofs, out_f, self.n_dofs),
@@ -210,6 +267,7 @@ class ContactSet:
             state=state,
             slip_plastic=slip,
             slip_reference=self.slip_reference,
+            accumulated=accumulated,
             u=u,
             contact=self,
         )
@@ -257,6 +315,34 @@ class ContactSet:
         self.state_committed = result.state.copy()
         self.gt_committed = result.gt.copy()
         self.pt_committed = result.pt.copy()
+        self.accumulated_committed = result.accumulated.copy()
+
+
+@dataclass(frozen=True)
+class PatchGeometry:
+    """Where the contact patches of a ContactSet lie: what path following
+    (xfemslip.solve.continuation) reports a nucleation with."""
+
+    centre: np.ndarray  # (m, 2) length-weighted centre of each patch [m]
+    s: np.ndarray  # (m,) arc length of that centre along its fracture [m]
+    fracture: np.ndarray  # (m,) case-file index of each patch's fracture
+
+
+def patch_geometry(contact: ContactSet, ip, fracture_ids) -> PatchGeometry:
+    """The PatchGeometry of ``contact`` built on the interface points ``ip``;
+    ``fracture_ids`` gives the case-file index of each fracture position
+    (``[fr.index for fr in model.fractures]``)."""
+    m = contact.n
+    W = np.bincount(contact.patch, weights=ip.weight, minlength=m)
+
+    def mean(values):
+        return np.bincount(contact.patch, weights=ip.weight * values, minlength=m) / W
+
+    return PatchGeometry(
+        centre=np.column_stack([mean(ip.xy[:, 0]), mean(ip.xy[:, 1])]),
+        s=mean(ip.s),
+        fracture=np.asarray(fracture_ids, np.int64)[contact.fracture],
+    )
 
 
 def _point_jumps(u, dofs, coef) -> np.ndarray:
@@ -481,6 +567,26 @@ def _or_nan(value):
     return np.nan if value is None else value
 
 
+def _weakening_arrays(fractures, frac, friction, cohesion) -> dict:
+    """friction_dynamic, cohesion_dynamic and slip_distance (m,) of the
+    patches (fractures[frac[p]] each): the fracture's slip-weakening law, or
+    the static values and D_c = inf for constant friction."""
+    out = {
+        "friction_dynamic": friction.copy(),
+        "cohesion_dynamic": cohesion.copy(),
+        "slip_distance": np.full(frac.size, np.inf),
+    }
+    for fi, fr in enumerate(fractures):
+        law = getattr(fr, "weakening", None)
+        if law is None:
+            continue
+        mine = frac == fi
+        out["friction_dynamic"][mine] = law.dynamic_friction
+        out["cohesion_dynamic"][mine] = law.dynamic_cohesion
+        out["slip_distance"][mine] = law.slip_distance
+    return out
+
+
 def build_contact(
     mesh,
     fractures,
@@ -525,6 +631,7 @@ def build_contact(
         name: np.array([_or_nan(getattr(fractures[f], name)) for f in frac], float)
         for name in ("kn", "kt", "friction", "cohesion")
     }
+    par |= _weakening_arrays(fractures, frac, par["friction"], par["cohesion"])
     # mean cell size over each patch, for the automatic penalty
     h = np.bincount(patch, weights=ip.weight * _cell_size(mesh, ip.cell)) / W
     for name in ("kn", "kt"):
@@ -576,6 +683,7 @@ def build_contact(
         state_committed=np.full(n, STICK, np.int8),
         gt_committed=np.zeros(n),
         pt_committed=-par["kt"] * slip0,
+        accumulated_committed=np.zeros(n),
         kernels=kernels,
         **par,
     )

@@ -82,9 +82,12 @@ def predicted_law(c: ContactSet, state, sign) -> ContactSet:
     (:func:`xfemslip.contact.branches.force_branches`): open, stick or slip
     with ``sign`` as ``state`` says.  A closed branch whose normal jump is
     open at the evaluation point stays open: that patch is simply not
-    predicted.  Never committed.
+    predicted.  A slip-weakening patch predicted to slip is not forced
+    either: its slip branch depends on the slip increment, which a forced
+    branch does not know (force_branches), so the true law decides it.
+    Never committed.
     """
-    is_slip = state == SLIP
+    is_slip = (state == SLIP) & ~c.weakens
     return force_branches(
         c,
         open_at=state == OPEN,

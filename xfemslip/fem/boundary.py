@@ -276,3 +276,30 @@ def _enriched_edge_load(F, mesh, segments, ec, cand, dofmap, fractures):
         d = dofmap.cand_dof[kk]
         np.add.at(F, d, contribution[:, 0])
         np.add.at(F, d + 1, contribution[:, 1])
+
+
+def fracture_face_load(contact, normal=None, shear=None) -> np.ndarray:
+    """External force (n_dofs,) [N/m] of equal and opposite tractions on the
+    two faces of the fractures: sum_p [[N_p]]^T (normal_p n_p + shear_p t_p)
+    over the interface points, with the points' own jump operators.
+
+    normal, shear : (n,) [N/m] per interface point: the point's weight times
+    the traction on its + face (shear along t, normal along n: a positive
+    normal pushes the faces apart, as a fluid pressure does).  Where the faces
+    stick this adds the traction to the contact tractions p_N, p_T without
+    deforming the body: the load of a stress acting on a locked fault.
+    """
+    F = np.zeros(contact.n_dofs)
+    dofs, coef = contact.point_dofs, contact.point_coef
+    if dofs.shape[1] == 0:
+        return F
+    for c in range(2):
+        d = dofs[:, c::2]
+        v = np.zeros(coef.shape)
+        if normal is not None:
+            v = v + coef * (normal * contact.point_normal[:, c])[:, None]
+        if shear is not None:
+            v = v + coef * (shear * contact.point_tangent[:, c])[:, None]
+        keep = d >= 0
+        np.add.at(F, d[keep], v[keep])
+    return F

@@ -95,6 +95,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from xfemslip.fem.assembly import enriched_part_bbar
+from xfemslip.fem.boundary import fracture_face_load
 from xfemslip.fem.material import elasticity_matrix
 from xfemslip.fem.zones import (
     HOST,
@@ -570,23 +571,10 @@ def _add_enriched_load(F, mesh, bulk, ec, w, factor, scale, backend) -> None:
 
 
 def fracture_load(contact, ip, pore: PorePressure) -> np.ndarray:
-    """F_frac of eq. (2) at load factor 1, (n_dofs,) [N/m].
-
-    Integrated with the interface points' own jump operators:
-    sum_p w_p dp_f(p) coef_pk n_p on the dofs of the point's enrichments,
-    dp_f of eq. (3).
-    """
-    F = np.zeros(contact.n_dofs)
-    dofs, coef = contact.point_dofs, contact.point_coef
-    if dofs.shape[1] == 0:
-        return F
-    g = ip.weight * pore.scale * pore.point_ratio
-    for c in range(2):
-        d = dofs[:, c::2]
-        v = coef * (g * contact.point_normal[:, c])[:, None]
-        keep = d >= 0
-        np.add.at(F, d[keep], v[keep])
-    return F
+    """F_frac of eq. (2) at load factor 1, (n_dofs,) [N/m]: the fluid
+    pressure change dp_f of eq. (3) on the faces (fracture_face_load), with
+    the interface points' own jump operators, sum_p w_p dp_f(p) coef_pk n_p."""
+    return fracture_face_load(contact, normal=ip.weight * pore.scale * pore.point_ratio)
 
 
 def make_contact_effective(contact, pore: PorePressure, ip) -> None:

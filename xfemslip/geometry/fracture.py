@@ -111,6 +111,10 @@ class Fracture:
     arms: tuple = ((),)
     junction_s: tuple = ()
     junction_ends: tuple = ()  # ends (0 first, 1 last) lying on another fracture
+    # slip weakening of friction and cohesion (case.specs.SlipWeakeningSpec),
+    # or None for constant Coulomb friction; friction and cohesion above are
+    # then the static values
+    weakening: object = None
 
     def arm_of(self, s: np.ndarray) -> np.ndarray:
         """Arm of points at arc lengths s (n,) int64."""
@@ -451,6 +455,7 @@ def build_fracture(
         tip_mode=tip_mode,
         tip_radius=float(radius),
         junction_ends=tuple(sorted(junction_ends)),
+        weakening=spec.weakening,
     )
     logger.debug(
         "%s: %d segment(s), %d tip(s), %d cut cells",

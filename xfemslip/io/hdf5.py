@@ -33,6 +33,8 @@ or for the derived quantities ``"m^2"``, ``"m^3"``, ``"N m/m"``, ``"N m"``)::
                               max_slip_increment [m] and
                               moment_per_length_increment [N m/m] of the
                               step's own slip; attr extent_given
+    with a slip-weakening friction on a fracture, every fracture also:
+    accumulated_slip [m] and friction_coefficient [-]
     with [permeability] (xfemslip.post.hydraulics) also: per fracture aperture
     [m] and transmissivity [m^3], and /permeability/ with step (S,), in_situ
     (2, 2) and tensor (S, 2, 2) [m^2], initial_aperture (F,) [m], attrs block,
@@ -65,7 +67,7 @@ from xfemslip import __version__, interrupt
 from xfemslip.conventions import STATE_CODES
 from xfemslip.io.atomic import atomic_path, refuse_non_finite
 from xfemslip.post.fields import FractureFields, FractureProperties, StepFields
-from xfemslip.post.result import EventTable, PermeabilityHistory
+from xfemslip.post.result import DepletionTable, EventTable, PermeabilityHistory
 
 logger = logging.getLogger(__name__)
 
@@ -97,6 +99,7 @@ def write_result(
     events: EventTable | None = None,
     permeability: PermeabilityHistory | None = None,
     properties: Sequence[FractureProperties] | None = None,
+    depletion: DepletionTable | None = None,
 ) -> None:
     """Write ``result.h5`` atomically.
 
@@ -124,6 +127,8 @@ def write_result(
     properties : list of FractureProperties, optional
         Per fracture (same order as the steps' fractures) its ends and elastic
         constants at its contact points, written into ``/fractures/<i>``.
+    depletion : DepletionTable, optional
+        What ``deplete`` found per fracture, written as ``/depletion``.
 
     Raises
     ------
@@ -148,6 +153,8 @@ def write_result(
                 _write_properties(h5["fractures"], properties)
             if steps:
                 _write_derived(h5, steps, events, permeability)
+            if depletion is not None:
+                _write_depletion(h5, depletion)
         with open(tmp, "wb") as fh:
             fh.write(image.getbuffer())
 
@@ -277,6 +284,8 @@ def _write_fracture(group: h5py.Group, fracture: FractureFields) -> None:
         ("aperture", "m"),  # with [permeability]
         ("transmissivity", "m^3"),
         ("utilisation", "-"),  # None only in a result read from an older file
+        ("accumulated_slip", "m"),  # with a slip-weakening friction
+        ("friction_coefficient", "-"),
     )
     for name, units in optional:
         given = getattr(fracture, name, None)
@@ -378,6 +387,30 @@ def _write_derived(h5, steps, events, permeability) -> None:
             _as_array(a0, np.float64, (len(a0),), "initial_aperture"),
             "m",
         )
+
+
+# (name, units) of the /depletion datasets, each (F,); NaN: did not happen
+DEPLETION_DATASETS = (
+    ("dp_lower", "Pa"),
+    ("dp_upper", "Pa"),
+    ("x", "m"),
+    ("y", "m"),
+    ("dp_patch", "Pa"),
+)
+
+
+def _write_depletion(h5, table: DepletionTable) -> None:
+    """``/depletion``: per fracture what ``deplete`` found."""
+    group = h5.create_group("depletion", track_order=True)
+    group.attrs["patch_length"] = float(table.patch_length)
+    group.attrs["tolerance"] = float(table.tolerance)
+    n = len(table.singularity)
+    for name, units in DEPLETION_DATASETS:
+        value = _as_array(getattr(table, name), np.float64, (n,), name)
+        _dataset(group, name, value, units, nan=True)
+    at = _as_array(table.at_singularity, np.int8, (n,), "at_singularity")
+    _dataset(group, "first_slip_at_singularity", at, "-")
+    group.attrs["singularity"] = np.array(table.singularity, dtype=h5py.string_dtype())
 
 
 def _dataset(

@@ -20,7 +20,12 @@ import numpy as np
 from xfemslip.errors import UsageError
 from xfemslip.geometry.box import Box
 from xfemslip.post.fields import FractureFields, FractureProperties, StepFields
-from xfemslip.post.result import EventTable, PermeabilityHistory, Result
+from xfemslip.post.result import (
+    DepletionTable,
+    EventTable,
+    PermeabilityHistory,
+    Result,
+)
 
 __all__ = ["FRACTURE_ARRAYS", "read_attrs", "read_result"]
 
@@ -42,6 +47,8 @@ OPTIONAL_FRACTURE_ARRAYS = (
     "aperture",
     "transmissivity",
     "utilisation",
+    "accumulated_slip",
+    "friction_coefficient",
 )
 BULK_ARRAYS = ("stress", "stress_zz", "principal_stress")
 OPTIONAL_BULK_ARRAYS = ("effective_stress", "pore_pressure")
@@ -235,6 +242,24 @@ def _permeability(h5: h5py.File) -> PermeabilityHistory | None:
     )
 
 
+def _depletion(h5: h5py.File) -> DepletionTable | None:
+    """``/depletion`` (None unless ``deplete`` wrote the file)."""
+    if "depletion" not in h5:
+        return None
+    g = h5["depletion"]
+    return DepletionTable(
+        dp_lower=g["dp_lower"][()],
+        dp_upper=g["dp_upper"][()],
+        x=g["x"][()],
+        y=g["y"][()],
+        at_singularity=g["first_slip_at_singularity"][()].astype(bool),
+        singularity=tuple(_text(v) for v in g.attrs.get("singularity", ())),
+        dp_patch=g["dp_patch"][()],
+        patch_length=float(g.attrs["patch_length"]),
+        tolerance=float(g.attrs["tolerance"]),
+    )
+
+
 def read_result(path: str | Path) -> Result:
     """Read a ``result.h5`` (or ``path/result.h5``) into a Result.
 
@@ -258,6 +283,7 @@ def read_result(path: str | Path) -> Result:
                 fracture_properties=_properties(h5),
                 events=_events(h5),
                 permeability=_permeability(h5),
+                depletion=_depletion(h5),
             )
         except KeyError:  # a dataset or attribute of the format is missing
             raise UsageError(

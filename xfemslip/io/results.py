@@ -76,6 +76,7 @@ def write_results(
         events=result.events,
         permeability=result.permeability,
         properties=result.fracture_properties,
+        depletion=result.depletion,
     )
     if "csv" in formats and result.steps and result.steps[0].fractures:
         write_rows(folder / "profile.csv", PROFILE_COLUMNS, profile_rows(result))

@@ -46,6 +46,8 @@ OPTIONAL_FRACTURE_POINT_DATA = (
     "utilisation",
     "aperture",
     "transmissivity",
+    "accumulated_slip",
+    "friction_coefficient",
 )
 
 
@@ -155,7 +157,9 @@ def write_fractures(
     utilisation, 1 where it slips), ``s`` [m] and ``fracture`` (the index),
     with ``faces`` the two displacements above, with pore pressure
     ``fluid_pressure`` and ``effective_normal_traction`` [Pa], and with
-    ``[permeability]`` also ``aperture`` [m] and ``transmissivity`` [m^3].
+    ``[permeability]`` also ``aperture`` [m] and ``transmissivity`` [m^3],
+    with a slip-weakening friction ``accumulated_slip`` [m] and
+    ``friction_coefficient`` [-].
     Points are 3D with z = 0.
 
     Returns
@@ -276,7 +280,8 @@ def _fracture_part(
     # plastic_slip [m] and utilisation [-] (None only when read from an older
     # result.h5); with pore pressure fluid_pressure and
     # effective_normal_traction [Pa]; [permeability]: aperture [m],
-    # transmissivity a^3 / 12 [m^3]
+    # transmissivity a^3 / 12 [m^3]; slip weakening: accumulated_slip
+    # [m], friction_coefficient [-]
     for name in OPTIONAL_FRACTURE_POINT_DATA:
         value = getattr(fields, name, None)
         if value is not None:

@@ -143,27 +143,97 @@ def enriched_cell_matrices(
     return K, Bbar
 
 
-def coulomb_return_map(gn, gt, slip_old, pn0, kn, kt, friction, cohesion):
+def weakened(static, dynamic, accumulated, slip_distance):
+    """contact.weakened on arrays: the linearly slip-weakened strength
+    parameter, ``static`` itself where the two values are equal."""
+    with np.errstate(divide="ignore", invalid="ignore"):
+        ramp = static - (static - dynamic) * (accumulated / slip_distance)
+    return np.where(
+        (static == dynamic) | (accumulated <= 0.0),
+        static,
+        np.where(accumulated >= slip_distance, dynamic, ramp),
+    )
+
+
+def weakening_rate(static, dynamic, slip_distance):
+    """contact.weakening_rate on arrays: (static - dynamic) / slip_distance,
+    exactly 0 where the values are equal."""
+    with np.errstate(invalid="ignore"):
+        return np.where(static == dynamic, 0.0, (static - dynamic) / slip_distance)
+
+
+def coulomb_return_map(
+    gn,
+    gt,
+    slip_old,
+    accumulated_old,
+    pn0,
+    kn,
+    kt,
+    friction,
+    cohesion,
+    friction_dynamic,
+    cohesion_dynamic,
+    slip_distance,
+):
     """The return map of contact.coulomb_return_map on arrays of points:
-    (pn, pt, state, slip_new, d_nn, d_nt, d_tn, d_tt), each (n,)."""
+    (pn, pt, state, slip_new, accumulated_new, d_nn, d_nt, d_tn, d_tt),
+    each (n,)."""
     pn = kn * gn + pn0
     is_open = pn > 0.0
     pt_trial = kt * (gt - slip_old)
-    bound = cohesion - friction * pn
+    f = weakened(friction, friction_dynamic, accumulated_old, slip_distance)
+    c = weakened(cohesion, cohesion_dynamic, accumulated_old, slip_distance)
+    bound = c - f * pn
     stick = ~is_open & (np.abs(pt_trial) <= bound)
     slip = ~is_open & ~stick
     sgn = np.where(pt_trial > 0.0, 1.0, -1.0)
-    pt = np.where(slip, sgn * bound, pt_trial)
-    state = np.where(is_open, OPEN, np.where(stick, STICK, SLIP)).astype(np.int8)
+    trial = np.abs(pt_trial)
+    rate_f = weakening_rate(friction, friction_dynamic, slip_distance)
+    rate_c = weakening_rate(cohesion, cohesion_dynamic, slip_distance)
+    H = rate_c - rate_f * pn  # softening of the bound per unit slip [Pa/m]
+    weakens = (
+        slip & (accumulated_old < slip_distance) & ((rate_f != 0.0) | (rate_c != 0.0))
+    )
+    bound_d = cohesion_dynamic - friction_dynamic * pn
     with np.errstate(divide="ignore", invalid="ignore"):  # kt = 0 never slips
+        dl = (trial - bound) / (kt - H)
+        on_branch = weakens & (kt > H) & (dl <= slip_distance - accumulated_old)
+        past = weakens & ~on_branch
+        f_new = f - rate_f * dl
+        pt_slip = np.where(
+            on_branch,
+            sgn * (c - rate_c * dl - f_new * pn),
+            np.where(past, sgn * bound_d, sgn * bound),
+        )
+        pt = np.where(slip, pt_slip, pt_trial)
         slip_new = np.where(is_open, gt, np.where(stick, slip_old, gt - pt / kt))
+        acc_new = np.where(
+            on_branch,
+            accumulated_old + dl,
+            np.where(
+                past,
+                accumulated_old + (trial - bound_d) / kt,
+                np.where(slip, accumulated_old + (trial - bound) / kt, accumulated_old),
+            ),
+        )
+        scale = kt / (kt - H)
+    state = np.where(is_open, OPEN, np.where(stick, STICK, SLIP)).astype(np.int8)
     pn = np.where(is_open, 0.0, pn)
     pt = np.where(is_open, 0.0, pt)
     d_nn = np.where(is_open, 0.0, kn)
     d_nt = np.zeros_like(pn)
-    d_tn = np.where(slip, -sgn * friction * kn, 0.0)
-    d_tt = np.where(stick, kt, 0.0)
-    return pn, pt, state, slip_new, d_nn, d_nt, d_tn, d_tt
+    d_tn = np.where(
+        on_branch,
+        -sgn * f_new * kn * scale,
+        np.where(
+            past,
+            -sgn * friction_dynamic * kn,
+            np.where(slip, -sgn * f * kn, 0.0),
+        ),
+    )
+    d_tt = np.where(stick, kt, np.where(on_branch, -H * scale, 0.0))
+    return pn, pt, state, slip_new, acc_new, d_nn, d_nt, d_tn, d_tt
 
 
 def contact_response(
@@ -175,10 +245,14 @@ def contact_response(
     ip_weight,
     pn0,
     slip_old,
+    accumulated_old,
     kn,
     kt,
     friction,
     cohesion,
+    friction_dynamic,
+    cohesion_dynamic,
+    slip_distance,
     tangent_mode,
     pt_prev,
     gt_prev,
@@ -190,6 +264,7 @@ def contact_response(
     out_pt,
     out_state,
     out_slip,
+    out_accumulated,
 ):
     """Contact forces and tangent of every interface point
     (contact.contact_response)."""
@@ -202,14 +277,26 @@ def contact_response(
     j1 = (ip_coef * uy).sum(axis=1)
     gn = j0 * n0 + j1 * n1
     gt = j0 * t0 + j1 * t1
-    pn, pt, state, slip, dnn, dnt, dtn, dtt = coulomb_return_map(
-        gn, gt, slip_old, pn0, kn, kt, friction, cohesion
+    pn, pt, state, slip, acc, dnn, dnt, dtn, dtt = coulomb_return_map(
+        gn,
+        gt,
+        slip_old,
+        accumulated_old,
+        pn0,
+        kn,
+        kt,
+        friction,
+        cohesion,
+        friction_dynamic,
+        cohesion_dynamic,
+        slip_distance,
     )
     if tangent_mode == TANGENT_SECANT:  # paper eq. 28, no n-t coupling
         dg = np.abs(gt - gt_prev)
         with np.errstate(divide="ignore", invalid="ignore"):
             sec = np.where(dg <= SECANT_MIN_INCREMENT, kt, np.abs(pt - pt_prev) / dg)
-        sliding = state == SLIP
+        # a point on a weakening branch keeps its consistent tangent
+        sliding = (state == SLIP) & (dtt == 0.0)
         dtt = np.where(sliding, np.minimum(sec, kt), dtt)
         dtn = np.where(sliding, 0.0, dtn)
     out_gn[:] = gn
@@ -218,6 +305,7 @@ def contact_response(
     out_pt[:] = pt
     out_state[:] = state
     out_slip[:] = slip
+    out_accumulated[:] = acc
     T = np.column_stack([pn * n0 + pt * t0, pn * n1 + pt * t1])
     # C = n (dnn n + dnt t)^T + t (dtn n + dtt t)^T
     a = dnn[:, None] * ip_normal + dnt[:, None] * ip_tangent

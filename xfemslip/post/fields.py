@@ -11,7 +11,8 @@ for enriched elements).  Out-of-plane stress in plane strain:
 sigma_zz = nu (sigma_xx + sigma_yy) (the in-situ sigma_zz is taken as
 nu (sigma0_xx + sigma0_yy), consistent with plane strain); zero in plane stress.
 Fracture fields: slip = [[u]] . t, opening = [[u]] . n, p_N, p_T and the state
-codes of :mod:`xfemslip.conventions`.
+codes of :mod:`xfemslip.conventions`; with a slip-weakening friction also the
+accumulated slip and the friction coefficient it leaves.
 """
 
 from __future__ import annotations
@@ -53,6 +54,10 @@ class FractureFields:
     # |p_T| / (c + f max(0, -p_N')) of a stuck point, 1 where it slips or is
     # open (coulomb_utilisation); None in a result written without it
     utilisation: np.ndarray | None = None  # (K,) [-]
+
+    # with a slip-weakening friction only (kernels.contact)
+    accumulated_slip: np.ndarray | None = None  # (K,) delta = int |d g_T^p| [m]
+    friction_coefficient: np.ndarray | None = None  # (K,) f(delta) [-]
 
     @property
     def slid(self) -> np.ndarray:
@@ -199,11 +204,15 @@ def fracture_fields(ip, res, n_fractures, fluid=None) -> list[FractureFields]:
     p_f are reported too (xfemslip.fem.poro).
     """
     c = getattr(res, "contact", None)
-    use = (
-        coulomb_utilisation(res.pn, res.pt, res.state, c.friction, c.cohesion)[c.patch]
-        if c is not None
-        else None
-    )
+    weakening = _weakening_law(res)
+    use = None
+    if c is not None:  # against the friction reached (weakened where it slid)
+        f, coh = (
+            (c.friction_at(res.accumulated), c.cohesion_at(res.accumulated))
+            if weakening
+            else (c.friction, c.cohesion)
+        )
+        use = coulomb_utilisation(res.pn, res.pt, res.state, f, coh)[c.patch]
     out = []
     for fi in range(n_fractures):
         m = np.nonzero(ip.fracture == fi)[0]
@@ -214,6 +223,9 @@ def fracture_fields(ip, res, n_fractures, fluid=None) -> list[FractureFields]:
             pf = np.asarray(fluid, float)[m].copy()
             extra = {"fluid_pressure": pf, "effective_normal_traction": pn}
             pn = pn - pf
+        if weakening:
+            extra["accumulated_slip"] = res.point_accumulated[m].copy()
+            extra["friction_coefficient"] = res.point_friction[m].copy()
         out.append(
             FractureFields(
                 s=ip.s[m].copy(),
@@ -229,6 +241,16 @@ def fracture_fields(ip, res, n_fractures, fluid=None) -> list[FractureFields]:
             )
         )
     return out
+
+
+def _weakening_law(res) -> bool:
+    """Whether a fracture of the contact set has a slip-weakening friction
+    (a finite slip distance; constant Coulomb has D_c = inf): every fracture
+    then reports its accumulated slip and friction."""
+    c = getattr(res, "contact", None)
+    if c is None or res.accumulated is None:
+        return False
+    return bool(np.isfinite(c.slip_distance).any())
 
 
 def vis_mesh(mesh, ec, bulk, u) -> VisMesh:

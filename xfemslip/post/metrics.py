@@ -73,12 +73,13 @@ def slipping_length(s, state, s_lo: float, s_hi: float) -> float:
     return float(np.sum(stretch[np.asarray(state) == SLIP]))
 
 
-def fracture_ends(result: Result, spec: CaseSpec) -> list[tuple[float, float]]:
+def fracture_ends(result: Result, spec: CaseSpec | None) -> list[tuple[float, float]]:
     """The arc-length range [m] of each fracture of ``result`` inside the
     domain: as the result stores it (``fracture_properties``), else from the
     case ``spec`` (a result written before the ends were kept)."""
     if result.fracture_properties is not None:
         return [p.ends for p in result.fracture_properties]
+    assert spec is not None  # a result without the ends needs its case
     return [arc_extent(fracture.points, spec.box) for fracture in spec.fractures]
 
 

@@ -36,7 +36,14 @@ import numpy as np
 
 from xfemslip.post.fields import FractureFields, FractureProperties, StepFields
 
-__all__ = ["TIMED_ATTRS", "EventTable", "PermeabilityHistory", "Result", "run_id"]
+__all__ = [
+    "TIMED_ATTRS",
+    "DepletionTable",
+    "EventTable",
+    "PermeabilityHistory",
+    "Result",
+    "run_id",
+]
 
 
 @dataclass
@@ -76,6 +83,26 @@ class PermeabilityHistory:
 
 
 @dataclass
+class DepletionTable:
+    """What ``xfemslip deplete`` found per fracture (:mod:`xfemslip.studies.
+    depletion`): arrays (F,) in case order, NaN where it did not happen."""
+
+    dp_lower: np.ndarray  # last stuck pore-pressure change [Pa]
+    dp_upper: np.ndarray  # first slipping one [Pa]
+    x: np.ndarray  # first slipping patch [m]
+    y: np.ndarray
+    at_singularity: np.ndarray  # bool: first slip at or next to a singular point
+    singularity: tuple[str, ...]  # what it is ("" when not)
+    dp_patch: np.ndarray  # the slipping length first reaches patch_length [Pa]
+    patch_length: float  # [m]; NaN when not asked for
+    tolerance: float  # of the bisections [Pa]
+
+    @property
+    def dp_critical(self) -> np.ndarray:
+        return 0.5 * (self.dp_lower + self.dp_upper)
+
+
+@dataclass
 class Result:
     """A run's mesh, the fields of its converged load steps and its attributes.
 
@@ -97,6 +124,7 @@ class Result:
     # and the block's permeability with [permeability]
     events: EventTable | None = None
     permeability: PermeabilityHistory | None = None
+    depletion: DepletionTable | None = None  # written by deplete
 
     @property
     def converged(self) -> bool:

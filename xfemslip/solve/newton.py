@@ -215,6 +215,46 @@ class NewtonSolver:
             lam0 = float(lam)
         return self.completed
 
+    # The pieces that path following (xfemslip.solve.continuation) drives:
+    # the equilibrium at a load factor, the residual, the tangent solve, and
+    # the acceptance of a converged state as a step.
+
+    def equilibrium(self, u, lam, step, steps):
+        """Newton (with its remedies) to load factor ``lam`` from ``u`` and
+        the committed history; nothing is committed.  Returns (u, contact
+        result, iterations); raises ConvergenceError."""
+        u, res, log = self._newton(u, lam, step, steps)
+        return u, res, log.iterations
+
+    def residual(self, u, lam, res: ContactResult):
+        """(residual on the free dofs, eta) at u, load factor lam, with the
+        contact result res of u."""
+        return self._residual(u, lam, res)
+
+    def solve_tangent(self, res: ContactResult, r, step, iteration, eta):
+        """x with (K_ff + the contact tangent of res) x = r on the free dofs;
+        ConvergenceError (step, iteration, eta) when the matrix is singular."""
+        return self._solve(res, r, step, iteration, eta)
+
+    def accept(self, step, lam, u, res: ContactResult, iterations) -> StepResult:
+        """Commit the converged state (u, res) at load factor lam as step
+        ``step`` (history, predictor state) and record its StepResult."""
+        self.p.contact.commit(res)
+        self._pn_committed = res.pn.copy()
+        self._lam_committed = lam
+        result = StepResult(
+            step,
+            lam,
+            u.copy(),
+            dataclasses.replace(res, blocks=None),
+            iterations,
+            [],
+            [],
+            factors=[lam],
+        )
+        self.completed.append(result)
+        return result
+
     def _residual(self, u, lam, res: ContactResult):
         f_int = self.p.K @ u + res.force - self.f_c0
         load = self.p.load(lam)

@@ -123,11 +123,17 @@ def local_search(c, law, u, res, r, stubborn, c_dofs, K_ff, free, mode):
     c : the true contact law; c_dofs, K_ff, free : its dofs on, the bulk
     stiffness of, and the free dofs of the Newton system; mode : the tangent.
     """
+    # slip-weakening patches stay out: on them the slip branch is not affine
+    # in the jump (the bound softens with the slip increment), which the
+    # search's closed form assumes; Newton handles them under the true law
+    constant = ~c.weakens
+    first = np.nonzero(stubborn & constant)[0]
+    if first.size == 0:
+        return None
     near = local_branches.neighbours(c_dofs, K_ff, stubborn)
-    first = np.nonzero(stubborn)[0]
     # open neighbours stay out: the search has no open branch, and its
     # Woodbury form assumes a closed (stick) block for every member
-    rest = np.nonzero(near & ~stubborn & (res.state != OPEN))[0]
+    rest = np.nonzero(near & ~stubborn & constant & (res.state != OPEN))[0]
     idx = np.concatenate([first, rest])[: local_branches.MAX_CLUSTER]
     mask = np.zeros(c.n, bool)
     mask[idx] = True
@@ -154,7 +160,11 @@ def local_search(c, law, u, res, r, stubborn, c_dofs, K_ff, free, mode):
     )
     # a patch of the cluster held in stick by a hold gets its own
     # cohesion back (a forced slip needs the finite bound)
-    base = dataclasses.replace(law, cohesion=np.where(mask, c.cohesion, law.cohesion))
+    base = dataclasses.replace(
+        law,
+        cohesion=np.where(mask, c.cohesion, law.cohesion),
+        cohesion_dynamic=np.where(mask, c.cohesion_dynamic, law.cohesion_dynamic),
+    )
     branches = np.asarray(branches)
     moving = branches != 0
     return force_branches(

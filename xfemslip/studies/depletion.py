@@ -37,7 +37,10 @@ import numpy as np
 from xfemslip.contact.interface import COMMITTED
 from xfemslip.conventions import SLIP
 from xfemslip.errors import ConvergenceError, UsageError
+from xfemslip.fem.poro import FACE_OFFSET
 from xfemslip.io.atomic import atomic_path
+from xfemslip.post.metrics import fracture_ends, point_stretches
+from xfemslip.post.result import DepletionTable
 from xfemslip.simulation import solve_and_write
 
 logger = logging.getLogger(__name__)
@@ -67,6 +70,13 @@ class FractureOnset:
     y: float = np.nan
     dp_linear: float = np.nan  # linear-response extrapolation [Pa]
     trials: int = 0  # bisection solves
+    # the first slipping patch holds or touches a singular point of the model
+    # (singular_points): its onset depends on the mesh
+    at_singularity: bool = False
+    singularity: str = ""  # which ("" when not)
+    # the pore-pressure change at which the slipping length first reaches
+    # the patch length asked for (bisected like the first slip) [Pa]
+    dp_patch: float = np.nan
 
     @property
     def dp_critical(self) -> float:
@@ -79,6 +89,7 @@ class DepletionReport:
     onsets: list
     rows: list = field(default_factory=list)  # slip vs depletion table rows
     tolerance: float = 0.0  # [Pa]
+    patch_length: float | None = None  # [m] (--patch-length)
     out_dir: Path | None = None
     wall_time_s: float = 0.0
     written: list = field(default_factory=list)
@@ -86,17 +97,70 @@ class DepletionReport:
 
 def _history(contact):
     """Copy of the committed friction history of a contact set."""
-    return tuple(getattr(contact, name).copy() for name in COMMITTED)
+    return contact.history()
 
 
 def _restore(contact, history) -> None:
-    for name, value in zip(COMMITTED, history, strict=True):
-        setattr(contact, name, value.copy())
+    contact.restore(history)
 
 
 def _slipping(contact, res, fi) -> np.ndarray:
     """Patches of fracture fi in state SLIP."""
     return (contact.fracture == fi) & (res.state == SLIP)
+
+
+def slipping_length(contact, res, fi) -> float:
+    """Length [m] of fracture fi whose patches slip."""
+    return float(contact.weight[_slipping(contact, res, fi)].sum())
+
+
+def singular_points(model, fi, others_slip=False) -> list[tuple[float, str]]:
+    """(arc length [m], what) of the points of fracture fi where the stress
+    that brings it to slip is singular: where the rock or the pressure change
+    on one of its faces changes along it (a reservoir corner on a fault,
+    model.breaks: the stuck state's tractions are log-singular there), and,
+    once another fracture slips (``others_slip``), its junctions.  Its own
+    tips are not: while it sticks, a fracture carries the stress as the
+    intact rock did, and a tip is singular only once slip ends there."""
+    fr = model.fractures[fi]
+    out = []
+    if others_slip:
+        out += [(float(s), "a junction") for s in fr.junction_s]
+    breaks = model.breaks[fi] if model.breaks is not None else ()
+    out += [(float(s), "a reservoir corner") for s in breaks if _corner(model, fr, s)]
+    return out
+
+
+def _corner(model, fr, s) -> bool:
+    """Whether the rock boundary meeting fracture ``fr`` at arc length s ends
+    there (a corner of a unit on the fracture: the faces' rocks change
+    differently), rather than running on through it (a horizon crossing the
+    fracture, with the same rock on both faces before and after: its
+    tractions stay bounded)."""
+    zones = model.materials.zones
+    eps = FACE_OFFSET * model.mesh.h_min
+    ds = max(eps, 1e-6 * float(model.contact.weight.max(initial=1.0)))
+    xy, normal = fr.point_at(np.array([s - ds, s + ds]))
+    plus = zones.at(xy + eps * normal)
+    minus = zones.at(xy - eps * normal)
+    through = plus[0] == minus[0] and plus[1] == minus[1]
+    return not through
+
+
+def at_singularity(model, fi, patch, others_slip=False) -> str:
+    """What singular point of fracture fi (:func:`singular_points`) the
+    contact patch ``patch`` holds or lies next to (within its own length
+    along the fracture), or ""."""
+    ip, c = model.ip, model.contact
+    s = ip.s[c.patch == patch]
+    lo, hi = float(s.min()), float(s.max())
+    reach = float(c.weight[patch])
+    near = [
+        (min(abs(p - lo), abs(p - hi)) if not lo <= p <= hi else 0.0, what)
+        for p, what in singular_points(model, fi, others_slip)
+    ]
+    near = [(d, what) for d, what in near if d <= reach]
+    return min(near)[1] if near else ""
 
 
 def _patch_centres(model) -> np.ndarray:
@@ -134,23 +198,40 @@ def _linear_onset(contact, fi, pn0, pt0, lam_lo, pn_lo, pt_lo) -> float:
 
 
 def _table_rows(result, change, n) -> list:
-    """Slip vs depletion rows: step, load factor, dp, and per fracture the max
+    """Slip vs depletion rows: step, load factor, dp, per fracture the max
     slip and the slipping length of its event sizes (``result.events``,
     :mod:`xfemslip.post.events`: the slip that slid, the elastic give of stuck
-    points left out), from the in-situ state (step 0) on; n fractures."""
-    rows = [(0, 0.0, 0.0, [(0.0, 0.0)] * n)]
+    points left out), and per fracture the mean slip over its slipping
+    length, from the in-situ state (step 0) on; n fractures."""
+    rows = [(0, 0.0, 0.0, [(0.0, 0.0)] * n, [0.0] * n)]
     events = result.events
+    ends = fracture_ends(result, None)
     for k, step in enumerate(result.steps):
         per = [
             (float(events.max_slip[k, i]), float(events.slipping_length[k, i]))
             for i in range(n)
         ]
-        rows.append((step.step, step.load_factor, step.load_factor * change, per))
+        means = [_mean_slip(ff, ends[i]) for i, ff in enumerate(step.fractures)]
+        rows.append(
+            (step.step, step.load_factor, step.load_factor * change, per, means)
+        )
     return rows
 
 
-def critical_depletion(solver, model, steps, tolerance, onsets=None):
-    """Run the steps with bisection of every fracture's first slip.
+def _mean_slip(ff, ends) -> float:
+    """Mean |slip that slid| [m] over the points in slip (0 without)."""
+    w = point_stretches(ff.s, *ends)
+    slipping = np.asarray(ff.state) == SLIP
+    length = float(w[slipping].sum())
+    if length == 0.0:
+        return 0.0
+    return float(np.sum(w[slipping] * np.abs(ff.slid[slipping])) / length)
+
+
+def critical_depletion(solver, model, steps, tolerance, onsets=None, patch_length=None):
+    """Run the steps with bisection of every fracture's first slip (and,
+    with ``patch_length`` [m], of the change at which its slipping length
+    first reaches it).
 
     Returns (onsets, results).  ``tolerance`` [Pa] is the final bracket width
     in pore pressure.  ``onsets``: a list to fill with one FractureOnset per
@@ -161,22 +242,23 @@ def critical_depletion(solver, model, steps, tolerance, onsets=None):
         onsets = []
     onsets[:] = [FractureOnset(fracture=fr.index) for fr in model.fractures]
     try:
-        _step_and_bisect(solver, model, steps, tolerance, onsets)
+        _step_and_bisect(solver, model, steps, tolerance, onsets, patch_length)
     finally:
         _drop_nonlinear(onsets)
     return onsets, solver.completed
 
 
-def _step_and_bisect(solver, model, steps, tolerance, onsets) -> None:
+def _step_and_bisect(solver, model, steps, tolerance, onsets, patch_length) -> None:
     """The loop of critical_depletion: fills ``onsets`` in place."""
     change = model.pore.change
     contact = model.contact
     n_frac = len(model.fractures)
     found = [False] * n_frac
+    grown = [patch_length is None] * n_frac
     centres = _patch_centres(model)
     pn0, pt0 = contact.pn0.copy(), contact.pt_committed.copy()
     for fi in range(n_frac):
-        found[fi] = _slips_in_situ(solver.in_situ, contact, onsets[fi], fi, centres)
+        found[fi] = _slips_in_situ(solver.in_situ, model, onsets[fi], fi, centres)
     u = np.zeros(model.problem.n_dofs)
     lam0 = 0.0
     prev_res = None
@@ -187,31 +269,68 @@ def _step_and_bisect(solver, model, steps, tolerance, onsets) -> None:
         u = solver._advance(u, lam0, lam1, k, steps)
         res = solver.completed[-1].contact
         after = _history(contact)
-        new = [
-            fi
-            for fi in range(n_frac)
-            if not found[fi] and _slipping(contact, res, fi).any()
-        ]
-        for fi in new:
-            found[fi] = True
-            bracket = _Bracket(before, u_before, lam0, lam1, k, steps, prev_res)
-            pn_lo, pt_lo = _bisect(
-                solver, contact, onsets[fi], fi, bracket, tolerance, centres, change
-            )
-            lam_lo = onsets[fi].dp_lower / change if change else 0.0
-            onsets[fi].dp_linear = change * _linear_onset(
-                contact, fi, pn0, pt0, lam_lo, pn_lo, pt_lo
-            )
+        bracket = _Bracket(before, u_before, lam0, lam1, k, steps, prev_res)
+        for fi in range(n_frac):
+            if not found[fi] and _slipping(contact, res, fi).any():
+                found[fi] = True
+                others = any(found[j] for j in range(n_frac) if j != fi)
+                lo_res = _first_slip(
+                    solver, model, onsets[fi], fi, bracket, tolerance, centres, others
+                )
+                lam_lo = onsets[fi].dp_lower / change if change else 0.0
+                pn_lo, pt_lo = (
+                    (
+                        contact.pn0.copy(),
+                        bracket.history[COMMITTED.index("pt_committed")].copy(),
+                    )
+                    if lo_res is None
+                    else (lo_res.pn, lo_res.pt)
+                )
+                onsets[fi].dp_linear = change * _linear_onset(
+                    contact, fi, pn0, pt0, lam_lo, pn_lo, pt_lo
+                )
+            if not grown[fi] and slipping_length(contact, res, fi) >= patch_length:
+                grown[fi] = True
+                lo, hi, *_ = _bisect(
+                    solver,
+                    contact,
+                    bracket,
+                    tolerance / abs(change),
+                    lambda r, fi=fi: slipping_length(contact, r, fi) >= patch_length,
+                )
+                onsets[fi].dp_patch = 0.5 * (lo + hi) * change
+                logger.info(
+                    "fracture %d: slipping over %.4g m from dp = %.6g Pa",
+                    onsets[fi].fracture,
+                    patch_length,
+                    onsets[fi].dp_patch,
+                )
         _restore(contact, after)
         prev_res = res
         lam0 = lam1
 
 
-def _slips_in_situ(zero, contact, onset, fi, centres) -> bool:
+def _note_singularity(model, onset, fi, patch, others_slip=False) -> None:
+    """Record and say whether the first slip sits at a singular point."""
+    what = at_singularity(model, fi, patch, others_slip)
+    onset.at_singularity, onset.singularity = bool(what), what
+    if what:
+        logger.info(
+            "fracture %d: the first slip sits at %s, where the stress of the "
+            "model is singular: its depletion depends on the mesh (it falls as "
+            "the mesh is refined); the growth of the slipping patch converges "
+            "(--patch-length)",
+            onset.fracture,
+            what,
+        )
+
+
+def _slips_in_situ(zero, model, onset, fi, centres) -> bool:
     """A fracture whose in-situ shear is already above the friction limit
     slips at dp = 0 (the first load step releases the excess: see
     ContactSet.in_situ_force); its onset is the initial state, found without
     bisection, at the patch with the largest excess.  Returns whether it does."""
+    contact = model.contact
     over = np.nonzero(_slipping(contact, zero, fi))[0]
     if over.size == 0:
         return False
@@ -219,13 +338,15 @@ def _slips_in_situ(zero, contact, onset, fi, centres) -> bool:
         zero.pt[over]
     )
     onset.dp_lower = onset.dp_upper = onset.dp_linear = 0.0
-    onset.x, onset.y = (float(v) for v in centres[over[np.argmax(excess)]])
+    j = over[np.argmax(excess)]
+    onset.x, onset.y = (float(v) for v in centres[j])
     logger.info(
         "fracture %d: slips in situ, before any depletion (its initial shear "
         "traction is above the friction limit on %d patch(es))",
         onset.fracture,
         over.size,
     )
+    _note_singularity(model, onset, fi, j)
     return True
 
 
@@ -271,32 +392,46 @@ def _trial(solver, contact, bracket, lam):
         return solver.completed.pop().contact
 
 
-def _bisect(solver, contact, onset, fi, bracket, tolerance, centres, change):
-    """Bracket the first slip of fracture fi in (lam0, lam1] (see module doc).
-
-    Returns the patch tractions (p_N, p_T) at the stuck lower bracket.
-    """
+def _bisect(solver, contact, bracket, width, happened):
+    """(lo, hi, lo_res, hi_res, trials): the load factors between which
+    ``happened(contact result)`` first holds in the bracket's step, to
+    ``width`` in load factor (lo_res None at the initial state)."""
     lo, hi = bracket.lam0, bracket.lam1
     hi_res = solver.completed[-1].contact
     lo_res = bracket.res0
-    width = tolerance / abs(change)
+    trials = 0
     while hi - lo > width:
         mid = 0.5 * (lo + hi)
-        if onset.trials >= MAX_BISECTIONS or not lo < mid < hi:
+        if trials >= MAX_BISECTIONS or not lo < mid < hi:
             logger.warning(
-                "fracture %d: bisection stopped after %d solves with the bracket "
-                "%.3g Pa wide (the load factor cannot be split further)",
-                onset.fracture,
-                onset.trials,
-                (hi - lo) * abs(change),
+                "bisection stopped after %d solves with the bracket %.3g of the "
+                "load wide (the load factor cannot be split further)",
+                trials,
+                hi - lo,
             )
             break
         res = _trial(solver, contact, bracket, mid)
-        onset.trials += 1
-        if _slipping(contact, res, fi).any():
+        trials += 1
+        if happened(res):
             hi, hi_res = mid, res
         else:
             lo, lo_res = mid, res
+    return lo, hi, lo_res, hi_res, trials
+
+
+def _first_slip(solver, model, onset, fi, bracket, tolerance, centres, others):
+    """Bracket the first slip of fracture fi in (lam0, lam1] (module doc);
+    returns the contact result at the stuck lower bracket (None: in situ)."""
+    contact = model.contact
+    change = model.pore.change
+    lo, hi, lo_res, hi_res, trials = _bisect(
+        solver,
+        contact,
+        bracket,
+        tolerance / abs(change),
+        lambda r: _slipping(contact, r, fi).any(),
+    )
+    onset.trials += trials
     onset.dp_lower, onset.dp_upper = lo * change, hi * change
     first = np.nonzero(_slipping(contact, hi_res, fi))[0]
     # the patch with the largest utilisation |p_T| / (c - f p_N) at hi
@@ -314,9 +449,8 @@ def _bisect(solver, contact, onset, fi, bracket, tolerance, centres, change):
         onset.y,
         onset.trials,
     )
-    if lo_res is None:  # lo = 0: the initial state
-        return contact.pn0.copy(), bracket.history[3].copy()
-    return lo_res.pn, lo_res.pt
+    _note_singularity(model, onset, fi, j, others)
+    return lo_res
 
 
 def resolved_tolerance(spec, tolerance=None) -> float:
@@ -341,11 +475,22 @@ def resolved_tolerance(spec, tolerance=None) -> float:
     return tolerance
 
 
-def deplete(spec, out_dir=None, *, tolerance=None, plot=False, overwrite=False):
+def deplete(
+    spec,
+    out_dir=None,
+    *,
+    tolerance=None,
+    plot=False,
+    overwrite=False,
+    patch_length=None,
+):
     """Critical depletion of every fracture of a case; writes the outputs.
 
     tolerance : bisection bracket width in pore pressure [Pa]; default
     DEFAULT_REL_TOLERANCE * |pore_pressure.change|.
+    patch_length : [m] also bisect the change at which each fracture's
+    slipping length first reaches it (converges under mesh refinement where
+    the first slip does not).
     Raises UsageError when the case has no [pore_pressure] or no fracture.
     """
     start = time.perf_counter()
@@ -368,8 +513,13 @@ def deplete(spec, out_dir=None, *, tolerance=None, plot=False, overwrite=False):
             f"{spec.path}: pore_pressure.change = 0: xfemslip deplete needs a "
             "non-zero pore-pressure change to search for the first slip"
         )
+    if patch_length is not None and not patch_length > 0.0:
+        raise UsageError(f"--patch-length must be > 0 m, got {patch_length!r}")
     tolerance = resolved_tolerance(spec, tolerance)
-    report = DepletionReport(onsets=[], tolerance=tolerance)
+    report = DepletionReport(onsets=[], tolerance=tolerance, patch_length=patch_length)
+
+    def annotate(result, model) -> None:
+        result.depletion = depletion_table(report)
 
     def finish(done, folder: Path) -> None:
         """The tables and figures, into the output set before it is swapped in."""
@@ -390,17 +540,38 @@ def deplete(spec, out_dir=None, *, tolerance=None, plot=False, overwrite=False):
         out_dir,
         overwrite,
         lambda solver, model: critical_depletion(
-            solver, model, spec.loading.steps, tolerance, report.onsets
+            solver, model, spec.loading.steps, tolerance, report.onsets, patch_length
         ),
         finish,
         # the series' time is the size of the pore-pressure change reached
         # [Pa]: increasing over the steps, whichever its sign
         step_time=lambda load_factor: abs(load_factor * change),
+        annotate=annotate,
     )
     report.wall_time_s = time.perf_counter() - start
     if done.failure is not None:
         raise done.failure
     return report
+
+
+def depletion_table(report: DepletionReport) -> DepletionTable:
+    """What the report found, as result.h5 keeps it (``/depletion``)."""
+    o = report.onsets
+
+    def col(name):
+        return np.array([getattr(a, name) for a in o], float)
+
+    return DepletionTable(
+        dp_lower=col("dp_lower"),
+        dp_upper=col("dp_upper"),
+        x=col("x"),
+        y=col("y"),
+        at_singularity=np.array([a.at_singularity for a in o], bool),
+        singularity=tuple(a.singularity for a in o),
+        dp_patch=col("dp_patch"),
+        patch_length=np.nan if report.patch_length is None else report.patch_length,
+        tolerance=report.tolerance,
+    )
 
 
 def write_tables(report: DepletionReport, out_dir: Path) -> list:
@@ -418,8 +589,13 @@ def write_tables(report: DepletionReport, out_dir: Path) -> list:
                 "x_first_slip_m",
                 "y_first_slip_m",
                 "dp_linear_Pa",
+                "first_slip_at_singularity",
+                "singularity",
+                "patch_length_m",
+                "dp_patch_length_Pa",
             ]
         )
+        length = report.patch_length if report.patch_length is not None else np.nan
         for o in report.onsets:
             w.writerow(
                 [
@@ -431,6 +607,10 @@ def write_tables(report: DepletionReport, out_dir: Path) -> list:
                     f"{o.x:.6g}",
                     f"{o.y:.6g}",
                     f"{o.dp_linear:.9g}",
+                    "true" if o.at_singularity else "false",
+                    o.singularity,
+                    f"{length:.6g}",
+                    f"{o.dp_patch:.9g}",
                 ]
             )
     table = out_dir / "slip_vs_depletion.csv"
@@ -440,13 +620,48 @@ def write_tables(report: DepletionReport, out_dir: Path) -> list:
         head = ["step", "load_factor", "dp_Pa"]
         for i in range(n):
             head += [f"max_abs_slip_{i}_m", f"slip_length_{i}_m"]
+        head += [f"mean_slip_{i}_m" for i in range(n)]
         w.writerow(head)
-        for step, lam, dp, per in report.rows:
+        for step, lam, dp, per, means in report.rows:
             row = [step, f"{lam:.9g}", f"{dp:.9g}"]
             for s, length in per:
                 row += [f"{s:.9g}", f"{length:.9g}"]
+            row += [f"{m:.9g}" for m in means]
             w.writerow(row)
     return [crit, table]
+
+
+def depletion_lines(table: DepletionTable) -> list[str]:
+    """What ``deplete`` found, in words, from what result.h5 keeps
+    (``/depletion``): per fracture its first slip, whether it sits at a
+    singular point (then mesh-dependent), and the change at which the
+    slipping patch reached the asked length."""
+    lines = [f"critical depletion (bisection to {table.tolerance:.4g} Pa):"]
+    for i, dp in enumerate(table.dp_critical):
+        if not np.isfinite(dp):
+            lines.append(f"  fracture {i}: does not slip")
+            continue
+        text = (
+            f"  fracture {i}: first slip at dp = {dp / 1e6:.4g} MPa at "
+            f"({table.x[i]:.4g}, {table.y[i]:.4g}) m"
+        )
+        if table.at_singularity[i]:
+            text += (
+                f", at {table.singularity[i]} where the stress is singular "
+                "(mesh-dependent)"
+            )
+        lines.append(text)
+        if np.isfinite(table.patch_length):
+            reached = table.dp_patch[i]
+            lines.append(
+                f"    slipping over {table.patch_length:g} m "
+                + (
+                    f"from dp = {reached / 1e6:.4g} MPa"
+                    if np.isfinite(reached)
+                    else "not reached"
+                )
+            )
+    return lines
 
 
 def format_report(report: DepletionReport) -> str:
@@ -466,6 +681,24 @@ def format_report(report: DepletionReport) -> str:
             f"{f'[{o.dp_lower:.6g}, {o.dp_upper:.6g}]':>27} "
             f"{f'({o.x:.4g}, {o.y:.4g})':>26} {o.dp_linear:>15.6g}"
         )
+        if o.at_singularity:
+            lines.append(
+                f"{'':>8} first slip at {o.singularity}, where the stress is "
+                "singular: this depletion depends on the mesh"
+            )
+    if report.patch_length is not None:
+        lines.append(
+            f"slipping over {report.patch_length:g} m (converges with the mesh): "
+            + ", ".join(
+                f"fracture {o.fracture} "
+                + (
+                    f"at dp = {o.dp_patch:.6g} Pa"
+                    if np.isfinite(o.dp_patch)
+                    else "not reached"
+                )
+                for o in report.onsets
+            )
+        )
     lines.append(
         "slip vs depletion (max |slip| that slid [m] / slipping length [m] per "
         "fracture):"
@@ -475,7 +708,7 @@ def format_report(report: DepletionReport) -> str:
         f"{'step':>5} {'dp [Pa]':>12} "
         + " ".join(f"{f'frac {i}':>23}" for i in range(n))
     )
-    for step, _lam, dp, per in report.rows:
+    for step, _lam, dp, per, _means in report.rows:
         lines.append(
             f"{step:>5} {dp:>12.5g} "
             + " ".join(f"{s:>11.4g} / {length:>9.4g}" for s, length in per)

@@ -81,6 +81,13 @@ def _contact_points(rng, n=600, J=3):
     angle = rng.uniform(0, np.pi, n)
     normal = np.column_stack([np.cos(angle), np.sin(angle)])
     tangent = np.column_stack([-normal[:, 1], normal[:, 0]])
+    friction = rng.uniform(0.0, 0.8, n)
+    cohesion = rng.uniform(0.0, 1e6, n) * (rng.random(n) < 0.5)
+    # two thirds of the points weaken (friction, and cohesion on half of
+    # those), over slip distances of a few penalty slips, from accumulated
+    # slips before, within and past the weakening range
+    weak = rng.random(n) < 2.0 / 3.0
+    distance = np.where(weak, rng.uniform(2e-6, 5e-5, n), np.inf)
     return dict(
         ip_dofs=dofs.astype(np.int64),
         ip_coef=rng.uniform(-2.0, 2.0, (n, J)),
@@ -89,10 +96,14 @@ def _contact_points(rng, n=600, J=3):
         ip_weight=rng.uniform(0.01, 0.1, n),
         pn0=-rng.uniform(0.0, 2e7, n),
         slip_old=rng.normal(0.0, 1e-5, n),
+        accumulated_old=np.where(weak, rng.uniform(0.0, 1.2, n) * distance, 0.0),
         kn=rng.uniform(1e12, 1e14, n),
         kt=rng.uniform(1e12, 1e14, n),
-        friction=rng.uniform(0.0, 0.8, n),
-        cohesion=rng.uniform(0.0, 1e6, n) * (rng.random(n) < 0.5),
+        friction=friction,
+        cohesion=cohesion,
+        friction_dynamic=np.where(weak, friction * rng.uniform(0.3, 1.0, n), friction),
+        cohesion_dynamic=np.where(weak & (rng.random(n) < 0.5), 0.0, cohesion),
+        slip_distance=distance,
     )
 
 
@@ -107,6 +118,7 @@ def _respond(impl, u, pts, mode, pt_prev, gt_prev):
         out_pt=np.zeros(n),
         out_state=np.zeros(n, np.int8),
         out_slip=np.zeros(n),
+        out_accumulated=np.zeros(n),
     )
     impl.contact_response(u, **pts, tangent_mode=mode, pt_prev=pt_prev,
                           gt_prev=gt_prev, **out)  # fmt: skip

@@ -18,7 +18,10 @@ F, C = 0.5, 0.2e6  # friction [-], cohesion [Pa]
 
 
 def _rm(gn, gt, slip_old=0.0, pn0=0.0, kn=KN, kt=KT, f=F, c=C):
-    return coulomb_return_map(gn, gt, slip_old, pn0, kn, kt, f, c)
+    """The return map of constant Coulomb friction (no accumulated slip, f_d
+    = f, c_d = c, D_c = inf): (pn, pt, state, slip, d_nn, d_nt, d_tn, d_tt)."""
+    out = coulomb_return_map(gn, gt, slip_old, 0.0, pn0, kn, kt, f, c, f, c, np.inf)
+    return out[:4] + out[5:]
 
 
 # ---------------------------------------------------------------- scalar return map
@@ -244,10 +247,14 @@ def _call(u, d, mode):
         d["weight"],
         d["pn0"],
         d["slip_old"],
+        np.zeros(n),
         d["kn"],
         d["kt"],
         d["friction"],
         d["cohesion"],
+        d["friction"],
+        d["cohesion"],
+        np.full(n, np.inf),
         mode,
         d["pt_prev"],
         d["gt_prev"],
@@ -259,6 +266,7 @@ def _call(u, d, mode):
         out["pt"],
         out["state"],
         out["slip"],
+        np.zeros(n),
     )
     return out
 
