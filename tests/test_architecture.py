@@ -6,7 +6,10 @@
 - no import of an underscored name from another module, and a private module
   (``kernels/_config.py``) imported only from inside its own subpackage;
 - at most MAX_TOP_LEVEL modules at the top of the package;
-- Numba imported only under ``kernels/``.
+- Numba imported only under ``kernels/``;
+- the numerical subpackages (NUMERICAL) import nothing from the case reader
+  (``case/``): they own their defaults, and the reader takes its defaults
+  from them.
 
 The checks are run on small hand-made graphs too, so that each can fail.
 """
@@ -22,6 +25,7 @@ import pytest
 import xfemslip
 
 MAX_TOP_LEVEL = 8
+NUMERICAL = ("solve", "contact", "fem", "kernels", "geometry")
 PACKAGE = Path(xfemslip.__file__).parent
 
 
@@ -156,6 +160,21 @@ def numba_outside_kernels(modules: dict[str, Path]) -> list[str]:
     ]
 
 
+def numerics_on_case(modules: dict[str, Path]) -> list[str]:
+    """Imports of xfemslip.case (or anything under it) from the NUMERICAL
+    subpackages."""
+    inside = tuple(f"xfemslip.{sub}" for sub in NUMERICAL)
+    bad = []
+    for name, path in modules.items():
+        if unit(name) not in inside:
+            continue
+        for target, what, _ in imports(name, path, modules):
+            full = target if what is None else f"{target}.{what}"
+            if full == "xfemslip.case" or full.startswith("xfemslip.case."):
+                bad.append(f"{name}: {full}")
+    return bad
+
+
 def top_level(modules: dict[str, Path]) -> list[str]:
     return [
         name
@@ -199,6 +218,17 @@ def test_numba_only_in_kernels(modules):
     assert numba_outside_kernels(modules) == []
 
 
+def test_numerics_import_nothing_from_case(modules):
+    users = [
+        name
+        for name, path in modules.items()
+        if any(top == "xfemslip" for _, _, top in imports(name, path, modules))
+        and unit(name) in {f"xfemslip.{sub}" for sub in NUMERICAL}
+    ]
+    assert "xfemslip.solve.newton" in users  # the walk sees the numerics' imports
+    assert numerics_on_case(modules) == []
+
+
 def test_the_checks_fail_on_a_bad_package(tmp_path):
     """A small package with each defect: every check reports it."""
     root = tmp_path / "xfemslip"
@@ -212,6 +242,15 @@ def test_the_checks_fail_on_a_bad_package(tmp_path):
         "sub/y.py": "",
         "sub/_conf.py": "",
         "d.py": "from xfemslip.sub import y\nfrom xfemslip.sub._conf import k\n",
+        "case/__init__.py": "",
+        "case/specs.py": "K = 1.0\n",
+        "solve/__init__.py": "",
+        "solve/newton.py": "from xfemslip.case.specs import K\n",
+        "fem/__init__.py": "",
+        "fem/mesh.py": "def f():\n    from xfemslip import case\n",
+        "geometry/__init__.py": "from xfemslip.case import specs\n",
+        "contact/__init__.py": "import xfemslip.case.specs\n",
+        "kernels/__init__.py": "from xfemslip.sub import y\n",
         **{f"t{i}.py": "" for i in range(MAX_TOP_LEVEL)},
     }
     for rel, text in files.items():
@@ -229,4 +268,10 @@ def test_the_checks_fail_on_a_bad_package(tmp_path):
         "xfemslip.d: private module xfemslip.sub._conf",
     ]
     assert numba_outside_kernels(mods) == ["xfemslip.c"]
+    assert numerics_on_case(mods) == [
+        "xfemslip.contact: xfemslip.case.specs",
+        "xfemslip.fem.mesh: xfemslip.case",
+        "xfemslip.geometry: xfemslip.case.specs",
+        "xfemslip.solve.newton: xfemslip.case.specs.K",
+    ]
     assert len(top_level(mods)) == MAX_TOP_LEVEL + 4

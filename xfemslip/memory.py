@@ -19,21 +19,11 @@ The peak resident memory of a run is modelled from the sizes that set it
   (TRIPLET_BYTES per entry) and, on the NumPy kernels, the shape-function
   gradients of all quadrature points at once (NUMPY_QP_FUNCTION_BYTES per
   point and function, 4 + S functions);
-- ``solver``: the stiffness, its free-dof part, the Newton matrix and its
-  CSC copy (MATRIX_BYTES per non-zero) and, with SuperLU, LU_FACTORS sparse
-  LU factorizations (the kept one while the next is built), whose fill grows
-  like nnz * log2(n_dofs) with a fill-reducing ordering (LU_BYTES per
-  non-zero and per log2); with MKL PARDISO (the mkl extra), one factorization
-  (PARDISO_BYTES per non-zero and per log2, measured on the reservoir case
-  from 324k to 2.0M dofs) and the dense Schur complement of the contact dofs
-  with its LU (16 B per entry, up to SCHUR_MAX_DOFS of them) or, with more
-  contact dofs, that of the patches' jumps and its inverse part
-  (lowrank.LowRankSystems: 2 rows per patch, 16 B per entry, up to
-  lowrank.MAX_ROWS rows); with AMG
-  (linsolve.choose), its hierarchy and set-up (AMG_BYTES per non-zero),
-  the GMRES basis (AMG_RESTART + 1 vectors) and the kept solutions that
-  start each solve (solve.guess.KEEP vectors).
-  A run whose AMG solve fails over to SuperLU may need more than estimated;
+- ``solver``: what the linear solver the run will take holds at once
+  (xfemslip.solve.linear: planned_solver states the choice, solver_bytes
+  the bytes of its matrices, factorizations -- with the Schur complement
+  of the contact dofs, or of the patches' jumps on networks -- or AMG
+  hierarchy and Krylov vectors);
 - ``contact tangents``, during the Newton iterations: the contact tangent
   blocks of every patch, padded to the widest (8 B per entry), NEWTON_BLOCKS
   arrays of them at once (the iterate's, the next one's -- a line-search
@@ -83,6 +73,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from xfemslip.case.specs import CaseSpec
 from xfemslip.errors import MeshError, UsageError
 
 logger = logging.getLogger(__name__)
@@ -102,16 +93,6 @@ GRID_BYTES = 800.0
 # per enriched-cell quadrature point and shape function, NumPy kernels only:
 # gradients, weighted gradients and their gathered cell data [B]
 NUMPY_QP_FUNCTION_BYTES = 56.0
-# per stiffness non-zero: K, K_ff, K_ff + K_contact and its CSC copy, 12 B
-# each (8 B value, 4 B index) [B]
-MATRIX_BYTES = 48.0
-LU_BYTES = 5.0  # per stiffness non-zero and per log2(n_dofs), one factor [B]
-LU_FACTORS = 2  # factorizations held at once
-# MKL PARDISO's factorization, per stiffness non-zero and per log2(n_dofs):
-# whole runs of the reservoir case peaked at 1043 / 2987 / 5892 MB at 324k /
-# 986k / 2.0M dofs (benchmarks/scaling.py), 5.2-5.6 B after the other terms [B]
-PARDISO_BYTES = 6.0
-AMG_BYTES = 40.0  # per stiffness non-zero: hierarchy and its set-up [B]
 NEWTON_BLOCKS = 3  # contact tangent-block arrays held at once (+1 on NumPy)
 NNZ_PER_ENTRY = 0.56  # CSR non-zeros per COO entry (shared nodes summed)
 # Enriched-cell quadrature points, estimated before the cells are cut: a
@@ -170,25 +151,9 @@ def estimate_terms(fp: Footprint) -> dict[str, float]:
     triplets = GRID_BYTES * fp.n_nodes + TRIPLET_BYTES * fp.enriched_entries
     assembly = chunk * (8 + 2 * fp.slots) ** 2 * 8.0
     assembly += max(gradients, triplets)  # one after the other
-    if fp.linear == "amg":
-        from xfemslip.solve.guess import KEEP
-        from xfemslip.solve.linear import AMG_RESTART
+    from xfemslip.solve.linear import solver_bytes
 
-        solver = fp.nnz * (MATRIX_BYTES + AMG_BYTES)
-        solver += (AMG_RESTART + 1 + KEEP) * 8.0 * fp.n_dofs
-    elif fp.linear == "pardiso":
-        from xfemslip.solve.lowrank import MAX_ROWS as LOWRANK_MAX_ROWS
-        from xfemslip.solve.pardiso import SCHUR_MAX_DOFS
-
-        log_n = math.log2(max(fp.n_dofs, 2))
-        solver = fp.nnz * (MATRIX_BYTES + PARDISO_BYTES * log_n)
-        if fp.contact_dofs <= SCHUR_MAX_DOFS:
-            solver += 16.0 * fp.contact_dofs**2
-        elif 2.0 * fp.patches <= LOWRANK_MAX_ROWS:
-            solver += 16.0 * (2.0 * fp.patches) ** 2
-    else:
-        log_n = math.log2(max(fp.n_dofs, 2))
-        solver = fp.nnz * (MATRIX_BYTES + LU_FACTORS * LU_BYTES * log_n)
+    solver = solver_bytes(fp.linear, fp.nnz, fp.n_dofs, fp.contact_dofs, fp.patches)
     arrays = NEWTON_BLOCKS + (0 if fp.numba else 1)
     tangents = arrays * 8.0 * fp.patches * fp.block**2
     tangents += TRIPLET_BYTES * fp.contact_entries
@@ -212,7 +177,7 @@ def estimate_terms(fp: Footprint) -> dict[str, float]:
     }
 
 
-def estimate_dofs(spec) -> int:
+def estimate_dofs(spec: CaseSpec) -> int:
     """Upper estimate of the number of dofs of a validated case."""
     nx, ny = spec.mesh.x.size - 1, spec.mesh.y.size - 1
     h = float(min(np.diff(spec.mesh.x).min(), np.diff(spec.mesh.y).min()))
@@ -224,7 +189,7 @@ def estimate_dofs(spec) -> int:
     return int(2 * (nx + 1) * (ny + 1) + enriched)
 
 
-def case_footprint(spec) -> Footprint:
+def case_footprint(spec: CaseSpec) -> Footprint:
     """From the case alone (before the mesh): the standard part exactly, the
     enrichment from the fracture lengths (no slots, no quadrature: a lower
     estimate for crowded fractures, which enriched_footprint refines)."""
@@ -258,13 +223,13 @@ def case_footprint(spec) -> Footprint:
     )
 
 
-def _patches(spec, length, h, points) -> float:
+def _patches(spec: CaseSpec, length: float, h: float, points: float) -> float:
     """Contact patches: one per contact_patch cells of fracture, or per point."""
     cells = spec.solver.contact_patch
     return points if cells <= 0 else min(points, length / (cells * h) + 2.0)
 
 
-def enriched_footprint(spec, mesh, fractures, cand) -> Footprint:
+def enriched_footprint(spec: CaseSpec, mesh, fractures, cand) -> Footprint:
     """From the built fractures and their node enrichments (enrichment.
     Candidates), before the enriched cells are cut: the enriched cells and
     their slots exactly (the cells around each enriched node, as
@@ -404,7 +369,7 @@ def configure_allocator() -> bool:
     if "glibc.malloc." in os.environ.get("GLIBC_TUNABLES", ""):
         return False
     try:
-        if not os.confstr("CS_GNU_LIBC_VERSION").startswith("glibc"):
+        if not (os.confstr("CS_GNU_LIBC_VERSION") or "").startswith("glibc"):
             return False
         mallopt = ctypes.CDLL(None).mallopt
     except (ValueError, OSError, AttributeError):  # not glibc
@@ -419,56 +384,29 @@ def configure_allocator() -> bool:
     return True
 
 
-def _linear(spec, x, y, n_dofs, band_share=None) -> str:
-    """The linear solver (linsolve.choose) for a mesh with grid lines x, y
-    and about n_dofs free dofs; ``band_share()`` gives the share of them in
-    the AMG band, and is called only when that decides between AMG and
-    SuperLU (None: taken as 0, not known yet)."""
-    from xfemslip.solve import linear as linsolve
+def _linear(spec: CaseSpec, x, y, n_dofs, band_share=None) -> str:
+    """The linear solver the run will take (linsolve.planned_solver) on a
+    mesh with grid lines x, y and about n_dofs free dofs; ``band_share()``
+    gives the share of them in the AMG band (None: not known yet)."""
+    from xfemslip.solve.linear import planned_solver
 
-    method = spec.solver.linear_solver
-    if method != "auto":
-        return method
-    if n_dofs < min(linsolve.AUTO_AMG_MIN_DOFS, linsolve.AUTO_PARDISO_MIN_DOFS):
-        return "superlu"
-    # the grid lines as node coordinates (cell_aspect_ratio reads those)
-    lines = np.zeros((x.size + y.size, 2))
-    lines[: x.size, 0], lines[x.size :, 1] = x, y
-    lines[: x.size, 1], lines[x.size :, 0] = y[0], x[0]
-    # the band only narrows AMG down to SuperLU: with no band, anything but
-    # "amg" is the answer already
-    choice = linsolve.choose(method, n_dofs, lines, 0.0)
-    if choice != "amg" or band_share is None:
-        return choice
-    return linsolve.choose(method, n_dofs, lines, band_share())
+    return planned_solver(spec.solver.linear_solver, n_dofs, x, y, band_share)
 
 
 def _problem_band_share(problem) -> float:
     """Share of the Problem's dofs in the AMG band, as "auto" forms it."""
-    from xfemslip.solve import linear as linsolve
+    from xfemslip.solve.linear import system_facts
 
-    enr = np.arange(problem.n_dofs) >= 2 * problem.node_xy.shape[0]
-    mask = linsolve.band_mask(problem.K, enr, linsolve.AMG_BAND_LAYERS)
-    return float(mask.sum()) / problem.n_dofs
+    return system_facts(problem.K, np.arange(problem.n_dofs), problem.node_xy)[
+        "band_share"
+    ]
 
 
 def _band_share(mesh, cand, n_dofs) -> float:
-    """Share of the dofs in the AMG band (linsolve.system_facts) before the
-    stiffness exists: the enriched dofs and the standard ones of the nodes
-    within AMG_BAND_LAYERS node rings of an enriched node (an enriched dof
-    couples to the nodes of its support, each layer adds a ring)."""
-    from xfemslip.solve.linear import AMG_BAND_LAYERS
+    """Share of the dofs in the AMG band before the stiffness exists."""
+    from xfemslip.solve.linear import grid_band_share
 
-    grid = np.zeros((mesh.ny + 1, mesh.nx + 1), bool)
-    grid.flat[np.unique(cand.node)] = True
-    for _ in range(AMG_BAND_LAYERS):
-        ring = grid.copy()
-        ring[1:] |= grid[:-1]
-        ring[:-1] |= grid[1:]
-        ring[:, 1:] |= ring[:, :-1].copy()
-        ring[:, :-1] |= ring[:, 1:].copy()
-        grid = ring
-    return (2.0 * grid.sum() + 2.0 * cand.node.size) / max(n_dofs, 1)
+    return grid_band_share((mesh.nx, mesh.ny), cand.node, n_dofs)
 
 
 def available_bytes() -> tuple[float, str]:
@@ -506,7 +444,7 @@ def _gb(value: float) -> str:
     return f"{value / 1e9:.3g} GB"
 
 
-def check_memory(spec, footprint: Footprint | None = None) -> None:
+def check_memory(spec: CaseSpec, footprint: Footprint | None = None) -> None:
     """Refuse a case whose memory estimate exceeds the limit (MeshError, one
     line naming the estimate, its largest terms and the limit).
 

@@ -34,12 +34,12 @@ from xfemslip.fem.poro import (
     body_load,
     build_materials,
     build_pore_pressure,
-    domain_box,
     fracture_load,
     make_contact_effective,
 )
 from xfemslip.fem.quadrature import InterfacePoints, interface_points
 from xfemslip.fem.zones import build_zones, in_situ_stress, loading_breaks
+from xfemslip.geometry.fracture import Fracture
 from xfemslip.geometry.junctions import build_fractures
 from xfemslip.io.results import run_folder, write_results
 from xfemslip.memory import check_memory, enriched_footprint, model_footprint
@@ -61,10 +61,10 @@ logger = logging.getLogger(__name__)
 class Model:
     """Everything built from a case before solving."""
 
-    spec: object
+    spec: CaseSpec
     mesh: Mesh
     D: np.ndarray
-    fractures: tuple
+    fractures: tuple[Fracture, ...]
     ec: EnrichedCells
     bulk: BulkSystem
     ip: InterfacePoints
@@ -75,11 +75,11 @@ class Model:
     pore: PorePressure | None = None  # [pore_pressure]
     # per fracture, the arc lengths where the rock on a face changes
     # (xfemslip.fem.zones.loading_breaks)
-    breaks: list | None = None
+    breaks: list[np.ndarray] | None = None
 
 
 @contextlib.contextmanager
-def _naming_the_file(spec):
+def _naming_the_file(spec: CaseSpec):
     """Geometry errors found while building name the case file."""
     try:
         yield
@@ -87,14 +87,13 @@ def _naming_the_file(spec):
         raise GeometryError(f"{spec.path}: {err}") from None
 
 
-def _geometry(spec):
+def _geometry(spec: CaseSpec) -> tuple[Mesh, tuple[Fracture, ...]]:
     """Mesh and fractures (after the memory estimate: nothing large is
     allocated for a case that would not fit)."""
     check_memory(spec)
     mesh = build_mesh(spec.mesh.x, spec.mesh.y)
-    box = np.array(domain_box(mesh))
     with _naming_the_file(spec):
-        return mesh, build_fractures(mesh, spec.fractures, box)
+        return mesh, build_fractures(mesh, spec.fractures, mesh.box)
 
 
 def _contact_in_situ(spec, zones, ip, eps):
@@ -110,7 +109,7 @@ def _contact_in_situ(spec, zones, ip, eps):
     return 0.5 * (faces[0] + faces[1])
 
 
-def check_geometry(spec) -> None:
+def check_geometry(spec: CaseSpec) -> None:
     """What ``xfemslip check`` adds to key validation: fractures against the
     mesh and the prescribed values at boundary corners (GeometryError)."""
     mesh, _ = _geometry(spec)
@@ -126,7 +125,7 @@ def kernel_work(ec) -> float:
     return float(ec.qp_w.size) * nd * nd
 
 
-def build_model(spec) -> Model:
+def build_model(spec: CaseSpec) -> Model:
     """Build the discrete problem of a validated case."""
     mesh, fractures = _geometry(spec)
     mat = spec.material
@@ -142,7 +141,7 @@ def build_model(spec) -> Model:
     kernel_backend = kernels.choose(spec.solver.kernels, kernel_work(ec))
     zones = build_zones(spec)
     eps = FACE_OFFSET * mesh.h_min
-    breaks = loading_breaks(zones, fractures, domain_box(mesh), eps)
+    breaks = loading_breaks(zones, fractures, mesh.box, eps)
     ip = interface_points(fractures, mesh.h_min, breaks)
     materials = build_materials(spec, mesh, ec, fractures)
     if not spec.units:
@@ -306,7 +305,9 @@ def floating_parts(mesh, fractures, contact, bc):
     return out
 
 
-def run_case(spec, out_dir: Path | str | None = None, *, overwrite: bool = False):
+def run_case(
+    spec: CaseSpec, out_dir: Path | str | None = None, *, overwrite: bool = False
+) -> Result:
     """Solve a case; returns its :class:`~xfemslip.post.result.Result`.
 
     Parameters
@@ -430,7 +431,7 @@ def solve_and_write(
     return done
 
 
-def _depth_datum(spec) -> float | None:
+def _depth_datum(spec: CaseSpec) -> float | None:
     """The y [m] of zero depth of a case whose state varies with depth."""
     if spec.loading.in_situ is not None:
         return spec.loading.in_situ.datum

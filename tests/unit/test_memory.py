@@ -9,6 +9,7 @@ import sys
 from dataclasses import replace
 from pathlib import Path
 
+import numpy as np
 import pytest
 from click.testing import CliRunner
 
@@ -21,12 +22,8 @@ from xfemslip.fem.enrichment import find_candidates
 from xfemslip.memory import (
     ENV_LIMIT,
     GRID_BYTES,
-    LU_BYTES,
-    LU_FACTORS,
-    MATRIX_BYTES,
     MMAP_THRESHOLD,
     NEWTON_BLOCKS,
-    PARDISO_BYTES,
     TRIM_THRESHOLD,
     TRIPLET_BYTES,
     Footprint,
@@ -38,6 +35,17 @@ from xfemslip.memory import (
     model_footprint,
 )
 from xfemslip.simulation import build_model
+from xfemslip.solve import linear as linsolve
+from xfemslip.solve.guess import KEEP
+from xfemslip.solve.linear import (
+    AMG_BYTES,
+    AMG_RESTART,
+    LU_BYTES,
+    LU_FACTORS,
+    MATRIX_BYTES,
+    PARDISO_BYTES,
+    solver_bytes,
+)
 
 CASES = Path(__file__).resolve().parents[2] / "cases"
 CASE = CASES / "reservoir_depletion.toml"
@@ -116,6 +124,37 @@ def test_terms_follow_their_sizes():
         + t["enriched cells"]
         + max(t["assembly"], t["solver"] + t["contact tangents"] + t["steps"])
     )
+
+
+def test_solver_term_is_the_solvers_own_statement(monkeypatch):
+    """The solver term is solve.linear.solver_bytes of the footprint's
+    sizes (a hand sum for AMG: the matrices and hierarchy per non-zero, the
+    GMRES basis and the kept solutions per dof), and the solver the
+    estimate counts is the one LinearSolver takes on the same matrix (the
+    reservoir case on 30 x 30 cells, the AMG floor lowered, the band limit
+    on both sides of the case's band share)."""
+    fp = Footprint(
+        n_nodes=10_000, n_cells=9_801, n_dofs=20_000, nnz=4e5, steps=1, contact_dofs=50
+    )
+    for method in ("superlu", "amg", "pardiso"):
+        assert estimate_terms(replace(fp, linear=method))["solver"] == solver_bytes(
+            method, 4e5, 20_000, 50
+        )
+    assert solver_bytes("amg", 4e5, 20_000, 50) == pytest.approx(
+        4e5 * (MATRIX_BYTES + AMG_BYTES) + (AMG_RESTART + 1 + KEEP) * 8.0 * 20_000
+    )
+    pytest.importorskip("pyamg")
+    monkeypatch.setattr(linsolve.pardiso, "available", lambda: False)
+    monkeypatch.setattr(linsolve, "AUTO_AMG_MIN_DOFS", 100)
+    text = build.case_text(build.file_case(CASE, **{"mesh.elements": [30, 30]}))
+    model = build_model(loads_case(text, CASE))
+    p = model.problem
+    share = linsolve.system_facts(p.K, np.arange(p.n_dofs), p.node_xy)["band_share"]
+    for limit, method in ((share, "amg"), (0.99 * share, "superlu")):
+        monkeypatch.setattr(linsolve, "AUTO_AMG_MAX_BAND", limit)
+        assert model_footprint(model).linear == method
+        solver = linsolve.LinearSolver(p.K, "auto", np.arange(p.n_dofs), p.node_xy)
+        assert solver.method == method
 
 
 def _text(name, **keys):

@@ -54,8 +54,6 @@ from xfemslip.case.options import (
 )
 from xfemslip.case.pore import PORE_PRESSURE_KEYS, PORE_PRESSURE_REGIONS
 from xfemslip.case.specs import (
-    AUTO_PENALTY,
-    CONTACT_PATCH_CELLS,
     EDGES,
     BoundarySpec,
     CaseSpec,
@@ -77,6 +75,7 @@ from xfemslip.case.specs import (
 )
 from xfemslip.case.tables import Option, Range
 from xfemslip.case.units import RESERVOIR_KEYS, UNIT_KEYS
+from xfemslip.contact.defaults import AUTO_PENALTY, CONTACT_PATCH_CELLS
 
 __all__ = [
     "AUTO_PENALTY",

@@ -35,6 +35,7 @@ class _EdgeFrame(NamedTuple):
 
 def _edge_frame(edge: str, grid: Grid) -> _EdgeFrame:
     """Geometry of one edge of the rectilinear mesh."""
+    assert grid.mesh is not None  # the edges are read once the mesh is known
     x, y = grid.mesh.x, grid.mesh.y
     return {
         "bottom": _EdgeFrame(0, float(y[0]), x),
@@ -225,6 +226,7 @@ def _read_edge(boundary: Table, edge: str, grid: Grid | None, folder: Path):
         )
         return None
     table = boundary.table(edge, EDGE_KEYS)
+    assert table is not None  # the value is a table (checked above)
     if table.has("file"):
         return _edge_from_csv(table, edge, grid, folder)
     return _edge_from_table(table, edge, grid)

@@ -10,7 +10,6 @@ import numpy as np
 from xfemslip.case.friction import describe_strength
 from xfemslip.case.options import SOLVER_OPTIONS
 from xfemslip.case.specs import (
-    AUTO_PENALTY,
     EDGES,
     CaseSpec,
     EdgeSpec,
@@ -23,6 +22,7 @@ from xfemslip.case.specs import (
     SolverSpec,
 )
 from xfemslip.case.tables import fmt
+from xfemslip.contact.defaults import AUTO_PENALTY
 from xfemslip.fem.zones import build_zones, in_situ_stress, initial_pressure
 from xfemslip.reference.screen import coulomb_margin, plane_stresses
 
@@ -131,6 +131,7 @@ def in_situ_margin(spec: CaseSpec, fracture: FractureSpec) -> tuple[float, float
         zone = zones.at(mid)
         p0 = initial_pressure(spec, zones, mid, zone)
         S = in_situ_stress(spec, zones, mid, zone, p0)
+        assert S is not None  # the case has an in-situ stress varying with depth
         pairs = [plane_stresses(S[k], angles[k]) for k in range(len(angles))]
         sigma_n = np.array([float(a) for a, _ in pairs])
         tau = np.array([float(b) for _, b in pairs])
@@ -169,9 +170,11 @@ def _describe_edge(name: str, edge: EdgeSpec, in_situ=False) -> str:
     if edge.kind == "free":
         note = " (not given in [boundary])" if edge.source == "default" else ""
         return f"  {name}: free (zero traction){note}"
+    values = edge.values
+    assert values is not None  # a displacement edge has its values
     parts = []
     for c, label in enumerate(("ux", "uy")):
-        column = edge.values[:, c]
+        column = values[:, c]
         if np.isnan(column).all():
             extra = " (traction = loading.stress . n)" if edge.traction else ""
             parts.append(f"{label} free{extra}")
@@ -185,7 +188,7 @@ def _describe_edge(name: str, edge: EdgeSpec, in_situ=False) -> str:
                 f"{_with_unit(float(column.max()), EdgeSpec.UNITS['values'])}"
             )
     return (
-        f"  {name}: displacement {', '.join(parts)} at {len(edge.values)} nodes "
+        f"  {name}: displacement {', '.join(parts)} at {len(values)} nodes "
         f"[{edge.source}]"
     )
 
@@ -206,10 +209,12 @@ def _describe_in_situ(spec: CaseSpec) -> str:
     if s.gravity is not None:
         yy = f"{fmt(s.yy)} Pa - g = {fmt(s.gravity)} m/s^2 x the rock above"
     else:
+        assert s.gradient_yy is not None  # gravity or a gradient (case/load.py)
         yy = f"{fmt(s.yy)} Pa + {fmt(s.gradient_yy)} Pa/m x depth"
     if s.ratio_xx is None:
+        assert s.xx is not None and s.gradient_xx is not None
         xx = f"sigma_xx = {fmt(s.xx)} Pa + {fmt(s.gradient_xx)} Pa/m x depth"
-    elif s.ratio_xx == "uniaxial_strain":
+    elif isinstance(s.ratio_xx, str):
         xx = "sigma'_xx = nu / (1 - nu) sigma'_yy in each unit"
     else:
         xx = f"sigma'_xx = {fmt(s.ratio_xx)} sigma'_yy"
@@ -221,23 +226,25 @@ def _describe_in_situ(spec: CaseSpec) -> str:
 
 def _describe_units(spec: CaseSpec) -> list[str]:
     """One line per rock unit of [[units]]."""
-    lines = []
+    lines: list[str] = []
     if spec.reservoir is not None or not spec.units:
         return lines
     zones = build_zones(spec)
     for unit, zs in zip(spec.units, zones.unit_zones, strict=True):
         r = unit.region
         if r.kind == "layer":
-            where = f"layer {fmt(r.base)} < y < {fmt(r.top)} m"
+            base, top = r.horizons
+            where = f"layer {fmt(base)} < y < {fmt(top)} m"
         elif r.kind == "offset":
+            base, top = r.horizons
             where = (
-                f"layer {fmt(r.base)} < y < {fmt(r.top)} m displaced "
+                f"layer {fmt(base)} < y < {fmt(top)} m displaced "
                 f"{fmt(r.throw)} m down on the {r.lowered} of fractures[{r.fracture}]"
             )
         elif r.kind == "polygon":
-            where = f"polygon of {len(r.polygon)} vertices"
+            where = f"polygon of {len(r.vertices)} vertices"
         else:
-            where = f"{len(r.boxes)} box(es)"
+            where = f"{len(r.box_array)} box(es)"
         dp = ", ".join(f"{zones.names[z]} {fmt(float(zones.change[z]))} Pa" for z in zs)
         lines.append(
             f"unit {unit.name!r}: {where}; E = {fmt(unit.E)} Pa, nu = "
@@ -260,11 +267,11 @@ def _describe_pore(spec: CaseSpec) -> list[str]:
             if p.gradient
             else ""
         )
-        change = (
-            f"change {fmt(p.change)} Pa"
-            if p.field is None
-            else f"change from {_describe_field(p.field)}"
-        )
+        if p.field is not None:
+            change = f"change from {_describe_field(p.field)}"
+        else:
+            assert p.change is not None  # without a field, a uniform change
+            change = f"change {fmt(p.change)} Pa"
         lines.append(
             f"pore pressure: initial {fmt(p.initial)} Pa{grad}, {change} over "
             f"the load steps (< 0 = depletion), Biot coefficient "

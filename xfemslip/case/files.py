@@ -191,7 +191,8 @@ def _read_stdin(limit: int) -> bytes:
             )
     except (ValueError, OSError):  # closed, or a stream without a descriptor
         pass
-    chunks, total = [], 0
+    chunks: list[bytes] = []
+    total = 0
     while True:
         try:
             chunk = stream.read(READ_CHUNK)
@@ -222,7 +223,8 @@ def input_folder(path: Path | str) -> Path:
 def _read_capped(fd: int, limit: int) -> bytes:
     """Read to the end in chunks; refuse once more than ``limit`` bytes came.
     A pipe with nothing to read yet is waited on (a signal ends the wait)."""
-    chunks, total = [], 0
+    chunks: list[bytes] = []
+    total = 0
     while True:
         try:
             chunk = os.read(fd, READ_CHUNK)

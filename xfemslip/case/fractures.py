@@ -23,6 +23,7 @@ from xfemslip.case.tables import (
     Table,
     check_number,
     check_vector,
+    complete,
     exact,
     fmt,
     frozen,
@@ -282,7 +283,7 @@ def read_fractures(root: Table, grid: Grid | None) -> tuple[FractureSpec, ...] |
             f"{show(value)} (write [[fractures]], not [fractures])",
         )
         return None
-    specs = []
+    specs: list[FractureSpec | None] = []
     for i, item in enumerate(value):
         if not isinstance(item, dict):
             root.error(f"fractures[{i}]", f"expected a table, got {show(item)}")
@@ -290,7 +291,8 @@ def read_fractures(root: Table, grid: Grid | None) -> tuple[FractureSpec, ...] |
             continue
         table = Table(item, f"fractures[{i}]", root.problems, FRACTURE_KEYS)
         specs.append(_read_fracture(table, i, grid))
-    return None if any(s is None for s in specs) else tuple(specs)
+    read = complete(specs)
+    return None if read is None else tuple(read)
 
 
 # --------------------------------------------------------------------------- #
@@ -346,8 +348,7 @@ def _check_polyline(table: Table, points: np.ndarray, grid: Grid | None) -> None
         )
     if grid is None:
         return
-    lo = grid.origin
-    hi = (lo[0] + grid.size[0], lo[1] + grid.size[1])
+    lo, hi = grid.box.lo, grid.box.hi
     if not any(
         segment_meets_box(a, b, lo, hi)
         for a, b in zip(points[:-1], points[1:], strict=True)

@@ -116,6 +116,7 @@ def read_strength(table: Table, friction_default=REQUIRED, cohesion_default=0.0)
     dynamic_friction = slip_distance = dynamic_cohesion = None
     if isinstance(table.data.get("friction"), dict):
         sub = table.table("friction", FRICTION_LAW_KEYS)
+        assert sub is not None  # a table (checked above)
         sub.choice("law", FRICTION_LAWS)
         friction, dynamic_friction = _static_dynamic(sub, "friction")
         slip_distance = sub.number("slip_distance", rule=POSITIVE)
@@ -131,6 +132,7 @@ def read_strength(table: Table, friction_default=REQUIRED, cohesion_default=0.0)
         friction = table.number("friction", friction_default, rule=NON_NEGATIVE)
     if isinstance(table.data.get("cohesion"), dict):
         sub = table.table("cohesion", COHESION_LAW_KEYS)
+        assert sub is not None  # a table (checked above)
         cohesion, dynamic_cohesion = _static_dynamic(sub, "cohesion")
         if not isinstance(table.data.get("friction"), dict):
             table.error(

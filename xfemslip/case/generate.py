@@ -5,6 +5,7 @@ and its realization in the domain (read by :mod:`xfemslip.case.network`).
 from __future__ import annotations
 
 import math
+from typing import Literal
 
 import numpy as np
 
@@ -16,10 +17,12 @@ from xfemslip.case.tables import (
     POSITIVE,
     Range,
     Table,
+    complete,
     fmt,
     show,
 )
 from xfemslip.geometry import dfn
+from xfemslip.geometry.box import Box
 
 GENERATE_KEYS = (
     "seed",
@@ -133,9 +136,7 @@ def _drawable(table: Table, law: dfn.LengthLaw) -> dfn.LengthLaw | None:
         with np.errstate(all="ignore"):  # an overflow is the answer, not a warning
             mean = dfn.mean_length(law)
             ends = (
-                dfn.power_law_ppf(
-                    np.array([0.0, 1.0]), law.exponent, law.lmin, law.lmax
-                )
+                dfn.power_law_ppf(np.array([0.0, 1.0]), law.exponent, *law.bounds)
                 if law.kind == "power_law"
                 else np.array([mean, mean])
             )
@@ -194,7 +195,7 @@ def _read_sets(table: Table) -> tuple[dfn.FractureSet, ...] | None:
                 "sets", f"expected a non-empty array of tables, got {show(value)}"
             )
             return None
-        out = []
+        out: list[dfn.FractureSet | None] = []
         for i, item in enumerate(value):
             if not isinstance(item, dict):
                 table.error(f"sets[{i}]", f"expected a table, got {show(item)}")
@@ -203,21 +204,22 @@ def _read_sets(table: Table) -> tuple[dfn.FractureSet, ...] | None:
             sub = Table(item, table.key(f"sets[{i}]"), table.problems, SET_KEYS)
             weight = sub.number("weight", rule=POSITIVE)
             orientation, length = _read_orientation(sub), _read_length(sub)
-            ok = None not in (weight, orientation, length)
+            if weight is None or orientation is None or length is None:
+                out.append(None)
+                continue
             out.append(
                 dfn.FractureSet(weight=weight, orientation=orientation, length=length)
-                if ok
-                else None
             )
-        return None if any(s is None for s in out) else tuple(out)
+        sets = complete(out)
+        return None if sets is None else tuple(sets)
     orientation, length = _read_orientation(table), _read_length(table)
     if orientation is None or length is None:
         return None
     return (dfn.FractureSet(weight=1.0, orientation=orientation, length=length),)
 
 
-def _read_region(table: Table) -> tuple[float, float, float, float] | None | bool:
-    """``region = [[x0, y0], [x1, y1]]`` (lower-left, upper-right) -> (x0, x1, y0, y1);
+def _read_region(table: Table) -> Box | Literal[False] | None:
+    """``region = [[x0, y0], [x1, y1]]`` (lower-left, upper-right) -> a Box;
     None when not given, False when invalid."""
     if not table.has("region"):
         return None
@@ -247,7 +249,7 @@ def _read_region(table: Table) -> tuple[float, float, float, float] | None | boo
             f"upper-right corner must be above and right of lower-left, got {value}",
         )
         return False
-    return (float(x0), float(x1), float(y0), float(y1))
+    return Box.from_corners(x0, y0, x1, y1)
 
 
 def _read_count(table: Table) -> dict | None:
@@ -281,7 +283,7 @@ def read_generate(table: Table) -> dfn.DfnParams | None:
         table.error("min_spacing", 'only used with intersections = "avoid"')
     outside = table.choice("outside", dfn.OUTSIDE, "clip")
     min_length = table.number("min_length", 0.0, NON_NEGATIVE)
-    if len(table.problems) > start or region is False:
+    if len(table.problems) > start or region is False or count is None or sets is None:
         return None
     return dfn.DfnParams(
         seed=seed,
@@ -295,17 +297,17 @@ def read_generate(table: Table) -> dfn.DfnParams | None:
     )
 
 
-def _expected_count(params: dfn.DfnParams, box) -> float:
+def _expected_count(params: dfn.DfnParams, box: Box) -> float:
     """The count ``dfn.resolve_count`` rounds, as a float that may be inf or
     NaN (p21 = 1e308), so that it is checked before it is converted."""
     if params.count is not None:
         return float(params.count)
-    x0, x1, y0, y1 = params.region or box
-    area = (x1 - x0) * (y1 - y0)
+    area = (params.region or box).area
     if params.p20 is not None:
         return params.p20 * area
     total = sum(s.weight for s in params.sets)
     mean = sum(s.weight / total * dfn.mean_length(s.length) for s in params.sets)
+    assert params.p21 is not None  # exactly one of count, p20, p21
     return params.p21 * area / mean
 
 
@@ -313,8 +315,7 @@ def realize(
     table: Table, params: dfn.DfnParams, grid: Grid, existing: np.ndarray
 ) -> dfn.Network | None:
     """The network of ``params`` in the domain; a problem if it does not fit."""
-    (x0, y0), (w, h) = grid.origin, grid.size
-    box = (x0, x0 + w, y0, y0 + h)
+    box = grid.box
     expected = _expected_count(params, box)
     if not expected <= MAX_NETWORK_FRACTURES + 0.5:  # NaN and inf too
         key = next(k for k in ("count", "p20", "p21") if table.has(k))

@@ -27,6 +27,7 @@ import numpy as np
 from xfemslip.case.grid import Grid, axis_resolves, check_element_count
 from xfemslip.case.specs import MeshSpec
 from xfemslip.case.tables import frozen
+from xfemslip.geometry.box import Box
 from xfemslip.geometry.grading import graded_axes
 
 __all__ = [
@@ -94,15 +95,11 @@ def _clip(a, b, lo, hi):
     return a + t0 * (b - a), a + t1 * (b - a)
 
 
-def _box(origin, extent):
-    lo = (float(origin[0]), float(origin[1]))
-    return lo, (lo[0] + float(extent[0]), lo[1] + float(extent[1]))
-
-
 def fracture_refinement(polylines, origin, extent) -> Refinement:
     """The x- and y-extents of the parts of polylines ((k_i, 2) vertices
     [m]) inside the domain (origin, extent) as fine intervals."""
-    lo, hi = _box(origin, extent)
+    box = Box.from_origin_size(origin, extent)
+    lo, hi = box.lo, box.hi
     fx, fy = [], []
     for points in polylines:
         parts = [
@@ -120,7 +117,8 @@ def region_refinement(boxes, polygon, origin, extent) -> Refinement:
     (m, 2) [m]) inside the domain: an axis-parallel edge as a line and the
     point interval across it, an inclined one as the fine intervals of its
     extents."""
-    lo, hi = _box(origin, extent)
+    box = Box.from_origin_size(origin, extent)
+    lo, hi = box.lo, box.hi
     edges = []
     for x0, y0, x1, y1 in np.asarray(boxes, dtype=np.float64).reshape(-1, 4):
         corners = [(x0, y0), (x1, y0), (x1, y1), (x0, y1)]
@@ -151,7 +149,8 @@ def region_refinement(boxes, polygon, origin, extent) -> Refinement:
 def horizon_refinement(elevations, origin, extent) -> Refinement:
     """Horizons y = c [m] (layer boundaries spanning the domain): each
     inside the domain is a node row and refined across."""
-    lo, hi = _box(origin, extent)
+    box = Box.from_origin_size(origin, extent)
+    lo, hi = box.lo, box.hi
     ys = [float(c) for c in elevations if lo[1] < c < hi[1]]
     return _refinement(fine_y=[[c, c] for c in ys], lines_y=ys)
 
@@ -165,6 +164,7 @@ def box_refinement(boxes) -> Refinement:
 def case_refinement(grid: Grid, fractures, reservoir) -> Refinement:
     """The features of a case: its fractures (FractureSpec), its
     ``[reservoir]`` (ReservoirSpec or None) and the ``mesh.refine`` boxes."""
+    assert grid.grading is not None  # a graded mesh waiting for its features
     parts = [
         fracture_refinement([f.points for f in fractures], grid.origin, grid.size),
         box_refinement(grid.grading.refine),
@@ -186,6 +186,7 @@ def graded_grid(
     coordinates that do not resolve).  The element count is checked before
     a node is placed."""
     g = grid.grading
+    assert g is not None  # a graded mesh waiting for its features
     if refinement.empty:
         problems.append(
             (

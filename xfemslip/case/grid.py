@@ -29,6 +29,7 @@ from xfemslip.case.tables import (
     frozen,
     show,
 )
+from xfemslip.geometry.box import Box
 
 # Memory guard: a Q4 element adds 64 stiffness triplets (8 B value + 2 x 8 B
 # indices = 1.5 kB) before CSR conversion and factorisation; 2 kB per element
@@ -57,6 +58,11 @@ class Grid(NamedTuple):
     size: tuple[float, float]
     mesh: MeshSpec | None
     grading: GradingSpec | None = None
+
+    @property
+    def box(self) -> Box:
+        """The domain [m]."""
+        return Box.from_origin_size(self.origin, self.size)
 
 
 def _int_text(n: int) -> str:
@@ -190,7 +196,8 @@ def _mesh_uniform(mesh: Table, domain: Table | None, size, origin) -> Grid | Non
         domain.error("size", "required key missing (mesh.elements needs domain.size)")
     if counts is None or size is None or origin is None:
         return None
-    if not check_element_count(*counts, mesh.key("elements"), mesh.problems):
+    nx, ny = counts
+    if not check_element_count(nx, ny, mesh.key("elements"), mesh.problems):
         return None
     with np.errstate(over="ignore"):
         x = origin[0] + size[0] * np.linspace(0.0, 1.0, counts[0] + 1)
@@ -244,7 +251,7 @@ def _mesh_graded(mesh: Table, domain: Table | None, size, origin) -> Grid | None
         )
     if domain is not None and not domain.has("size"):
         domain.error("size", "required key missing (mesh.size needs domain.size)")
-    if len(mesh.problems) > start or size is None or origin is None:
+    if len(mesh.problems) > start or size is None or origin is None or refine is None:
         return None
     grading = GradingSpec(size=cell, growth=growth, max_size=largest, refine=refine)
     return Grid(origin, size, None, grading)

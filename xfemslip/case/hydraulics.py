@@ -20,7 +20,8 @@ import math
 import numpy as np
 
 from xfemslip.case.specs import HydraulicSpec, PermeabilitySpec
-from xfemslip.case.tables import NON_NEGATIVE, POSITIVE, Range, Table, fmt
+from xfemslip.case.tables import NON_NEGATIVE, POSITIVE, Range, Table, complete, fmt
+from xfemslip.geometry.box import Box
 
 __all__ = [
     "HYDRAULIC_KEYS",
@@ -133,8 +134,7 @@ def _read_block(table: Table, grid) -> tuple[float, float, float, float] | None:
     if block is None or grid is None:
         return None
     x0, y0, x1, y1 = block
-    lo, size = grid.origin, grid.size
-    hi = (lo[0] + size[0], lo[1] + size[1])
+    lo, hi, size = grid.box.lo, grid.box.hi, grid.size
     if not (x0 < x1 and y0 < y1):
         table.error(
             "block",
@@ -184,18 +184,17 @@ def read_permeability(root: Table, grid, fractures) -> PermeabilitySpec | None:
     if table.has("block"):
         block = _read_block(table, grid)
     elif grid is not None:
-        (x0, y0), (w, h) = grid.origin, grid.size
-        block = (x0, y0, x0 + w, y0 + h)
+        block = grid.box.corners
     else:
         block = None
     if len(root.problems) > start or fractures is None or block is None:
         return None
-    laws = [_resolve(defaults, f, root) for f in fractures]
-    if any(law is None for law in laws):
+    laws = complete([_resolve(defaults, f, root) for f in fractures])
+    if laws is None:
         return None
     return PermeabilitySpec(
         laws=tuple(laws),
         matrix=matrix,
-        block=tuple(float(v) for v in block),
+        block=Box.from_corners(*block).corners,
         block_given=table.has("block"),
     )

@@ -75,6 +75,7 @@ from xfemslip.case.tables import (
     Range,
     Table,
     check_choice,
+    complete,
     show,
 )
 from xfemslip.case.units import (
@@ -352,11 +353,13 @@ def _read_formats(table: Table) -> tuple[str, ...] | None:
         )
         return None
     key = table.key("formats")
-    formats = [
-        check_choice(v, f"{key}[{i}]", table.problems, OUTPUT_FORMATS)
-        for i, v in enumerate(value)
-    ]
-    if any(f is None for f in formats):
+    formats = complete(
+        [
+            check_choice(v, f"{key}[{i}]", table.problems, OUTPUT_FORMATS)
+            for i, v in enumerate(value)
+        ]
+    )
+    if formats is None:
         return None
     if len(set(formats)) != len(formats):
         table.error("formats", f"lists a format twice: {formats}")
@@ -408,11 +411,14 @@ def _read_output(root: Table, name: str | None) -> OutputSpec | None:
         table.error("directory", f"{problem}, got {show(directory)}")
         directory = None
     formats = _read_formats(table)
-    if formats is None or (
-        directory is None and (table.has("directory") or name is None)
-    ):
+    if formats is None:
         return None
-    path = Path(directory) if directory is not None else Path("out") / name
+    if directory is not None:
+        path = Path(directory)
+    elif table.has("directory") or name is None:
+        return None
+    else:
+        path = Path("out") / name
     return OutputSpec(directory=path, formats=formats)
 
 
@@ -478,6 +484,15 @@ def loads_case(
     permeability = read_permeability(root, grid, fractures)
     if problems:
         raise CaseError(path, problems)
+    # each reader returns None only after recording a problem
+    assert (
+        name is not None
+        and material is not None
+        and loading is not None
+        and boundary is not None
+        and solver is not None
+        and output is not None
+    )
     return CaseSpec(
         path=path,
         text=text,

@@ -79,15 +79,17 @@ def read_network(
             )
         if params is not None and grid is not None and len(table.problems) == start:
             others = [f.points for f in inline] + [p for p, _, _ in found]
+            assert gen is not None  # params were read from it
             network = realize(gen, params, grid, _segments_of(others))
-            for k, seg in enumerate(network.segments if network is not None else ()):
-                found.append(
+            if network is not None:
+                found += [
                     (
                         seg,
                         defaults,
                         f"network.generate #{k} (set {network.set_index[k]})",
                     )
-                )
+                    for k, seg in enumerate(network.segments)
+                ]
     if len(table.problems) > start:
         return None
     return tuple(

@@ -8,19 +8,14 @@ default, meaning and allowed values serve the validation
 
 from __future__ import annotations
 
-import importlib.util
-
-from xfemslip.case.specs import CONTACT_PATCH_CELLS
 from xfemslip.case.tables import Option, Range
-
-# the package that linear_solver = "pardiso" needs (the mkl extra); the
-# solver (xfemslip.solve.pardiso) asks the same question through this
-PARDISO_PACKAGE = "pypardiso"
+from xfemslip.contact.defaults import CONTACT_PATCH_CELLS
+from xfemslip.solve import pardiso
 
 
 def pardiso_installed() -> bool:
-    """Whether MKL PARDISO (the mkl extra: pypardiso) is installed."""
-    return importlib.util.find_spec(PARDISO_PACKAGE) is not None
+    """Whether linear_solver = "pardiso" can run: the solver's own answer."""
+    return pardiso.available()
 
 
 # The constants of [domain]/[mesh], [[fractures]], [boundary] and the CSV files

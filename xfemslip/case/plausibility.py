@@ -10,7 +10,8 @@ the value and why it looks wrong:
   (the faces open instead of slipping; the paper's problems are in
   compression, signs in docs/output-format.md: compression negative);
 - a penalty stiffness kn h/E or kt h/E outside the range where Newton was
-  measured to converge (specs.PENALTY_RATIO_LOWEST to PENALTY_RATIO_MEASURED);
+  measured to converge (xfemslip.contact.defaults: PENALTY_RATIO_LOWEST to
+  PENALTY_RATIO_MEASURED);
 - a fracture that reaches outside the domain (it is clipped at the boundary,
   so its tip there becomes an edge crossing);
 - a unit's edge that was moved onto a fracture it lay within 0.1 cell of
@@ -21,7 +22,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from xfemslip.case.specs import PENALTY_RATIO_LOWEST, PENALTY_RATIO_MEASURED
+from xfemslip.case.specs import CaseSpec
+from xfemslip.contact.defaults import PENALTY_RATIO_LOWEST, PENALTY_RATIO_MEASURED
 
 __all__ = ["E_RANGE", "plausibility_warnings"]
 
@@ -31,7 +33,7 @@ __all__ = ["E_RANGE", "plausibility_warnings"]
 E_RANGE = (1.0e6, 1.0e12)
 
 
-def plausibility_warnings(spec) -> list[str]:
+def plausibility_warnings(spec: CaseSpec) -> list[str]:
     """The warnings of a validated ``CaseSpec``, one line each."""
     out: list[str] = []
     moduli = [("material.E", spec.material.E)]
@@ -77,8 +79,7 @@ def plausibility_warnings(spec) -> list[str]:
                 "and is moved onto it (within 0.1 cell of a fracture, an edge is "
                 "taken to follow it)"
             )
-    x0, y0 = spec.origin
-    x1, y1 = x0 + spec.size[0], y0 + spec.size[1]
+    x0, x1, y0, y1 = spec.box
     tol = 1e-9 * max(spec.size)
     for fr in spec.fractures:
         p = fr.points

@@ -149,7 +149,12 @@ def read_field_table(pore: Table, folder: Path) -> PressureFieldSpec | None:
     outside = _read_outside(table)
     if name is not None and Path(name).suffix.lower() not in FIELD_SUFFIXES:
         table.error("file", f"expected a .csv, .vtu or .vtk file, got {name!r}")
-    if len(table.problems) > start:
+    if (
+        len(table.problems) > start
+        or name is None
+        or columns is None
+        or outside is None
+    ):
         return None
     file = folder / name
     try:

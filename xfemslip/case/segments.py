@@ -7,6 +7,7 @@ from __future__ import annotations
 import math
 from collections import Counter
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
@@ -107,12 +108,13 @@ def _csv_rows(lines: list[str], columns: list[str], file: Path):
                 f"({','.join(columns)}), got {len(fields)}: {quote(line)}"
             )
             continue
-        row, problems = {}, []
+        row: dict[str, Any] = {}
+        problems: list[str] = []
         for name, text in zip(columns, fields, strict=True):
             row[name], problem = _csv_cell(name, text)
             if problem:
                 problems.append(problem)
-        p0, p1 = (row.get("x0"), row.get("y0")), (row.get("x1"), row.get("y1"))
+        p0, p1 = (row["x0"], row["y0"]), (row["x1"], row["y1"])
         if not problems and p0 == p1:
             problems.append(
                 f"zero-length segment: (x0, y0) = (x1, y1) = "
@@ -145,7 +147,7 @@ def _fracture_count(lines: list[str], columns: list[str]) -> int:
     return len(ids) + single
 
 
-def _group_rows(rows: list) -> list[tuple[str, list]]:
+def _group_rows(rows: list) -> list[tuple[str | None, list]]:
     """Rows grouped by the ``fracture`` column in order of first appearance; a
     row without a fracture id is a fracture of its own."""
     groups: dict[object, list] = {}
@@ -189,7 +191,8 @@ def _group_properties(group: list, fid, file: Path, defaults: dict):
     else the [network] defaults; friction must come from one or the other.
     ``properties["given"]`` names those the rows give (a [network] friction
     law applies to a fracture only where they do not: case.friction)."""
-    props, bad = {"given": set()}, []
+    props: dict[str, Any] = {"given": set()}
+    bad: list[str] = []
     for name in PROPERTY_RULES:
         given = [(n, r[name]) for n, r in group if r.get(name) is not None]
         if given:
@@ -261,8 +264,7 @@ def _shape_problem(points: np.ndarray, grid: Grid | None) -> str | None:
         return f"self-intersecting polyline: segments {i} and {j} touch or cross"
     if grid is None:
         return None
-    lo = grid.origin
-    hi = (lo[0] + grid.size[0], lo[1] + grid.size[1])
+    lo, hi = grid.box.lo, grid.box.hi
     if not any(
         segment_meets_box(a, b, lo, hi)
         for a, b in zip(points[:-1], points[1:], strict=True)

@@ -8,6 +8,9 @@ from typing import ClassVar
 
 import numpy as np
 
+from xfemslip.contact.defaults import CONTACT_PATCH_CELLS
+from xfemslip.geometry.box import Box
+
 EDGES = ("bottom", "top", "left", "right")
 
 
@@ -51,33 +54,6 @@ class MaterialSpec:
         "model": "",
         "density": "kg/m^3",
     }
-
-
-# Penalty stiffness when a fracture omits kn / kt: k = AUTO_PENALTY * E / h with
-# h the local cell size (sqrt of the area of the cut cell).  Measured on the
-# inclined crack (docs/case-format.md, "Automatic penalty"): below ~1e3 the stuck faces'
-# elastic penalty slip is the larger error (2e-4 of the free slip at 100, 3e-2
-# at 1), from 1e3 up it sits at the discretisation floor (5e-5); the slip error
-# (0.42 % at a/20) and the Newton iterations (2 per step on the plate case up
-# to 1e5) do not change.  A stiffer penalty only worsens the conditioning.
-AUTO_PENALTY = 1.0e3
-# The penalty range kn h/E where Newton was measured to converge on every
-# shipped case, kn = kt = 10^k E/h for k = -1..9 (benchmarks/penalty_range.py,
-# docs/robustness.md "Known limits"): 0.1 to 1e6.  Above it the contact
-# stiffness swamps the bulk stiffness by that ratio and the residual stalls at
-# round-off (eta 1e-8 to 6e-8, stick/slip states settled), just above the
-# default tolerance; every Newton failure then names the penalty and the top
-# of the range, and `check` and `run` warn outside it.
-PENALTY_RATIO_MEASURED = 1.0e6
-PENALTY_RATIO_LOWEST = 0.1
-
-# Length of a contact patch in local cell sizes ([solver] contact_patch): the
-# penalty law acts on the jump averaged over each patch (contact.ContactSet).
-# Measured on the inclined crack at h = a/20: normal-traction oscillation (max
-# deviation / mean) 23 % pointwise (0), 1.2 % with 1-cell patches, 0.3 % with
-# 1.5-cell patches, slip error unchanged (docs/verification.md, "Contact
-# tractions: patches against points").
-CONTACT_PATCH_CELLS = 1.5
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -367,6 +343,28 @@ class RegionSpec:
         "throw": "m",
     }
 
+    @property
+    def horizons(self) -> tuple[float, float]:
+        """(base, top) [m] of a layer, or of a displaced layer on the side that
+        is not lowered."""
+        if self.base is None or self.top is None:
+            raise ValueError(f"a {self.kind!r} region has no horizons")
+        return self.base, self.top
+
+    @property
+    def vertices(self) -> np.ndarray:
+        """(k, 2) vertices [m] of a polygon region."""
+        if self.polygon is None:
+            raise ValueError(f"a {self.kind!r} region has no polygon")
+        return self.polygon
+
+    @property
+    def box_array(self) -> np.ndarray:
+        """(k, 4) boxes [x0, y0, x1, y1] [m] of a boxes region."""
+        if self.boxes is None:
+            raise ValueError(f"a {self.kind!r} region has no boxes")
+        return self.boxes
+
 
 @dataclass(frozen=True, kw_only=True)
 class UnitSpec:
@@ -429,3 +427,8 @@ class CaseSpec:
     units: tuple[UnitSpec, ...] = ()
     events: EventsSpec | None = None  # None: no [events] table
     permeability: PermeabilitySpec | None = None  # None: no [permeability] table
+
+    @property
+    def box(self) -> Box:
+        """The domain ([domain] origin and size) [m]."""
+        return Box.from_origin_size(self.origin, self.size)

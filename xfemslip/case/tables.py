@@ -8,7 +8,8 @@ from __future__ import annotations
 
 import difflib
 import math
-from typing import Any, NamedTuple
+from collections.abc import Sequence
+from typing import Any, NamedTuple, TypeVar
 
 import numpy as np
 
@@ -92,12 +93,14 @@ def range_problem(value: float, rule: Range | None, label: str) -> str | None:
     if not (below or above):
         return None
     lo_op, hi_op = ("<" if rule.lo_open else "<="), ("<" if rule.hi_open else "<=")
-    if rule.hi is None:
+    if rule.lo is not None and rule.hi is not None:
+        text = f"must satisfy {fmt(rule.lo)} {lo_op} {label} {hi_op} {fmt(rule.hi)}"
+    elif rule.lo is not None:
         text = f"must be {'>' if rule.lo_open else '>='} {fmt(rule.lo)}"
-    elif rule.lo is None:
+    elif rule.hi is not None:
         text = f"must be {hi_op} {fmt(rule.hi)}"
     else:
-        text = f"must satisfy {fmt(rule.lo)} {lo_op} {label} {hi_op} {fmt(rule.hi)}"
+        return None
     return f"{text}, got {value!r}"
 
 
@@ -176,6 +179,15 @@ def check_choice(
     return value
 
 
+T = TypeVar("T")
+
+
+def complete(items: Sequence[T | None]) -> list[T] | None:
+    """The items, or None when one is None (its problem is recorded)."""
+    out = [item for item in items if item is not None]
+    return out if len(out) == len(items) else None
+
+
 def check_vector(value: Any, key: str, problems: list, n: int, check) -> tuple | None:
     """An array of exactly ``n`` items, each passed through ``check(item, key)``."""
     if not isinstance(value, list) or len(value) != n:
@@ -212,7 +224,7 @@ class Table:
         for k, name in enumerate(unknown):
             # a suggestion for the first few; thousands of unknown keys are
             # a wrong file, and difflib on each would take seconds
-            hint = suggest(name, allowed) if k < MAX_SUGGESTIONS else ""
+            hint = suggest(name, allowed or ()) if k < MAX_SUGGESTIONS else ""
             self.error(name, f"unknown key {name!r}{where}{hint}")
 
     def key(self, name: str | None) -> str:

@@ -33,6 +33,7 @@ from xfemslip.case.tables import (
     Range,
     Table,
     check_number,
+    complete,
     frozen,
     show,
 )
@@ -81,11 +82,13 @@ def check_box(value, key: str, problems: list) -> tuple | None:
             )
         )
         return None
-    items = [
-        check_number(v, f"{key}[{i}]", problems, COORDINATE)
-        for i, v in enumerate(value)
-    ]
-    if any(v is None for v in items):
+    items = complete(
+        [
+            check_number(v, f"{key}[{i}]", problems, COORDINATE)
+            for i, v in enumerate(value)
+        ]
+    )
+    if items is None:
         return None
     x0, y0, x1, y1 = items
     if not (x0 < x1 and y0 < y1):
@@ -245,10 +248,11 @@ def snap_to_fractures(region: RegionSpec, fractures, grid):
     distance [m]) of each edge moved."""
     if grid is None or not fractures or region.kind not in ("polygon", "boxes"):
         return region, ()
-    if region.kind == "boxes" and len(region.boxes) > 1:
-        return region, ()  # boxes of a union cannot all be one polygon
     if region.kind == "boxes":
-        x0, y0, x1, y1 = np.asarray(region.boxes, float)[0]
+        boxes = np.asarray(region.boxes, float).reshape(-1, 4)
+        if len(boxes) > 1:
+            return region, ()  # boxes of a union cannot all be one polygon
+        x0, y0, x1, y1 = boxes[0]
         P = np.array([[x0, y0], [x1, y0], [x1, y1], [x0, y1]])
         names = [f"box: y0 = {y0:g}", f"box: x1 = {x1:g}", f"box: y1 = {y1:g}"]
         names.append(f"box: x0 = {x0:g}")
@@ -453,15 +457,16 @@ def read_units(root: Table, fractures, material) -> tuple[UnitSpec, ...] | None:
         )
         return None
     ctx = {"fractures": fractures or (), "material": material}
-    specs = []
+    read: list[UnitSpec | None] = []
     for i, item in enumerate(value):
         if not isinstance(item, dict):
             root.error(f"units[{i}]", f"expected a table, got {show(item)}")
-            specs.append(None)
+            read.append(None)
             continue
         table = Table(item, f"units[{i}]", root.problems, UNIT_KEYS)
-        specs.append(_read_unit(table, i, ctx))
-    if any(s is None for s in specs):
+        read.append(_read_unit(table, i, ctx))
+    specs = complete(read)
+    if specs is None:
         return None
     names = [s.name for s in specs]
     for i, name in enumerate(names):
@@ -502,7 +507,7 @@ def read_reservoir(root: Table) -> ReservoirSpec | None:
 
 def _reservoir_spec(region: RegionSpec, E, nu, snapped=()) -> ReservoirSpec:
     return ReservoirSpec(
-        boxes=region.boxes if region.kind == "boxes" else frozen(np.zeros((0, 4))),
+        boxes=region.box_array if region.kind == "boxes" else frozen(np.zeros((0, 4))),
         E=E,
         nu=nu,
         polygon=region.polygon if region.kind == "polygon" else None,

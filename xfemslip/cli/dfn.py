@@ -61,10 +61,8 @@ def dfn(case, csv_path, include_inline, plot, result, summary, debug) -> None:
         from xfemslip.geometry.dfn import network_stats, segments_csv_text
         from xfemslip.io.csv import write_text
 
-        (x0, y0), (w, h) = spec.origin, spec.size
-        box = (x0, x0 + w, y0, y0 + h)
         chosen = [f for f in spec.fractures if include_inline or f.source]
-        stats = network_stats([f.points for f in spec.fractures], box)
+        stats = network_stats([f.points for f in spec.fractures], spec.box)
         click.echo(
             f"{spec.name}: {stats['count']} fractures "
             f"({len(spec.fractures) - sum(bool(f.source) for f in spec.fractures)}"

@@ -69,6 +69,7 @@ def run(
         if plot:  # matplotlib is imported only here
             from xfemslip.cli.studies import plot_run
 
+            assert summary.out_dir is not None  # the command writes a folder
             plot_run(summary.out_dir)
 
 

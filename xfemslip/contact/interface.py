@@ -17,7 +17,7 @@ from functools import cached_property
 import numpy as np
 
 from xfemslip import kernels
-from xfemslip.case.specs import AUTO_PENALTY, CONTACT_PATCH_CELLS
+from xfemslip.contact.defaults import AUTO_PENALTY, CONTACT_PATCH_CELLS
 from xfemslip.conventions import OPEN, STICK
 from xfemslip.fem.assembly import coo_block, scatter_vector
 from xfemslip.fem.enrichment import HEAVISIDE, group_values
@@ -51,7 +51,7 @@ class ContactResult:
     """
 
     force: np.ndarray  # (n_dofs,) contact internal force [N/m]
-    blocks: np.ndarray  # (m, 2J, 2J) tangent blocks
+    blocks: np.ndarray | None  # (m, 2J, 2J) tangent blocks; None: not kept
     gn: np.ndarray  # (m,) [m]
     gt: np.ndarray  # (m,) [m]
     pn: np.ndarray  # (m,) [Pa]
@@ -59,13 +59,13 @@ class ContactResult:
     state: np.ndarray  # (m,) int8
     slip_plastic: np.ndarray  # (m,) [m]
     # ContactSet.slip_reference when it was evaluated (m,) [m]
-    slip_reference: np.ndarray = field(repr=False, default=None)
+    slip_reference: np.ndarray = field(repr=False)
     # accumulated frictional slip delta = int |d g_T^p| (kernels.contact)
-    accumulated: np.ndarray = field(repr=False, default=None)  # (m,) [m]
+    accumulated: np.ndarray = field(repr=False)  # (m,) [m]
     # the displacement it was evaluated at (a reference, not a copy: the solver
     # never changes an array in place once it has been evaluated)
-    u: np.ndarray = field(repr=False, default=None)  # (n_dofs,) [m]
-    contact: ContactSet = field(repr=False, default=None)
+    u: np.ndarray = field(repr=False)  # (n_dofs,) [m]
+    contact: ContactSet = field(repr=False)
 
     @cached_property
     def _point_jump(self) -> np.ndarray:
@@ -150,40 +150,30 @@ class ContactSet:
     friction: np.ndarray  # static f_s [-]
     cohesion: np.ndarray  # static c_s [Pa]
     n_dofs: int
-    fracture: np.ndarray = field(default=None)  # (m,) fracture of each patch
-    patch: np.ndarray = field(default=None)  # (n,) patch of each interface point
-    point_dofs: np.ndarray = field(default=None)  # (n, 2Jp) jump of each point
-    point_coef: np.ndarray = field(default=None)  # (n, Jp)
-    point_normal: np.ndarray = field(default=None)  # (n, 2)
-    point_tangent: np.ndarray = field(default=None)  # (n, 2)
-    slip_committed: np.ndarray = field(default=None)  # (m,) [m]
+    fracture: np.ndarray  # (m,) fracture of each patch
+    patch: np.ndarray  # (n,) patch of each interface point
+    point_dofs: np.ndarray  # (n, 2Jp) jump of each point
+    point_coef: np.ndarray  # (n, Jp)
+    point_normal: np.ndarray  # (n, 2)
+    point_tangent: np.ndarray  # (n, 2)
+    slip_committed: np.ndarray  # (m,) [m]
     # g_T^p of a patch that has slid nothing (m,) [m]: -p_T0 / k_T, which lets
     # the penalty carry the in-situ shear p_T0 at zero jump; 0 once the patch
     # has opened (its faces separated and shed that shear)
-    slip_reference: np.ndarray = field(default=None)
-    state_committed: np.ndarray = field(default=None)  # (m,) int8
-    gt_committed: np.ndarray = field(default=None)
-    pt_committed: np.ndarray = field(default=None)
+    slip_reference: np.ndarray
+    state_committed: np.ndarray  # (m,) int8
+    gt_committed: np.ndarray
+    pt_committed: np.ndarray
     # kernel backend of the model ("numba" | "numpy", kernels.choose)
     kernels: str = field(kw_only=True)
     # slip weakening (kernels.contact): dynamic friction f_d [-] and cohesion
     # c_d [Pa], reached after slip_distance D_c [m] of accumulated slip; for
-    # constant friction f_d = f_s, c_d = c_s and D_c = inf (the default)
-    friction_dynamic: np.ndarray = field(default=None, kw_only=True)
-    cohesion_dynamic: np.ndarray = field(default=None, kw_only=True)
-    slip_distance: np.ndarray = field(default=None, kw_only=True)
+    # constant friction f_d = f_s, c_d = c_s and D_c = inf (_weakening_arrays)
+    friction_dynamic: np.ndarray = field(kw_only=True)
+    cohesion_dynamic: np.ndarray = field(kw_only=True)
+    slip_distance: np.ndarray = field(kw_only=True)
     # committed accumulated slip delta of each patch [m], like slip_committed
-    accumulated_committed: np.ndarray = field(default=None, kw_only=True)
-
-    def __post_init__(self):
-        if self.friction_dynamic is None:
-            self.friction_dynamic = self.friction.copy()
-        if self.cohesion_dynamic is None:
-            self.cohesion_dynamic = self.cohesion.copy()
-        if self.slip_distance is None:
-            self.slip_distance = np.full(self.weight.size, np.inf)
-        if self.accumulated_committed is None:
-            self.accumulated_committed = np.zeros(self.weight.size)
+    accumulated_committed: np.ndarray = field(kw_only=True)
 
     @property
     def n(self) -> int:
@@ -283,6 +273,7 @@ class ContactSet:
         )
 
     def tangent_matrix(self, result: ContactResult):
+        assert result.blocks is not None  # evaluated with its tangent kept
         return coo_block(self.dofs, result.blocks, self.n_dofs, self.kernels)
 
     def in_situ_force(self, zero: ContactResult) -> np.ndarray:
@@ -469,7 +460,7 @@ def contact_patches(
     for run in np.split(order, runs):
         cells, first = np.unique(ip.cell[run], return_index=True)
         cells = cells[np.argsort(first)]  # cells in order along the segment
-        piece = {c: [] for c in cells}
+        piece: dict[int, list[int]] = {c: [] for c in cells}
         for i in run:
             piece[ip.cell[i]].append(i)
         lengths = [ip.weight[piece[c]].sum() / size[piece[c][0]] for c in cells]
@@ -687,12 +678,13 @@ def build_contact(
         point_coef=coef,
         point_normal=np.ascontiguousarray(ip.normal),
         point_tangent=np.ascontiguousarray(ip.tangent),
+        slip_committed=slip0,
+        slip_reference=slip0.copy(),
+        state_committed=np.full(n, STICK, np.int8),
+        gt_committed=np.zeros(n),
+        pt_committed=-par["kt"] * slip0,
+        accumulated_committed=np.zeros(n),
         kernels=kernels,
         **par,
     )
-    cs.slip_committed = slip0
-    cs.slip_reference = slip0.copy()
-    cs.state_committed = np.full(n, STICK, np.int8)
-    cs.gt_committed = np.zeros(n)
-    cs.pt_committed = -par["kt"] * slip0
     return cs

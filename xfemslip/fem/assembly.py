@@ -362,7 +362,9 @@ def _enriched_entries(mesh, ec, D, material, qp_material, backend):
     return diag, Bbar, [rows, cols, vals]
 
 
-def _kept_entries(entries, to_dof, step=1 << 20):
+def _kept_entries(
+    entries, to_dof, step=1 << 20
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """The entries [rows, cols, vals] (emptied: the caller keeps no
     reference) renumbered by to_dof, those with a -1 left out, in place and
     in order, as (rows, cols, vals) views."""
@@ -468,7 +470,7 @@ def assemble_bulk(
     )
 
 
-def _triplets(dofs, blocks, backend):
+def _triplets(dofs, blocks, backend) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Rows, columns and values of the entries of per-item blocks (m, k, k)
     whose dofs (m, k) are both >= 0 (kernels.block_triplets)."""
     return kernels.backend(backend).block_triplets(

@@ -41,8 +41,8 @@ class Dirichlet:
 
 def dirichlet(mesh, boundary) -> Dirichlet:
     """Prescribed dofs and their final values from the four edges, plus pins."""
-    values = {}
-    owner = {}
+    values: dict[int, float] = {}  # dof -> prescribed value [m]
+    owner: dict[int, str] = {}  # dof -> the edge that prescribes it
     scale = 0.0
     for name in ("bottom", "top", "left", "right"):
         edge = getattr(boundary, name)
@@ -101,7 +101,7 @@ def hold_enriched(bc: Dirichlet, cand, dofmap) -> Dirichlet:
     kept = dofmap.cand_dof >= 0
     if not kept.any() or prescribed.size == 0:
         return bc
-    by_node = {}
+    by_node: dict[int, list[int]] = {}
     for k in np.nonzero(kept)[0]:
         by_node.setdefault(int(cand.node[k]), []).append(int(dofmap.cand_dof[k]))
     extra = [

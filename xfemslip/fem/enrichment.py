@@ -40,6 +40,7 @@ from __future__ import annotations
 
 import logging
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
@@ -103,7 +104,7 @@ class EnrichedCells:
         gF[used] = self.slot_gradF[v[used]]
         return F, gF
 
-    def part(self, rows) -> tuple[np.ndarray, ...]:
+    def part(self, rows) -> tuple[Any, ...]:
         """The points and slot values of the cells ``rows`` (indices into
         cells, or a slice of them: then views, no copy), as the cell kernels
         take them: (qp_offsets, points (index array or slice), slot_offsets,
@@ -342,11 +343,12 @@ def build_enriched_cells(
 
     Two passes: the sub-cells of every cell (its own cut lines, all cells in
     one call of the kernel ``backend``'s cell_subtriangles, "numba" or
-    "numpy"), then the enrichment functions of each (fracture, tip or arm) group evaluated once
-    on the quadrature points and sub-triangle vertices of all the cells the
-    group reaches (the functions are point-wise, so the values are those of a
-    cell-by-cell evaluation; measured in docs/performance.md, "Fracture
-    networks").  The fracture side of a point is that of its sub-cell's centroid.
+    "numpy"), then the enrichment functions of each (fracture, tip or arm)
+    group evaluated once on the quadrature points and sub-triangle vertices
+    of all the cells the group reaches (the functions are point-wise, so
+    the values are those of a cell-by-cell evaluation; measured in
+    docs/performance.md, "Fracture networks").  The fracture side of a point
+    is that of its sub-cell's centroid.
     """
     tol = GEOMETRY_TOL * mesh.h_min
     cand_fnode = _candidate_node_values(fractures, mesh, cand, tol)

@@ -12,6 +12,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from xfemslip.geometry.box import Box
+
 logger = logging.getLogger(__name__)
 
 
@@ -38,6 +40,11 @@ class Mesh:
     @property
     def n_cells(self) -> int:
         return self.cells.shape[0]
+
+    @property
+    def box(self) -> Box:
+        """The domain the mesh covers [m]."""
+        return Box.from_lines(self.x, self.y)
 
     @property
     def h_min(self) -> float:
@@ -75,8 +82,8 @@ def build_mesh(x: np.ndarray, y: np.ndarray) -> Mesh:
     nx, ny = x.size - 1, y.size - 1
     X, Y = np.meshgrid(x, y)
     nodes = np.column_stack([X.ravel(), Y.ravel()])
-    i, j = np.meshgrid(np.arange(nx), np.arange(ny))
-    i, j = i.ravel(), j.ravel()
+    gi, gj = np.meshgrid(np.arange(nx), np.arange(ny))
+    i, j = gi.ravel(), gj.ravel()
     n0 = j * (nx + 1) + i
     cells = np.column_stack([n0, n0 + 1, n0 + nx + 2, n0 + nx + 1]).astype(np.int64)
     bounds = np.column_stack([x[i], x[i + 1], y[j], y[j + 1]])

@@ -131,8 +131,8 @@ class Materials:
     cell: np.ndarray  # (n_cells,) int64 zone of each cell (by centre;
     # enriched cells: the zone covering most of their area)
     model: str
+    zones: Zones
     qp: np.ndarray | None = None  # (nq,) int64 zone of each enriched-cell QP
-    zones: Zones | None = None
 
     @property
     def several(self) -> bool:
@@ -207,17 +207,7 @@ def cell_centres(mesh) -> np.ndarray:
     return np.column_stack([0.5 * (b[:, 0] + b[:, 1]), 0.5 * (b[:, 2] + b[:, 3])])
 
 
-def domain_box(mesh) -> tuple[float, float, float, float]:
-    """(x0, x1, y0, y1) of the mesh [m]."""
-    return (
-        float(mesh.x[0]),
-        float(mesh.x[-1]),
-        float(mesh.y[0]),
-        float(mesh.y[-1]),
-    )
-
-
-def _on_fracture(fractures, p, q, tol) -> bool:
+def _on_fracture(fractures, p: np.ndarray, q: np.ndarray, tol: float) -> bool:
     """Whether one fracture segment covers the segment p-q (within tol [m])."""
     for fr in fractures:
         for a, b in zip(fr.points[:-1], fr.points[1:], strict=True):
@@ -245,10 +235,11 @@ def _on_mesh_line(mesh, p, q) -> bool:
     return False
 
 
-def _clip_to_domain(mesh, p, q):
+def _clip_to_domain(
+    mesh, p: np.ndarray, q: np.ndarray
+) -> tuple[np.ndarray, np.ndarray] | None:
     """The part of p-q inside the domain's bounding box, or None."""
-    lo = np.array([mesh.x[0], mesh.y[0]])
-    hi = np.array([mesh.x[-1], mesh.y[-1]])
+    lo, hi = mesh.box.lo, mesh.box.hi
     t0, t1 = 0.0, 1.0
     d = q - p
     for k in range(2):
@@ -266,7 +257,7 @@ def _warn_unaligned(mesh, unit, fractures=()) -> None:
     lines, unless a fracture covers it (its cut cells are split per QP)."""
     tol = ALIGN_TOL * mesh.h_min
     off = []
-    for name, p, q in edges(unit.region, domain_box(mesh)):
+    for name, p, q in edges(unit.region, mesh.box):
         if _on_mesh_line(mesh, p, q):
             continue
         part = _clip_to_domain(mesh, p, q)

@@ -146,7 +146,7 @@ def interface_points(
     GEOMETRY_TOL * min_cell (a kink falling on a piece's end) are skipped
     (default: 1e-12 of the segment length).
     """
-    cols = {
+    cols: dict[str, list[np.ndarray]] = {
         k: [] for k in ("fracture", "cell", "xy", "s", "weight", "normal", "tangent")
     }
     for fi, fr in enumerate(fractures):
@@ -155,17 +155,17 @@ def interface_points(
         ):
             p0 = fr.points[seg]
             d = fr.points[seg + 1] - p0
-            cuts = [ta, tb]
+            found = [ta, tb]
             if breaks is not None and len(breaks[fi]):
                 t = (np.asarray(breaks[fi]) - fr.s_start[seg]) / fr.length[seg]
-                cuts.extend(t[(t > ta) & (t < tb)])
+                found.extend(t[(t > ta) & (t < tb)])
             for tip in fr.tips:
                 dd = d @ tip.direction
                 if abs(dd) > 0.0:
                     t = (-tip.ramp_length - (p0 - tip.point) @ tip.direction) / dd
                     if ta < t < tb:
-                        cuts.append(t)
-            cuts = np.sort(cuts)
+                        found.append(t)
+            cuts = np.sort(found)
             tol = GEOMETRY_TOL * min_cell if min_cell else 1e-12 * fr.length[seg]
             keep = np.diff(cuts) * fr.length[seg] > tol
             for a, b in zip(cuts[:-1][keep], cuts[1:][keep], strict=True):

@@ -38,6 +38,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from xfemslip.geometry.box import Box
 from xfemslip.geometry.regions import edges, fault_side, in_region
 
 __all__ = [
@@ -128,7 +129,7 @@ def build_zones(spec) -> Zones:
             0.0,
         )
     ]
-    unit_zones = []
+    unit_zones: list[tuple[int, ...]] = []
     for unit in spec.units:
         base = (
             unit.E,
@@ -310,7 +311,7 @@ def _crossings(p, q, a, b, tol) -> list[float]:
     return [float(t)] if -1e-12 <= u <= 1.0 + 1e-12 else []
 
 
-def loading_breaks(zones: Zones, fractures, box, eps: float) -> list[np.ndarray]:
+def loading_breaks(zones: Zones, fractures, box: Box, eps: float) -> list[np.ndarray]:
     """Per fracture, the arc lengths [m] where the zone on one of its faces
     changes (a unit boundary meets it: a reservoir corner on a fault).
 
@@ -322,7 +323,7 @@ def loading_breaks(zones: Zones, fractures, box, eps: float) -> list[np.ndarray]
     out = []
     segments = [e for unit in zones.units for e in edges(unit.region, box)]
     for fr in fractures:
-        found = []
+        found: list[float] = []
         for k, (a, b) in enumerate(zip(fr.points[:-1], fr.points[1:], strict=True)):
             L = float(np.hypot(*(b - a)))
             for _, p, q in segments:

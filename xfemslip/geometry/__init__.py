@@ -2,6 +2,8 @@
 
 Modules:
 
+- ``box``: ``Box``, the axis-aligned box (the domain, a region's boxes, the
+  permeability block) and its conversions from and to the case file's forms;
 - ``fracture``: one Fracture (a polyline clipped to the domain and brought
   to the mesh's resolution), level sets, cell pieces, tips; ``build_fracture``;
 - ``junctions``: where fractures meet (X, T/Y, V), the snapping of ends onto
@@ -17,4 +19,4 @@ Modules:
 The subpackage imports nothing itself: import the module you need (``from
 xfemslip.geometry.fracture import ...``)."""
 
-__all__ = ["dfn", "fracture", "junctions", "polyline", "regions"]
+__all__ = ["box", "dfn", "fracture", "junctions", "polyline", "regions"]

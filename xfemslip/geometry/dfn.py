@@ -43,6 +43,8 @@ from typing import ClassVar
 
 import numpy as np
 
+from xfemslip.geometry.box import Box
+
 ORIENTATIONS = ("uniform", "von_mises", "normal")
 LENGTHS = ("constant", "power_law", "lognormal")
 INTERSECTIONS = ("allow", "avoid")
@@ -85,6 +87,13 @@ class LengthLaw:
         "sigma": "-",
     }
 
+    @property
+    def bounds(self) -> tuple[float, float]:
+        """(lmin, lmax) [m] of a power law (both required)."""
+        if self.lmin is None or self.lmax is None:
+            raise ValueError(f"a {self.kind!r} length law without lmin and lmax")
+        return self.lmin, self.lmax
+
 
 @dataclass(frozen=True, kw_only=True)
 class FractureSet:
@@ -101,7 +110,7 @@ class DfnParams:
     count: int | None = None  # exactly one of count, p20, p21
     p20: float | None = None  # [1/m^2]
     p21: float | None = None  # [m/m^2]
-    region: tuple[float, float, float, float] | None = None  # x0, x1, y0, y1 [m]
+    region: Box | None = None  # where the centres are drawn [m]
     sets: tuple[FractureSet, ...]
     intersections: str = "allow"
     min_spacing: float = 0.0  # [m], with intersections = "avoid"
@@ -172,7 +181,7 @@ def sample_lengths(rng: np.random.Generator, law: LengthLaw, n: int) -> np.ndarr
     if law.kind == "constant":
         return np.full(n, law.value)
     if law.kind == "power_law":
-        return power_law_ppf(rng.random(n), law.exponent, law.lmin, law.lmax)
+        return power_law_ppf(rng.random(n), law.exponent, *law.bounds)
     if law.kind == "lognormal":
         lo = law.lmin if law.lmin is not None else 0.0
         hi = law.lmax if law.lmax is not None else math.inf
@@ -193,7 +202,7 @@ def mean_length(law: LengthLaw) -> float:
     if law.kind == "constant":
         return law.value
     if law.kind == "power_law":
-        a, lo, hi = law.exponent, law.lmin, law.lmax
+        a, (lo, hi) = law.exponent, law.bounds
         if abs(a - 1.0) < 1e-12:
             return (hi - lo) / math.log(hi / lo)
         if abs(a - 2.0) < 1e-12:
@@ -223,15 +232,15 @@ def mean_length(law: LengthLaw) -> float:
     raise ValueError(f"unknown length law {law.kind!r}")
 
 
-def resolve_count(params: DfnParams, box) -> int:
+def resolve_count(params: DfnParams, box: Box) -> int:
     """The number of fractures asked for: count, round(P20 A) or
     round(P21 A / E[L]) over the region (default the domain box)."""
     if params.count is not None:
         return params.count
-    x0, x1, y0, y1 = params.region or box
-    area = (x1 - x0) * (y1 - y0)
+    area = Box(*(params.region or box)).area
     if params.p20 is not None:
         return int(round(params.p20 * area))
+    assert params.p21 is not None  # exactly one of count, p20, p21
     weights = np.array([s.weight for s in params.sets])
     mean = float(
         np.dot(weights / weights.sum(), [mean_length(s.length) for s in params.sets])
@@ -244,7 +253,7 @@ def resolve_count(params: DfnParams, box) -> int:
 # --------------------------------------------------------------------------- #
 
 
-def clip_to_box(p0: np.ndarray, p1: np.ndarray, box) -> tuple[np.ndarray, np.ndarray]:
+def clip_to_box(p0: np.ndarray, p1: np.ndarray, box: Box) -> tuple[float, float]:
     """Liang-Barsky for one segment: (t_in, t_out) in [0, 1]; empty if t_in >= t_out."""
     x0, x1, y0, y1 = box
     ta, tb = 0.0, 1.0
@@ -308,7 +317,7 @@ def intersecting_pairs(segments: np.ndarray, spacing: float = 0.0) -> list[tuple
 # --------------------------------------------------------------------------- #
 
 
-def _draw_block(rng, params: DfnParams, region, n: int) -> tuple:
+def _draw_block(rng, params: DfnParams, region: Box, n: int) -> tuple:
     """n candidates: (set index, centres (n, 2), angles [deg], lengths [m])."""
     weights = np.array([s.weight for s in params.sets], dtype=float)
     which = rng.choice(len(weights), size=n, p=weights / weights.sum())
@@ -324,7 +333,9 @@ def _draw_block(rng, params: DfnParams, region, n: int) -> tuple:
     return which, centers, angles, lengths
 
 
-def _fit(p0, p1, params: DfnParams, box):
+def _fit(
+    p0: np.ndarray, p1: np.ndarray, params: DfnParams, box: Box
+) -> tuple[np.ndarray, np.ndarray] | None:
     """End points kept in the domain, or None if the candidate is redrawn."""
     ta, tb = clip_to_box(p0, p1, box)
     if params.outside == "reject":
@@ -332,7 +343,7 @@ def _fit(p0, p1, params: DfnParams, box):
     if tb <= ta:
         return None
     # p0 + t (p1 - p0) may round a hair outside the box: put it on the edge
-    lo, hi = np.array(box[0::2]), np.array(box[1::2])
+    lo, hi = box.lo, box.hi
     q0 = np.clip(p0 + ta * (p1 - p0), lo, hi)
     q1 = np.clip(p0 + tb * (p1 - p0), lo, hi)
     if math.hypot(*(q1 - q0)) <= params.min_length:
@@ -340,8 +351,10 @@ def _fit(p0, p1, params: DfnParams, box):
     return q0, q1
 
 
-def generate(params: DfnParams, box, existing: np.ndarray | None = None) -> Network:
-    """Realize the network of ``params`` in the domain ``box`` = (x0, x1, y0, y1).
+def generate(
+    params: DfnParams, box: Box, existing: np.ndarray | None = None
+) -> Network:
+    """Realize the network of ``params`` in the domain ``box``.
 
     existing : (m, 2, 2) float64 [m], segments of the case's other fractures;
         with intersections = "avoid" the new ones keep away from these too.
@@ -349,7 +362,7 @@ def generate(params: DfnParams, box, existing: np.ndarray | None = None) -> Netw
     Returns a Network; ``placed < requested`` when the candidates ran out
     (ATTEMPTS_PER_FRACTURE per fracture asked for), which the caller reports.
     """
-    box = tuple(float(v) for v in box)
+    box = Box(*(float(v) for v in box))
     region = params.region or box
     rng = np.random.default_rng(params.seed)
     wanted = resolve_count(params, box)
@@ -411,8 +424,8 @@ def segments_csv_text(fractures) -> str:
     return "\n".join(lines) + "\n"
 
 
-def length_in_box(points: np.ndarray, box) -> float:
-    """Length [m] of a polyline (k, 2) inside box (x0, x1, y0, y1)."""
+def length_in_box(points: np.ndarray, box: Box) -> float:
+    """Length [m] of a polyline (k, 2) inside the box."""
     total = 0.0
     for a, b in zip(points[:-1], points[1:], strict=True):
         ta, tb = clip_to_box(a, b, box)
@@ -421,11 +434,10 @@ def length_in_box(points: np.ndarray, box) -> float:
     return total
 
 
-def network_stats(polylines, box) -> dict:
+def network_stats(polylines, box: Box) -> dict:
     """Count, P20 [1/m^2], length in the domain [m] (total, min, mean, max)
-    and P21 [m/m^2] of polylines in the domain box (x0, x1, y0, y1)."""
-    x0, x1, y0, y1 = box
-    area = (x1 - x0) * (y1 - y0)
+    and P21 [m/m^2] of polylines in the domain box."""
+    area = Box(*box).area
     lengths = np.array([length_in_box(np.asarray(p), box) for p in polylines])
     n = lengths.size
     return {

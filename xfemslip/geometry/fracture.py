@@ -19,6 +19,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from xfemslip.errors import GeometryError
+from xfemslip.geometry.box import Box
 from xfemslip.geometry.polyline import first_meeting, simplify
 
 logger = logging.getLogger(__name__)
@@ -250,30 +251,32 @@ def clip_segment(p0, p1, boxes):
     return ta, tb
 
 
-def clip_to_domain(points, box, tol, key):
+def clip_to_domain(points, box: Box, tol, key):
     """Clip a polyline to the domain box; it must stay in one connected piece."""
-    kept = []
+    boxes = np.asarray(box, float)[None, :]
+    # per segment: (start, end, t_start, t_end) of its part inside, or None
+    kept: list[tuple[np.ndarray, np.ndarray, float, float] | None] = []
     for p0, p1 in zip(points[:-1], points[1:], strict=True):
-        ta, tb = clip_segment(p0, p1, box[None, :])
+        ta, tb = clip_segment(p0, p1, boxes)
         if tb[0] - ta[0] <= 0.0:
             kept.append(None)
             continue
         kept.append((p0 + ta[0] * (p1 - p0), p0 + tb[0] * (p1 - p0), ta[0], tb[0]))
     idx = [k for k, piece in enumerate(kept) if piece is not None]
+    inside = [piece for piece in kept if piece is not None]  # those of idx
     if not idx:
         raise GeometryError(f"{key}: the fracture misses the domain")
     if idx != list(range(idx[0], idx[-1] + 1)) or any(
-        (kept[k][3] < 1.0 and k != idx[-1]) or (kept[k][2] > 0.0 and k != idx[0])
-        for k in idx
+        (piece[3] < 1.0 and k != idx[-1]) or (piece[2] > 0.0 and k != idx[0])
+        for k, piece in zip(idx, inside, strict=True)
     ):
         raise GeometryError(
             f"{key}: the fracture leaves and re-enters the domain; "
             "split it into separate fractures"
         )
-    pts = [kept[idx[0]][0]] + [kept[k][1] for k in idx]
-    pts = np.array(pts)
+    pts = np.array([inside[0][0]] + [piece[1] for piece in inside])
     seg_len = np.linalg.norm(np.diff(points, axis=0), axis=1)
-    s_offset = float(seg_len[: idx[0]].sum() + kept[idx[0]][2] * seg_len[idx[0]])
+    s_offset = float(seg_len[: idx[0]].sum() + inside[0][2] * seg_len[idx[0]])
     # drop segments that became (nearly) zero length by clipping
     keep = np.concatenate([[True], np.linalg.norm(np.diff(pts, axis=0), axis=1) > tol])
     if keep.sum() < 2:
@@ -324,7 +327,7 @@ def at_mesh_resolution(mesh, pts, key):
     return out
 
 
-def on_boundary(p, box, tol):
+def on_boundary(p, box: Box, tol):
     return (
         min(
             abs(p[0] - box[0]),
@@ -384,9 +387,9 @@ def _check_pieces_per_cell(mesh, piece_cell, key) -> None:
 
 
 def build_fracture(
-    mesh, spec, box, points=None, s_offset=0.0, junction_ends=(), reach=None
+    mesh, spec, box: Box, points=None, s_offset=0.0, junction_ends=(), reach=None
 ) -> Fracture:
-    """Fracture from a FractureSpec on a mesh; box = [x0, x1, y0, y1] of the domain.
+    """Fracture from a FractureSpec on a mesh; box: the domain.
 
     points / s_offset : the polyline already clipped (and snapped to its
     junctions, build_fractures); junction_ends : ends lying on another fracture

@@ -18,6 +18,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from xfemslip.errors import GeometryError
+from xfemslip.geometry.box import Box
 from xfemslip.geometry.fracture import (
     GEOMETRY_TOL,
     Fracture,
@@ -571,9 +572,9 @@ def _split_pieces(fr, s_values, tol):
     )
 
 
-def build_fractures(mesh, specs, box) -> tuple[Fracture, ...]:
-    """All fractures of a case, with their junctions (X, T/Y, V)."""
-    box = np.asarray(box, float)
+def build_fractures(mesh, specs, box: Box) -> tuple[Fracture, ...]:
+    """All fractures of a case, with their junctions (X, T/Y, V), in the
+    domain ``box``."""
     tol = GEOMETRY_TOL * mesh.h_min
     names = [f"fractures[{s.index}]" for s in specs]
     clipped, offsets, free = [], [], []
@@ -597,8 +598,9 @@ def build_fractures(mesh, specs, box) -> tuple[Fracture, ...]:
                 f"{names[f]}: a segment vanishes where the fracture is snapped onto "
                 "a junction; move its end point"
             )
-    junction_ends = [set() for _ in specs]
-    arcs = [[] for _ in specs]  # junction arc lengths (polyline own, from pts[0])
+    junction_ends: list[set[int]] = [set() for _ in specs]
+    # junction arc lengths (polyline own, from pts[0])
+    arcs: list[list[float]] = [[] for _ in specs]
     for kind, main, sec, point in found:
         if kind in ("T", "V"):
             pts = clipped[sec]
@@ -621,8 +623,9 @@ def build_fractures(mesh, specs, box) -> tuple[Fracture, ...]:
     ]
     # arms and cuts (Daux et al. 2000): the secondary of an X is cut into two
     # arms, each ending on the main; a T / V secondary's end arm is cut too
-    splits = [[] for _ in specs]
-    end_cuts = [{} for _ in specs]
+    # per fracture: (arc length, main fracture, point, tangent) of its X splits
+    splits: list[list[tuple]] = [[] for _ in specs]
+    end_cuts: list[dict[int, Cut]] = [{} for _ in specs]
     for kind, main, sec, point in found:
         fm, fs = fracs[main], fracs[sec]
         _, j, t, _ = _closest_on_polyline(fs.points, point)
@@ -650,7 +653,7 @@ def build_fractures(mesh, specs, box) -> tuple[Fracture, ...]:
     out = []
     for f, fr in enumerate(fracs):
         sp = sorted(splits[f], key=lambda r: r[0])
-        arms = [[] for _ in range(len(sp) + 1)]
+        arms: list[list[Cut]] = [[] for _ in range(len(sp) + 1)]
         for k, (_, main, point, tan) in enumerate(sp):
             arms[k].append(_junction_cut(fracs[main], fr, point, -tan, 0.0))
             arms[k + 1].append(_junction_cut(fracs[main], fr, point, tan, 0.0))

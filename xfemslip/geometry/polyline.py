@@ -58,7 +58,7 @@ def _overlap_pairs(lo: np.ndarray, hi: np.ndarray):
     then filtered on the other axis.  Every overlapping pair is produced once.
     """
     n = lo.shape[0]
-    best = None
+    best: tuple[int, np.ndarray, np.ndarray] | None = None
     for axis in (0, 1):
         order = np.argsort(lo[:, axis], kind="stable")
         start = lo[order, axis]
@@ -66,6 +66,7 @@ def _overlap_pairs(lo: np.ndarray, hi: np.ndarray):
         count = np.maximum(end - np.arange(n) - 1, 0)
         if best is None or count.sum() < best[2].sum():
             best = (axis, order, count)
+    assert best is not None
     axis, order, count = best
     other = 1 - axis
     first = 0

@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from xfemslip.geometry.box import Box
 from xfemslip.geometry.polyline import first_meeting
 
 
@@ -20,8 +21,8 @@ def in_boxes(xy: np.ndarray, boxes: np.ndarray) -> np.ndarray:
     """(n,) bool: points strictly inside one of the boxes (k, 4) [x0, y0, x1, y1]."""
     xy = np.asarray(xy, float).reshape(-1, 2)
     inside = np.zeros(xy.shape[0], bool)
-    for x0, y0, x1, y1 in np.asarray(boxes, float).reshape(-1, 4):
-        inside |= (xy[:, 0] > x0) & (xy[:, 0] < x1) & (xy[:, 1] > y0) & (xy[:, 1] < y1)
+    for corners in np.asarray(boxes, float).reshape(-1, 4):
+        inside |= Box.from_corners(*corners).contains(xy)
     return inside
 
 
@@ -120,12 +121,11 @@ def in_region(xy: np.ndarray, region) -> np.ndarray:
     return in_boxes(xy, region.boxes)
 
 
-def edges(region, box=None) -> list[tuple[str, np.ndarray, np.ndarray]]:
+def edges(region, box: Box | None = None) -> list[tuple[str, np.ndarray, np.ndarray]]:
     """(name, start, end) of every edge of the region, named by case key.
 
     A layer's horizons (and a displaced layer's, each ending at the fault)
-    run across ``box`` = (x0, x1, y0, y1), the domain; without it they are
-    left out."""
+    run across ``box``, the domain; without it they are left out."""
     kind = getattr(region, "kind", None)
     if kind in ("layer", "offset"):
         return [] if box is None else _horizon_edges(region, box)
@@ -133,7 +133,8 @@ def edges(region, box=None) -> list[tuple[str, np.ndarray, np.ndarray]]:
         P = np.asarray(region.polygon, float)
         return [(f"polygon edge {i}", P[i], P[(i + 1) % len(P)]) for i in range(len(P))]
     out = []
-    for i, (x0, y0, x1, y1) in enumerate(np.asarray(region.boxes, float)):
+    for i, corners in enumerate(np.asarray(region.boxes, float)):
+        x0, x1, y0, y1 = Box.from_corners(*corners)
         out += [
             (f"box {i}: x0 = {x0:g}", np.array([x0, y0]), np.array([x0, y1])),
             (f"box {i}: x1 = {x1:g}", np.array([x1, y0]), np.array([x1, y1])),
@@ -161,9 +162,9 @@ def polygon_problem(polygon: np.ndarray) -> str | None:
     return None
 
 
-def _horizon_edges(region, box) -> list[tuple[str, np.ndarray, np.ndarray]]:
-    """The horizons of a layer across the domain ``box`` (x0, x1, y0, y1);
-    those of a displaced layer end at its fault, one piece per side."""
+def _horizon_edges(region, box: Box) -> list[tuple[str, np.ndarray, np.ndarray]]:
+    """The horizons of a layer across the domain ``box``; those of a
+    displaced layer end at its fault, one piece per side."""
     x0, x1 = float(box[0]), float(box[1])
     if region.kind == "layer":
         return [

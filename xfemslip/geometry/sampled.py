@@ -54,6 +54,18 @@ class _Field:
     outside: str | float
     description: str
 
+    def _inside(self, xy: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """(values (n_fields, n), covered (n,) bool) at points xy (n, 2)."""
+        raise NotImplementedError
+
+    def _tree(self):
+        """A KD-tree of the data's locations (the "nearest" rule)."""
+        raise NotImplementedError
+
+    def _nearest_values(self) -> np.ndarray:
+        """(n_fields, m) values at the locations of ``_tree``."""
+        raise NotImplementedError
+
     def _outside_values(self, xy: np.ndarray, missing: np.ndarray, out: np.ndarray):
         """Fill out[:, missing] by the outside rule (or raise CaseError)."""
         if not missing.any():

@@ -17,7 +17,7 @@ from xfemslip.errors import OutputError
 from xfemslip.io.lock import folder_lock, reason, remove_tree, sibling
 
 
-def replace_files(writes: Mapping[Path, Callable[[Path], None] | None]) -> list[Path]:
+def replace_files(writes: Mapping[Path, Callable[[Path], object] | None]) -> list[Path]:
     """Write a set of single files that may lie in different folders.
 
     Parameters
@@ -51,9 +51,10 @@ def replace_files(writes: Mapping[Path, Callable[[Path], None] | None]) -> list[
                 stack.enter_context(folder_lock(current, current))
             with interrupt.deferred():
                 for current in finals:
-                    if writes[current] is not None:
+                    write = writes[current]
+                    if write is not None:
                         temps[current] = sibling(current, "tmp", os.getpid())
-                        writes[current](temps[current])
+                        write(temps[current])
                         interrupt.checkpoint()
                 for current in finals:
                     with contextlib.suppress(FileNotFoundError):
@@ -63,7 +64,8 @@ def replace_files(writes: Mapping[Path, Callable[[Path], None] | None]) -> list[
     except OSError as err:
         raise OutputError(f"cannot write {current}: {reason(err)}") from None
     except OutputError as err:  # from a writer that names its temporary file
-        err.args = (str(err).replace(str(temps.get(current)), str(current)),)
+        staged = temps.get(current) if current is not None else None
+        err.args = (str(err).replace(str(staged), str(current)),)
         raise
     finally:
         for tmp in temps.values():

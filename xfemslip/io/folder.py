@@ -303,6 +303,7 @@ def _commit(stage: Staging, owned: frozenset[str]) -> None:
     pause_for_test("staged")
     interrupt.checkpoint()  # a signal before the swap keeps the earlier set
     final, staging = stage.final, stage.path
+    assert staging is not None  # only a staged set is committed
     try:
         if not final.is_dir():
             os.rename(staging, final)
@@ -377,7 +378,7 @@ def _swap(staging: Path, final: Path) -> Path:
     return old
 
 
-_LIBC = []
+_LIBC: list[ctypes.CDLL] = []
 
 
 def _rename_exchange(a: Path, b: Path) -> None:

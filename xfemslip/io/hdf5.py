@@ -288,10 +288,10 @@ def _write_fracture(group: h5py.Group, fracture: FractureFields) -> None:
         ("friction_coefficient", "-"),
     )
     for name, units in optional:
-        value = getattr(fracture, name, None)
-        if value is not None:
+        given = getattr(fracture, name, None)
+        if given is not None:
             _dataset(
-                group, name, _as_array(value, np.float64, (n_points,), name), units
+                group, name, _as_array(given, np.float64, (n_points,), name), units
             )
 
 

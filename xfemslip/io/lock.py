@@ -79,7 +79,8 @@ def folder_lock(final: Path, display: Path) -> Iterator[None]:
         try:
             fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
         except BlockingIOError:
-            holder = (_pids(fd) or ["unknown"])[0]
+            pids = _pids(fd)
+            holder = pids[0] if pids else "unknown"
             os.close(fd)
             raise UsageError(
                 f"{display} is being written by another xfemslip process "

@@ -18,6 +18,7 @@ import h5py
 import numpy as np
 
 from xfemslip.errors import ResultError
+from xfemslip.geometry.box import Box
 from xfemslip.io.result_check import (
     check_attrs,
     check_final_copy,
@@ -241,7 +242,7 @@ def _permeability(h5: h5py.File) -> PermeabilityHistory | None:
         return None
     g = h5["permeability"]
     return PermeabilityHistory(
-        block=tuple(float(v) for v in g.attrs["block"]),
+        block=Box.from_corners(*g.attrs["block"]).corners,
         matrix=float(g.attrs["matrix"]),
         in_situ=g["in_situ"][()],
         tensors=g["tensor"][()],

@@ -190,7 +190,7 @@ def _check_fracture(fracture, where: str, path: Path) -> int:
         value = getattr(fracture, item.name)
         if value is None or item.name == "s":
             continue
-        shape = (k, 2) if item.name == "points" else (k,)
+        shape: tuple[int | None, ...] = (k, 2) if item.name == "points" else (k,)
         if item.name != "points" and np.ndim(value) == 2:
             shape = (k, None)
         array = _array(value, f"{where}/{item.name}", path, shape)

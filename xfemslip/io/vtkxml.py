@@ -73,7 +73,7 @@ def _encode(data: np.ndarray) -> list[bytes]:
     """The appended bytes of one compressed DataArray: its header of block
     sizes, then the compressed blocks."""
     # zero-copy views of the array's bytes (zlib reads any buffer)
-    raw = memoryview(np.ascontiguousarray(data)).cast("B")
+    raw = np.ascontiguousarray(data).data.cast("B")
     blocks = [raw[i : i + BLOCK_SIZE] for i in range(0, len(raw), BLOCK_SIZE)]
     packed = _compress(blocks)
     last = len(blocks[-1]) if blocks else 0
@@ -86,7 +86,7 @@ def _encode(data: np.ndarray) -> list[bytes]:
 class _Appended:
     """The DataArray tags of one file and the raw bytes they point to."""
 
-    def __init__(self):
+    def __init__(self) -> None:
         self.parts: list[bytes] = []
         self.offset = 0
 
@@ -170,10 +170,12 @@ def write_vtu(
         )
         _data_array(fh, "Points", points)
         fh.write(b"</Points>\n<Cells>\n")
-        conn = [c.reshape(-1) for _, c in blocks]
+        connectivity = [c.reshape(-1) for _, c in blocks]
         sizes = [np.full(c.shape[0], c.shape[1], np.int64) for _, c in blocks]
         types = [np.full(c.shape[0], CELL_TYPES[t], np.uint8) for t, c in blocks]
-        _data_array(fh, "connectivity", np.concatenate(conn or [np.zeros(0, np.int64)]))
+        _data_array(
+            fh, "connectivity", np.concatenate(connectivity or [np.zeros(0, np.int64)])
+        )
         _data_array(
             fh, "offsets", np.cumsum(np.concatenate(sizes or [np.zeros(0, np.int64)]))
         )

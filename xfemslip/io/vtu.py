@@ -265,7 +265,9 @@ def _fracture_part(
     s = np.asarray(fields.s, dtype=np.float64).reshape(-1)
     order = np.argsort(s, kind="stable")
     n_points = s.shape[0]
-    part = {"points": np.asarray(fields.points, dtype=np.float64).reshape(n_points, 2)}
+    part: dict[str, np.ndarray] = {
+        "points": np.asarray(fields.points, dtype=np.float64).reshape(n_points, 2)
+    }
     for name in FRACTURE_POINT_DATA:
         part[name] = np.asarray(getattr(fields, name), dtype=np.float64).reshape(
             n_points

@@ -18,12 +18,14 @@ def numba_settings() -> list[tuple[str, str]]:
     """Numba's threading layer, thread count, cache dir and JIT switch (for `info`)."""
     import numba
 
-    cache_dir = numba.config.CACHE_DIR or "default (__pycache__ next to the sources)"
+    # numba.config sets these from the environment when it is imported
+    config = vars(numba.config)
+    cache_dir = config["CACHE_DIR"] or "default (__pycache__ next to the sources)"
     return [
-        ("numba threading layer", str(numba.config.THREADING_LAYER)),
-        ("NUMBA_NUM_THREADS", str(numba.config.NUMBA_NUM_THREADS)),
+        ("numba threading layer", str(config["THREADING_LAYER"])),
+        ("NUMBA_NUM_THREADS", str(config["NUMBA_NUM_THREADS"])),
         ("numba cache dir", str(cache_dir)),
-        ("NUMBA_DISABLE_JIT", str(numba.config.DISABLE_JIT)),
+        ("NUMBA_DISABLE_JIT", str(config["DISABLE_JIT"])),
         (
             "xfemslip numba cache",
             "on" if NUMBA_CACHE else "off (XFEMSLIP_NUMBA_CACHE=0)",

@@ -29,6 +29,7 @@ from matplotlib.collections import LineCollection
 from matplotlib.figure import Figure
 from matplotlib.patches import Rectangle
 
+from xfemslip.case.specs import CaseSpec
 from xfemslip.fem.zones import build_zones
 from xfemslip.geometry.regions import edges
 
@@ -44,15 +45,15 @@ SYMBOLS = 9  # rollers or arrows per edge
 MAX_MESH_LINES = 160  # per direction; more are thinned (every k-th drawn)
 
 
-def _edge_points(spec, name: str, n: int) -> np.ndarray:
+def _edge_points(spec: CaseSpec, name: str, n: int) -> np.ndarray:
     """n points spread along an edge (not at the corners)."""
-    (x0, y0), (w, h) = spec.origin, spec.size
+    box, (w, h) = spec.box, spec.size
     t = (np.arange(n) + 0.5) / n
     if name in ("bottom", "top"):
-        y = y0 if name == "bottom" else y0 + h
-        return np.column_stack([x0 + t * w, np.full(n, y)])
-    x = x0 if name == "left" else x0 + w
-    return np.column_stack([np.full(n, x), y0 + t * h])
+        y = box.y0 if name == "bottom" else box.y1
+        return np.column_stack([box.x0 + t * w, np.full(n, y)])
+    x = box.x0 if name == "left" else box.x1
+    return np.column_stack([np.full(n, x), box.y0 + t * h])
 
 
 def _colours(n: int) -> list:
@@ -63,7 +64,7 @@ def _colours(n: int) -> list:
     return list(matplotlib.colormaps["turbo"](np.linspace(0.0, 1.0, n)))
 
 
-def _mesh_lines(ax, spec) -> str:
+def _mesh_lines(ax, spec: CaseSpec) -> str:
     """The mesh lines (every k-th beyond MAX_MESH_LINES); returns a note."""
     x, y = spec.mesh.x, spec.mesh.y
     step = max(1, int(np.ceil(max(len(x), len(y)) / MAX_MESH_LINES)))
@@ -79,16 +80,16 @@ def _mesh_lines(ax, spec) -> str:
 ZONE_RASTER = 400
 
 
-def _regions(ax, spec) -> list[str]:
+def _regions(ax, spec: CaseSpec) -> list[str]:
     """The rock units (filled by zone, edges drawn) and where the pore
     pressure changes; legend notes."""
     notes = []
     pore = spec.pore_pressure
     if spec.units:
         zones = build_zones(spec)
-        (x0, y0), (w, h) = spec.origin, spec.size
-        gx = np.linspace(x0, x0 + w, ZONE_RASTER)
-        gy = np.linspace(y0, y0 + h, ZONE_RASTER)
+        box = spec.box
+        gx = np.linspace(box.x0, box.x1, ZONE_RASTER)
+        gy = np.linspace(box.y0, box.y1, ZONE_RASTER)
         X, Y = np.meshgrid(gx, gy)
         Z = zones.at(np.column_stack([X.ravel(), Y.ravel()])).reshape(X.shape)
         colours = matplotlib.colormaps["Pastel1"](np.arange(zones.n) % 9)
@@ -96,12 +97,11 @@ def _regions(ax, spec) -> list[str]:
         ax.imshow(
             colours[Z],
             origin="lower",
-            extent=(x0, x0 + w, y0, y0 + h),
+            extent=box,
             interpolation="nearest",
             aspect="auto",
             zorder=0,
         )
-        box = (x0, x0 + w, y0, y0 + h)
         for k in range(1, zones.n):
             label = (
                 f"{zones.names[k]}: E = {zones.E[k] / 1e9:g} GPa, "
@@ -115,19 +115,20 @@ def _regions(ax, spec) -> list[str]:
                 ax.plot([p[0], q[0]], [p[1], q[1]], color="0.35", lw=0.8)
     if pore is not None:
         where = "everywhere" if pore.region == "all" else f"in {pore.region}"
+        if pore.field is not None:
+            change = f"\u0394p from {pore.field.file.name}"
+        else:
+            assert pore.change is not None  # without a field, a uniform change
+            change = f"\u0394p = {pore.change / 1e6:g} MPa {where}"
         notes.append(
             f"pore pressure p0 = {pore.initial / 1e6:g} MPa, change "
-            + (
-                f"\u0394p = {pore.change / 1e6:g} MPa {where}"
-                if pore.change is not None
-                else f"\u0394p from {pore.field.file.name}"
-            )
+            + change
             + f" (Biot {pore.biot:g})"
         )
     return notes
 
 
-def _fractures(ax, spec) -> None:
+def _fractures(ax, spec: CaseSpec) -> None:
     colours = _colours(len(spec.fractures))
     many = len(spec.fractures) > 10
     for k, fr in enumerate(spec.fractures):
@@ -157,7 +158,7 @@ def _fractures(ax, spec) -> None:
         )
 
 
-def _arrows(ax, points, vectors, colour, label) -> None:
+def _arrows(ax, points, vectors, colour, label: str | None) -> None:
     ax.quiver(
         points[:, 0],
         points[:, 1],
@@ -177,7 +178,7 @@ def _arrows(ax, points, vectors, colour, label) -> None:
 TOWARDS = {"bottom": "^", "top": "v", "left": ">", "right": "<"}
 
 
-def _boundary(ax, spec) -> list[str]:
+def _boundary(ax, spec: CaseSpec) -> list[str]:
     """Symbols of each edge's condition; returns one note per edge."""
     notes, size = [], 0.07 * max(spec.size)
     stress = spec.loading.stress
@@ -185,9 +186,9 @@ def _boundary(ax, spec) -> list[str]:
     if stress is not None:
         S = np.array([[stress[0], stress[2]], [stress[2], stress[1]]])
     tractions, used = {}, set()
-    for name, normal in OUTWARD.items():
+    for name, outward in OUTWARD.items():
         edge = getattr(spec.boundary, name)
-        normal = np.array(normal)
+        normal = np.array(outward)
         points = _edge_points(spec, name, SYMBOLS)
         loaded = np.zeros(2, bool)  # components that carry sigma . n
         words = []
@@ -229,7 +230,7 @@ def _boundary(ax, spec) -> list[str]:
             )
         notes.append(f"{name:>6}: " + (", ".join(words) or "free"))
     top = max((np.linalg.norm(t) for t in tractions.values()), default=0.0)
-    label = "traction \u03c3\u00b7n of loading.stress"
+    label: str | None = "traction \u03c3\u00b7n of loading.stress"
     for name, t in tractions.items():
         if top == 0.0 or not np.any(t):
             continue
@@ -248,7 +249,7 @@ def _boundary(ax, spec) -> list[str]:
     return notes
 
 
-def figure_case(spec) -> Figure:
+def figure_case(spec: CaseSpec) -> Figure:
     """The geometry, mesh, fractures, boundary conditions and loads of a case."""
     fig = Figure(figsize=(9.6, 7.0), layout="constrained")
     ax = fig.subplots()

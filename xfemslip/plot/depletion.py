@@ -10,7 +10,6 @@ from pathlib import Path
 import numpy as np
 
 from xfemslip.conventions import SLIP
-from xfemslip.fem.poro import domain_box
 from xfemslip.geometry.regions import edges
 
 
@@ -66,16 +65,18 @@ def plot_field(model, result, out_dir: Path, dpi: float = 110.0) -> Path:
     s0 = cell_in_situ(model)
     s0 = np.zeros(3) if s0 is None else np.atleast_2d(np.asarray(s0, float))
     shape = (mesh.ny, mesh.nx)
+    stress = f.stress
+    assert stress is not None  # step_fields computes the stresses
     panels = [
         (
             "shear stress change $\\Delta\\sigma_{xy}$ [MPa]",
-            f.stress[:, 2] - np.broadcast_to(s0, f.stress.shape)[:, 2],
+            stress[:, 2] - np.broadcast_to(s0, stress.shape)[:, 2],
         ),
         (
             "effective stress $\\sigma'_{xx}$ [MPa]",
             f.effective_stress[:, 0]
             if f.effective_stress is not None
-            else f.stress[:, 0],
+            else stress[:, 0],
         ),
     ]
     fig, axes = plt.subplots(1, 2, figsize=(10.0, 4.2), constrained_layout=True)
@@ -88,7 +89,7 @@ def plot_field(model, result, out_dir: Path, dpi: float = 110.0) -> Path:
         )
         fig.colorbar(im, ax=ax, shrink=0.85)
         for unit in model.spec.units:
-            for _, p, q in edges(unit.region, domain_box(mesh)):
+            for _, p, q in edges(unit.region, mesh.box):
                 ax.plot([p[0], q[0]], [p[1], q[1]], "k--", lw=0.8)
         for fr in f.fractures:
             slip = fr.state == SLIP

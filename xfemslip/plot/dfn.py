@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import csv
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 from matplotlib.collections import LineCollection
@@ -19,6 +20,7 @@ from matplotlib.colors import Normalize
 from matplotlib.figure import Figure
 from matplotlib.ticker import MaxNLocator
 
+from xfemslip.case.specs import CaseSpec
 from xfemslip.conventions import SLIP
 from xfemslip.errors import OutputError, UsageError
 from xfemslip.io.read import read_result
@@ -30,9 +32,10 @@ MAX_FRACTURE_COUNT = 1_000_000
 MAX_BARS = 200  # one histogram bar per count up to this spread
 
 
-def _domain_frame(ax, spec) -> None:
+def _domain_frame(ax, spec: CaseSpec) -> None:
     (x0, y0), (w, h) = spec.origin, spec.size
-    ax.plot([x0, x0 + w, x0 + w, x0, x0], [y0, y0, y0 + h, y0 + h, y0], "k-", lw=0.8)
+    frame = np.vstack([spec.box.vertices(), spec.box.vertices()[:1]])
+    ax.plot(*frame.T, "k-", lw=0.8)
     ax.set_aspect("equal")
     ax.set_xlim(x0 - 0.02 * w, x0 + 1.02 * w)
     ax.set_ylim(y0 - 0.02 * h, y0 + 1.02 * h)
@@ -64,14 +67,16 @@ def _draw_slip(fig, ax, fields) -> None:
         pieces = np.stack([points[:-1], points[1:]], axis=1)
         value = 0.5 * (np.abs(slip[:-1]) + np.abs(slip[1:]))
         width = 2.6 if np.any(state == SLIP) else 1.0
-        collection = LineCollection(pieces, cmap="viridis", norm=norm, linewidths=width)
+        collection = LineCollection(
+            list(pieces), cmap="viridis", norm=norm, linewidths=width
+        )
         collection.set_array(value)
         ax.add_collection(collection)
     if collection is not None:
         fig.colorbar(collection, ax=ax, label="|slip| (m)", shrink=0.8)
 
 
-def _draw_plain(ax, spec) -> None:
+def _draw_plain(ax, spec: CaseSpec) -> None:
     """Fractures coloured by where they come from (inline, file, generated)."""
     colours = {"": "tab:red", "network.file": "tab:blue", "network.generate": "k"}
     for fracture in spec.fractures:
@@ -134,6 +139,7 @@ def _short(n: int) -> str:
 def _draw_counts(ax, counts: np.ndarray, totals: np.ndarray) -> None:
     """Histogram of the slipping count over the realizations: one bar per
     count up to MAX_BARS counts apart, else numpy's automatic bins."""
+    bins: Any
     if counts.size and counts.max() - counts.min() < MAX_BARS:
         bins = np.arange(counts.min(), counts.max() + 2) - 0.5
     else:
@@ -153,7 +159,9 @@ def _draw_counts(ax, counts: np.ndarray, totals: np.ndarray) -> None:
         )
 
 
-def figure_network(spec, result: Path | None = None, summary: Path | None = None):
+def figure_network(
+    spec: CaseSpec, result: Path | None = None, summary: Path | None = None
+):
     """The network of ``spec`` (slip from ``result``), plus the slipping-count
     histogram of a sweep ``summary`` when given."""
     n = 2 if summary is not None else 1

@@ -115,7 +115,11 @@ def _row_colorbar(fig, mappable, axes_row, label: str) -> None:
 
 def _triangulation(data: ResultData):
     """(Triangulation, displacement (P, 2)): the split mesh when available."""
-    if data.vis_triangles is not None:
+    if (
+        data.vis_triangles is not None
+        and data.vis_points is not None
+        and data.vis_displacement is not None
+    ):
         pts, tri, u = data.vis_points, data.vis_triangles, data.vis_displacement
     else:
         c = data.cells
@@ -212,7 +216,11 @@ def auto_scale(data: ResultData) -> float:
 
 def _draw_mesh(ax, data: ResultData, factor: float) -> str:
     """The deformed element outlines; returns a note for the title."""
-    if data.vis_edges is None:
+    if (
+        data.vis_edges is None
+        or data.vis_points is None
+        or data.vis_displacement is None
+    ):
         moved = data.points + factor * data.displacement
         ax.add_collection(
             PolyCollection(
@@ -222,7 +230,7 @@ def _draw_mesh(ax, data: ResultData, factor: float) -> str:
         return "no result.vtu: the jump is not shown"
     moved = data.vis_points + factor * data.vis_displacement
     ax.add_collection(
-        LineCollection(moved[data.vis_edges], colors="0.2", linewidths=0.35)
+        LineCollection(list(moved[data.vis_edges]), colors="0.2", linewidths=0.35)
     )
     return "cut elements split along the fracture"
 
@@ -364,7 +372,7 @@ def figure_network(data: ResultData, scale: float | None = None) -> Figure:
         )
         moved = pieces + factor * data.displacement[near].reshape(pieces.shape)
         mappable = LineCollection(
-            moved,
+            list(moved),
             array=1e3 * np.abs(fr.slid[owner]),
             cmap="plasma",
             norm=norm,
@@ -374,7 +382,9 @@ def figure_network(data: ResultData, scale: float | None = None) -> Figure:
         ax_slip.add_collection(mappable)
         colours = [STATE_COLOURS.get(int(c), "k") for c in fr.state[owner]]
         ax_state.add_collection(
-            LineCollection(pieces, colors=colours, linewidths=2.2, capstyle="butt")
+            LineCollection(
+                list(pieces), colors=colours, linewidths=2.2, capstyle="butt"
+            )
         )
         m = fr.points[len(fr.points) // 3]  # not the middle: Xs cross there
         ax_state.annotate(
@@ -401,7 +411,8 @@ def figure_network(data: ResultData, scale: float | None = None) -> Figure:
 def _point_labels(results: Sequence[ResultData]) -> dict:
     """Label of each (result, fracture) point on the Mohr circle; results whose
     points coincide (same stress and angle) share one label, on the first."""
-    labels, first = {}, {}
+    labels: dict[tuple[int, int], str] = {}
+    first: dict[tuple, tuple[int, int]] = {}  # key -> the label's owner
     for k, data in enumerate(results):
         for f in data.fractures:
             if len(results) == 1:
@@ -477,7 +488,11 @@ def figure_mohr(results: Sequence[ResultData]) -> Figure:
             for f in data.fractures
         ]
         keys = {(stress, f, c) for _, _, f, c in fractures}
-        if changed and data.in_situ_stress not in circles:
+        if (
+            changed
+            and data.in_situ_stress is not None
+            and data.in_situ_stress not in circles
+        ):
             draw_circle(ax, data.in_situ_stress, "0.6", "in situ", lw=0.9, ls=":")
             circles.add(data.in_situ_stress)
         draw_mohr(

@@ -343,10 +343,10 @@ def _inset(ax, band, lines) -> None:
         fontsize=7,
     )
     for theta, color in lines:
-        t = math.radians(theta)
+        angle = math.radians(theta)
         ins.plot(
-            [-math.cos(t), math.cos(t)],
-            [-math.sin(t), math.sin(t)],
+            [-math.cos(angle), math.cos(angle)],
+            [-math.sin(angle), math.sin(angle)],
             color=color,
             lw=1.5,
         )

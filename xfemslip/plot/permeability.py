@@ -22,6 +22,7 @@ import numpy as np
 from matplotlib.figure import Figure
 
 from xfemslip.errors import UsageError
+from xfemslip.geometry.box import Box
 from xfemslip.io.read import read_result
 
 __all__ = ["figure_permeability", "load_axis"]
@@ -60,7 +61,7 @@ def figure_permeability(path: str | Path, label: str | None = None) -> Figure:
     history = result.permeability
     fig = Figure(figsize=(12.0, 3.8), layout="constrained")
     ax_a, ax_t, ax_k = fig.subplots(1, 3)
-    for i, ff in enumerate(result.final.fractures):
+    for i, ff in enumerate(result.fractures):
         if ff.aperture is None or not np.size(ff.s):
             continue
         s = ff.s - ff.s.min()
@@ -85,7 +86,7 @@ def figure_permeability(path: str | Path, label: str | None = None) -> Figure:
     ax_k.plot(x, ratios[:, 1], "s-", ms=3, label="k_yy / k_yy,0")
     ax_k.set_xlabel(xlabel + (" (0: in situ)" if xlabel == "load step" else ""))
     ax_k.set_ylabel("permeability / in situ [-]")
-    x0, y0, x1, y1 = history.block
+    x0, x1, y0, y1 = Box.from_corners(*history.block)
     ax_k.set_title(f"block [{x0:g}, {x1:g}] x [{y0:g}, {y1:g}] m (Oda)", fontsize=9)
     ax_k.legend(fontsize=8)
     for ax in (ax_a, ax_t, ax_k):

@@ -92,7 +92,11 @@ def figure_profile(path: Path | str, label: str | None = None) -> Figure:
         )
         a1.plot(ff.shear_traction / 1e6, z, "-", color="tab:red", label="shear $p_T$")
         a1.plot(normal / 1e6, z, "-", color="tab:blue", label="normal $p_N'$")
-        if prop is not None and prop.in_situ_normal_traction is not None:
+        if (
+            prop is not None
+            and prop.in_situ_normal_traction is not None
+            and prop.in_situ_shear_traction is not None
+        ):
             a1.plot(prop.in_situ_shear_traction / 1e6, z, "--", color="tab:red", lw=0.8)
             a1.plot(
                 prop.in_situ_normal_traction / 1e6, z, "--", color="tab:blue", lw=0.8

@@ -33,6 +33,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from xfemslip.case.specs import CaseSpec
 from xfemslip.conventions import SLIP
 from xfemslip.post.metrics import point_stretches
 from xfemslip.post.result import EventTable, Result
@@ -127,7 +128,7 @@ NO_PROPERTIES = (
 )
 
 
-def event_inputs(result: Result, spec=None) -> EventInputs:
+def event_inputs(result: Result, spec: CaseSpec | None = None) -> EventInputs:
     """The :class:`EventInputs` of ``result``, from what it stores; W is
     ``events.extent`` of ``spec`` (the case it ran) when given, else the one
     its ``/events`` recorded, else each fracture's slipping length."""
@@ -224,7 +225,7 @@ def event_sizes(result: Result, inputs: EventInputs) -> list[list[FractureEvent]
     """Per converged load step, the :class:`FractureEvent` of every fracture:
     those the result keeps (``result.events``) when it has them, else
     computed from its fields."""
-    if _stored(result):
+    if result.events is not None and _stored(result):
         return _from_table(result.events)
     return _computed(result, inputs)
 
@@ -367,7 +368,7 @@ def _number(value: float):
     return float(value) if math.isfinite(value) else ""
 
 
-def fracture_metrics(result: Result, spec) -> dict:
+def fracture_metrics(result: Result, spec: CaseSpec) -> dict:
     """The sweep columns of the final step of ``result`` (the case ``spec``):
     CASE_COLUMNS, and FRACTURE_COLUMNS of each fracture when there are at
     most MAX_FRACTURE_COLUMNS of them (a network's realizations have their

@@ -25,7 +25,7 @@ from xfemslip.contact.interface import JUMP_PROBE
 from xfemslip.conventions import STICK
 from xfemslip.fem.enrichment import HEAVISIDE, find_candidates, group_values
 from xfemslip.fem.material import shear_modulus
-from xfemslip.fem.poro import FACE_OFFSET, cell_centres, domain_box, face_zones
+from xfemslip.fem.poro import FACE_OFFSET, cell_centres, face_zones
 from xfemslip.fem.zones import build_zones, in_situ_stress, loading_breaks
 from xfemslip.geometry.fracture import GEOMETRY_TOL
 
@@ -412,6 +412,7 @@ def step_fields(model, r) -> StepFields:
     extra = {}
     fluid = None
     if pore is not None:
+        assert biot_p is not None  # set with the pore pressure above
         extra = {
             "effective_stress": stress + biot_p[1][:, None] * [1.0, 1.0, 0.0],
             "pore_pressure": p,
@@ -460,7 +461,7 @@ def fracture_properties(model) -> list[FractureProperties]:
     use0 = np.where(pn0 > 0.0, 1.0, use0)  # in tension in situ: it opens
     breaks = model.breaks
     if breaks is None:
-        breaks = loading_breaks(zones, model.fractures, domain_box(model.mesh), eps)
+        breaks = loading_breaks(zones, model.fractures, model.mesh.box, eps)
     out = []
     for fi, fr in enumerate(model.fractures):
         m = np.nonzero(ip.fracture == fi)[0]

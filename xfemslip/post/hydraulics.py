@@ -32,9 +32,11 @@ from __future__ import annotations
 
 import numpy as np
 
+from xfemslip.case.specs import CaseSpec
 from xfemslip.conventions import OPEN
 from xfemslip.fem.poro import FACE_OFFSET
 from xfemslip.fem.zones import build_zones, in_situ_stress, initial_pressure
+from xfemslip.geometry.box import Box
 from xfemslip.post.metrics import arc_extent, fracture_ends, point_stretches
 from xfemslip.post.permeability import ApertureLaw, oda_tensor, transmissivity
 from xfemslip.post.result import PermeabilityHistory, Result
@@ -72,7 +74,7 @@ def polyline_tangents(points, s) -> np.ndarray:
     return d[k] / length[k, None]
 
 
-def in_situ_normal(spec, tangents, points=None) -> np.ndarray:
+def in_situ_normal(spec: CaseSpec, tangents, points=None) -> np.ndarray:
     """sigma_n0' = n . sigma0 . n + p0 [Pa] at points of the given unit
     tangents (K, 2): the effective normal traction of the in-situ state;
     ``points`` (K, 2) [m] where it varies with depth (the mean of the two
@@ -91,7 +93,9 @@ def in_situ_normal(spec, tangents, points=None) -> np.ndarray:
             face = xy + 2.0 * sign * eps * n
             zone = zones.at(face)
             p = initial_pressure(spec, zones, xy, zone)
-            S += 0.5 * in_situ_stress(spec, zones, face, zone, p)
+            face_stress = in_situ_stress(spec, zones, face, zone, p)
+            assert face_stress is not None  # the case has an in-situ stress
+            S += 0.5 * face_stress
             p0 += 0.5 * p
         sn = S[:, 0] * n[:, 0] ** 2 + S[:, 1] * n[:, 1] ** 2
         return sn + 2.0 * S[:, 2] * n[:, 0] * n[:, 1] + p0
@@ -117,20 +121,15 @@ def block_stretches(s, domain_ends, block_ends) -> np.ndarray:
     return np.maximum(inside, 0.0)
 
 
-def _box(x0, y0, x1, y1) -> tuple[float, float, float, float]:
-    """(x0, x1, y0, y1), the order of ``arc_extent``."""
-    return (x0, x1, y0, y1)
-
-
-def add_permeability(result: Result, spec) -> None:
+def add_permeability(result: Result, spec: CaseSpec) -> None:
     """Fill, for a case with ``[permeability]``, the ``aperture`` and
     ``transmissivity`` of every fracture of every step of ``result`` and
     ``result.permeability`` (module doc); nothing without the table."""
     p = spec.permeability
     if p is None or not result.steps:
         return
-    block = _box(*p.block)
-    area = (p.block[2] - p.block[0]) * (p.block[3] - p.block[1])
+    block = Box.from_corners(*p.block)
+    area = block.area
     laws = [aperture_law(law) for law in p.laws]
     geometry = []  # per fracture: tangents, sigma_n0', block stretches
     ends = fracture_ends(result, spec)
@@ -164,7 +163,7 @@ def add_permeability(result: Result, spec) -> None:
             parts.append((wk, t, ff.aperture))
         tensors.append(oda_tensor(parts, area, p.matrix))
     result.permeability = PermeabilityHistory(
-        block=tuple(p.block),
+        block=p.block,
         matrix=float(p.matrix),
         in_situ=in_situ,
         tensors=np.array(tensors).reshape(-1, 2, 2),
@@ -206,12 +205,13 @@ def permeability_lines(result: Result, index: int = -1) -> list[str]:
         s = np.asarray(ff.s, float)
         w = point_stretches(s, s[0], s[-1]) if s.size > 1 else np.ones(1)
         mean_a = float(np.sum(w * ff.aperture) / np.sum(w))
+        assert ff.transmissivity is not None  # filled with the aperture
         ratio = float(np.sum(w * ff.transmissivity) / np.sum(w)) / (a0**3 / 12.0)
         lines.append(
             f"{i:>8}  {a0 * 1e3:>8.4g}  {mean_a * 1e3:>11.4g}  "
             f"{float(np.max(ff.aperture)) * 1e3:>10.4g}  {ratio:>8.4g}"
         )
-    x0, y0, x1, y1 = history.block
+    x0, x1, y0, y1 = Box.from_corners(*history.block)
     k0, k = history.in_situ, history.tensors[index]
     lines.append(
         f"block [{x0:g}, {x1:g}] x [{y0:g}, {y1:g}] m, permeability [m^2] in situ "

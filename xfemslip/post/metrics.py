@@ -12,7 +12,9 @@ import math
 
 import numpy as np
 
+from xfemslip.case.specs import CaseSpec
 from xfemslip.conventions import SLIP
+from xfemslip.geometry.box import Box
 from xfemslip.geometry.fracture import clip_segment
 from xfemslip.post.result import Result
 
@@ -40,8 +42,8 @@ METRICS = (
 )
 
 
-def arc_extent(points: np.ndarray, box: tuple) -> tuple[float, float]:
-    """Arc-length range [s_lo, s_hi] of a polyline inside box (x0, x1, y0, y1)."""
+def arc_extent(points: np.ndarray, box: Box) -> tuple[float, float]:
+    """Arc-length range [s_lo, s_hi] of a polyline inside the box."""
     points = np.asarray(points, dtype=float)
     seg = np.linalg.norm(np.diff(points, axis=0), axis=1)
     start = np.concatenate([[0.0], np.cumsum(seg)[:-1]])
@@ -71,27 +73,22 @@ def slipping_length(s, state, s_lo: float, s_hi: float) -> float:
     return float(np.sum(stretch[np.asarray(state) == SLIP]))
 
 
-def fracture_ends(result: Result, spec) -> list[tuple[float, float]]:
+def fracture_ends(result: Result, spec: CaseSpec | None) -> list[tuple[float, float]]:
     """The arc-length range [m] of each fracture of ``result`` inside the
     domain: as the result stores it (``fracture_properties``), else from the
     case ``spec`` (a result written before the ends were kept)."""
     if result.fracture_properties is not None:
         return [p.ends for p in result.fracture_properties]
-    box = (
-        spec.origin[0],
-        spec.origin[0] + spec.size[0],
-        spec.origin[1],
-        spec.origin[1] + spec.size[1],
-    )
-    return [arc_extent(fracture.points, box) for fracture in spec.fractures]
+    assert spec is not None  # a result without the ends needs its case
+    return [arc_extent(fracture.points, spec.box) for fracture in spec.fractures]
 
 
-def result_metrics(result: Result, spec) -> dict:
+def result_metrics(result: Result, spec: CaseSpec) -> dict:
     """The METRICS of a result (final step) of the case ``spec``; the slip is
     the one that slid (``FractureFields.slid``)."""
     slip_max, length, n_slip, n_points = 0.0, 0.0, 0, 0
     slipping_means = []  # mean |slip| of each fracture with a point in slip
-    fields = result.final.fractures if result.steps else []
+    fields = result.final.fractures if result.final is not None else []
     for ends, ff in zip(fracture_ends(result, spec), fields, strict=False):
         s, slip, state = ff.s, ff.slid, ff.state
         if slip.size:

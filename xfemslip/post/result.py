@@ -173,12 +173,16 @@ class Result:
     @property
     def stress(self) -> np.ndarray:
         """(M, 3) [Pa] element-average sxx, syy, sxy of the final step."""
-        return self._final().stress
+        stress = self._final().stress
+        assert stress is not None  # the final step keeps its stresses
+        return stress
 
     @property
     def principal_stress(self) -> np.ndarray:
         """(M, 2) [Pa] s_max, s_min of the final step."""
-        return self._final().principal_stress
+        principal = self._final().principal_stress
+        assert principal is not None  # the final step keeps its stresses
+        return principal
 
     @property
     def fractures(self) -> list[FractureFields]:

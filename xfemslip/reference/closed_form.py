@@ -24,11 +24,15 @@ side n points to; jump = u(+) - u(-).
 from __future__ import annotations
 
 import math
+from typing import TypeVar
 
 import numpy as np
 
+# a number, or an array of them per point
+Value = TypeVar("Value", float, np.ndarray)
 
-def kolosov(nu: float, plane: str) -> float:
+
+def kolosov(nu: Value, plane: str) -> Value:
     """Kolosov constant: 3 - 4 nu (plane strain), (3 - nu)/(1 + nu) (plane stress)."""
     return 3.0 - 4.0 * nu if plane == "plane_strain" else (3.0 - nu) / (1.0 + nu)
 

@@ -65,6 +65,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from xfemslip.geometry.box import Box
 from xfemslip.reference.inclusion import polygon_stress
 from xfemslip.reference.onset import critical_change, plane_directions, plane_tractions
 
@@ -92,8 +93,8 @@ def rectangles_shear(x, y, rects, dp, nu, biot=1.0) -> np.ndarray:
     x, y = np.broadcast_arrays(np.asarray(x, float), np.asarray(y, float))
     xy = np.column_stack([x.ravel(), y.ravel()])
     out = np.zeros(x.size)
-    for x0, y0, x1, y1 in np.asarray(rects, float).reshape(-1, 4):
-        box = [[x0, y0], [x1, y0], [x1, y1], [x0, y1]]
+    for corners in np.asarray(rects, float).reshape(-1, 4):
+        box = Box.from_corners(*corners).vertices()
         out += polygon_stress(xy, box, dp, nu, biot)[:, 2]
     return out.reshape(x.shape)
 

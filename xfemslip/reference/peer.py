@@ -42,8 +42,8 @@ def graded(h, fine=0.8, half=10.0, growth=1.3) -> np.ndarray:
         if half - x < 0.5 * step:
             x = half
         outer.append(x)
-    outer = np.array(outer)
-    return np.concatenate([-outer[::-1], core, outer])
+    ring = np.array(outer)
+    return np.concatenate([-ring[::-1], core, ring])
 
 
 def case_table(

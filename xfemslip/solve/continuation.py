@@ -284,7 +284,8 @@ class _Follower:
             last = s.completed[-1] if s.completed else None
             start = (last.u, last.load_factor) if last else (np.zeros(s.p.n_dofs), 0.0)
         u, lam = np.array(start[0], float), float(start[1])
-        self.c0 = None  # the control's origin, set when the control stage starts
+        # the control's origin, set when the control stage starts
+        self.c0: float | None = None
         u, lam, res = self._approach(u, lam)
         if res is None or lam >= self.opt.max_load:
             return self.result
@@ -516,7 +517,7 @@ class _Follower:
         u, lam = u0.copy(), start.lam
         res = c.evaluate(u, s.mode, c.pt_committed, c.gt_committed)
         r, eta = s.residual(u, lam, res)
-        seen = []  # the stick/slip sets of the iterates
+        seen: list[bytes] = []  # the stick/slip sets of the iterates
         for it in range(s.max_it + 1):
             g = dc - float(a @ (u[free] - u0[free]))
             if it > 0 and eta <= s.tol and abs(g) <= 1e-12 * abs(dc):
@@ -601,6 +602,7 @@ class _Follower:
         opt = self.opt
         lo, hi = 0.0, dc
         lo_state, hi_state = start, end
+        assert self.c0 is not None  # a limit point is met in the control stage
         control_here = abs(float(a @ start.u[self.solver.free]) - self.c0) + dc
         while hi - lo > opt.limit_tolerance * control_here:
             mid = 0.5 * (lo + hi)

@@ -74,7 +74,9 @@ from __future__ import annotations
 
 import importlib.util
 import logging
+import math
 import time
+from collections.abc import Callable
 
 import numpy as np
 import scipy.sparse as sp
@@ -82,7 +84,7 @@ import scipy.sparse as sp
 from xfemslip.fem.assembly import coo_block
 from xfemslip.solve import lowrank, pardiso
 from xfemslip.solve.backward import backward_error
-from xfemslip.solve.guess import PreviousSolutions
+from xfemslip.solve.guess import KEEP, PreviousSolutions
 
 logger = logging.getLogger(__name__)
 
@@ -177,6 +179,19 @@ LU_SAFE = {"permc_spec": "COLAMD", "diag_pivot_thresh": 1.0}
 # (docs/performance.md, "Fracture networks").
 LU_BACKWARD_ERROR = 1.0e-10
 
+# Memory of the solvers' structures (solver_bytes), measured against the
+# peak resident memory of whole runs (xfemslip.memory, docs/robustness.md):
+# per stiffness non-zero, K, K_ff, K_ff + K_contact and its CSC copy, 12 B
+# each (8 B value, 4 B index) [B]
+MATRIX_BYTES = 48.0
+LU_BYTES = 5.0  # per stiffness non-zero and per log2(n_dofs), one factor [B]
+LU_FACTORS = 2  # factorizations held at once
+# MKL PARDISO's factorization, per stiffness non-zero and per log2(n_dofs):
+# whole runs of the reservoir case peaked at 1043 / 2987 / 5892 MB at 324k /
+# 986k / 2.0M dofs (benchmarks/scaling.py), 5.2-5.6 B after the other terms [B]
+PARDISO_BYTES = 6.0
+AMG_BYTES = 40.0  # per stiffness non-zero: hierarchy and its set-up [B]
+
 
 def pyamg_available() -> bool:
     return importlib.util.find_spec("pyamg") is not None
@@ -214,36 +229,148 @@ def system_facts(K, free, node_xy) -> dict:
     }
 
 
-def choose(method: str, n_free: int, node_xy=None, band_share: float = 0.0) -> str:
+def auto_choice(
+    n_free: int,
+    aspect: Callable[[], float] | None,
+    band_share: Callable[[], float],
+) -> str:
     """The strategy "auto" stands for: "pardiso" from AUTO_PARDISO_MIN_DOFS
     free dofs when the mkl extra is installed; else "amg" from
     AUTO_AMG_MIN_DOFS free dofs on meshes with cells up to
     AUTO_AMG_MAX_ASPECT : 1 whose AMG band (the enriched dofs and
     AMG_BAND_LAYERS matrix neighbours, system_facts) holds at most
-    AUTO_AMG_MAX_BAND of the free dofs; "superlu" otherwise."""
-    if method != "auto":
-        return method
+    AUTO_AMG_MAX_BAND of the free dofs; "superlu" otherwise.
+
+    aspect() gives the mesh's largest cell aspect ratio (None: the mesh is
+    not known, no AMG), band_share() the share of the free dofs in the AMG
+    band; each is called only when it decides (the band costs a sparse
+    product per layer)."""
     if n_free >= AUTO_PARDISO_MIN_DOFS and pardiso.available():
         return "pardiso"
     if (
         n_free >= AUTO_AMG_MIN_DOFS
-        and band_share <= AUTO_AMG_MAX_BAND
-        and node_xy is not None
-        and cell_aspect_ratio(node_xy) <= AUTO_AMG_MAX_ASPECT
+        and aspect is not None
+        and aspect() <= AUTO_AMG_MAX_ASPECT
         and pyamg_available()
+        and band_share() <= AUTO_AMG_MAX_BAND
     ):
         return "amg"
     return "superlu"
 
 
-def cell_aspect_ratio(node_xy) -> float:
+def choose(
+    method: str,
+    n_free: int,
+    node_xy: np.ndarray | None = None,
+    band_share: float | Callable[[], float] = 0.0,
+) -> str:
+    """The strategy of ``linear_solver = method`` for n_free free dofs on the
+    mesh with nodes node_xy: method itself, or what "auto" stands for
+    (auto_choice).  band_share: a number, or a function called only when it
+    decides."""
+    if method != "auto":
+        return method
+    share = band_share if callable(band_share) else _constant(band_share)
+    if node_xy is None:
+        return auto_choice(n_free, None, share)
+    nodes = node_xy
+    return auto_choice(n_free, lambda: cell_aspect_ratio(nodes), share)
+
+
+def planned_solver(
+    method: str,
+    n_free: int,
+    x: np.ndarray,
+    y: np.ndarray,
+    band_share: Callable[[], float] | None = None,
+) -> str:
+    """The strategy a run will take (choose) on the rectilinear mesh with
+    grid lines x, y and about n_free free dofs, known before the mesh or the
+    stiffness is built (the memory estimate asks this).  band_share() as in
+    auto_choice; None: not known yet, taken as 0."""
+    if method != "auto":
+        return method
+    share = _constant(0.0) if band_share is None else band_share
+    return auto_choice(n_free, lambda: grid_aspect_ratio(x, y), share)
+
+
+def _constant(value: float) -> Callable[[], float]:
+    return lambda: value
+
+
+def cell_aspect_ratio(node_xy: np.ndarray) -> float:
     """Largest cell aspect ratio of a structured rectilinear mesh, from its
-    grid lines: max(max hx / min hy, max hy / min hx)."""
-    hx = np.diff(np.unique(node_xy[:, 0]))
-    hy = np.diff(np.unique(node_xy[:, 1]))
+    nodes (grid_aspect_ratio of their distinct x and y)."""
+    return grid_aspect_ratio(np.unique(node_xy[:, 0]), np.unique(node_xy[:, 1]))
+
+
+def grid_aspect_ratio(x: np.ndarray, y: np.ndarray) -> float:
+    """Largest cell aspect ratio of the rectilinear mesh with increasing grid
+    lines x, y: max(max hx / min hy, max hy / min hx)."""
+    hx = np.diff(x)
+    hy = np.diff(y)
     if hx.size == 0 or hy.size == 0:
         return 1.0
     return float(max(hx.max() / hy.min(), hy.max() / hx.min()))
+
+
+def grid_band_share(
+    shape: tuple[int, int], enriched_nodes: np.ndarray, n_dofs: int
+) -> float:
+    """The share of n_dofs in the AMG band (system_facts) estimated before
+    the stiffness exists, on a structured grid of shape (nx, ny) cells: the
+    enriched dofs (two per entry of enriched_nodes, one entry per enrichment
+    function of a node) and the standard ones of the nodes within
+    AMG_BAND_LAYERS node rings of an enriched node (an enriched dof couples
+    to the nodes of its support, each layer adds a ring)."""
+    nx, ny = shape
+    grid = np.zeros((ny + 1, nx + 1), bool)
+    grid.flat[np.unique(enriched_nodes)] = True
+    for _ in range(AMG_BAND_LAYERS):
+        ring = grid.copy()
+        ring[1:] |= grid[:-1]
+        ring[:-1] |= grid[1:]
+        ring[:, 1:] |= ring[:, :-1].copy()
+        ring[:, :-1] |= ring[:, 1:].copy()
+        grid = ring
+    return (2.0 * grid.sum() + 2.0 * enriched_nodes.size) / max(n_dofs, 1)
+
+
+def solver_bytes(
+    method: str, nnz: float, n_dofs: int, contact_dofs: float, patches: float = 0.0
+) -> float:
+    """The memory the linear solver of a run holds at once [B], for a
+    stiffness with nnz non-zeros on n_dofs dofs, contact_dofs of them in the
+    contact blocks; method a strategy ("superlu", "amg" or "pardiso", as
+    choose resolves it).
+
+    The stiffness, its free-dof part, the Newton matrix and its CSC copy
+    (MATRIX_BYTES per non-zero) and: with "superlu", LU_FACTORS sparse LU
+    factorizations (the kept one while the next is built), whose fill grows
+    like nnz log2(n_dofs) with a fill-reducing ordering (LU_BYTES per
+    non-zero and per log2); with "pardiso", one factorization (PARDISO_BYTES
+    per non-zero and per log2) and the dense Schur complement of the contact
+    dofs with its LU (16 B per entry, up to pardiso.SCHUR_MAX_DOFS of them)
+    or, with more contact dofs, that of the patches' jumps and its inverse
+    part (lowrank.LowRankSystems: 2 rows per patch, 16 B per entry, up to
+    lowrank.MAX_ROWS rows); with "amg", its hierarchy and set-up (AMG_BYTES
+    per non-zero), the GMRES basis (AMG_RESTART + 1 vectors) and the kept
+    solutions that start each solve (guess.KEEP vectors).  A run whose AMG
+    solve fails over to SuperLU may need more."""
+    if method == "amg":
+        out = nnz * (MATRIX_BYTES + AMG_BYTES)
+        out += (AMG_RESTART + 1 + KEEP) * 8.0 * n_dofs
+    elif method == "pardiso":
+        log_n = math.log2(max(n_dofs, 2))
+        out = nnz * (MATRIX_BYTES + PARDISO_BYTES * log_n)
+        if contact_dofs <= pardiso.SCHUR_MAX_DOFS:
+            out += 16.0 * contact_dofs**2
+        elif 2.0 * patches <= lowrank.MAX_ROWS:
+            out += 16.0 * (2.0 * patches) ** 2
+    else:
+        log_n = math.log2(max(n_dofs, 2))
+        out = nnz * (MATRIX_BYTES + LU_FACTORS * LU_BYTES * log_n)
+    return out
 
 
 def _splu(A, settings):
@@ -424,10 +551,12 @@ class LinearSolver:
         # the kernel backend that gathers the contact blocks (the model's)
         self.kernels = kernels
         self.facts = {"n_free": n}
-        if method == "auto" and node_xy is not None and n >= AUTO_AMG_MIN_DOFS:
-            if not (n >= AUTO_PARDISO_MIN_DOFS and pardiso.available()):
-                self.facts = system_facts(self.K, self.free, node_xy)
-        self.method = choose(method, n, node_xy, self.facts.get("band_share", 0.0))
+
+        def band_share() -> float:
+            self.facts = system_facts(self.K, self.free, node_xy)
+            return self.facts["band_share"]
+
+        self.method = choose(method, n, node_xy, band_share)
         if self.method == "amg" and node_xy is None:
             raise ValueError("the AMG linear solver needs the node coordinates")
         if self.method == "pardiso" and not pardiso.available():

@@ -238,6 +238,7 @@ class LowRankSystems:
 
     def _apply(self, x):
         """A x = K x + L^T D L x with the tangent of the current system."""
+        assert self._update is not None, "apply() follows update()"
         D = self._update[1]
         j = (self.L @ x).reshape(-1, 2)
         return self.K @ x + self.L.T @ np.einsum("mab,mb->ma", D, j).ravel()
@@ -245,6 +246,7 @@ class LowRankSystems:
     def _norm_bound(self) -> float:
         """An upper bound of ||A||_inf: the |K| row sums plus those of the
         patch blocks |c_k c_l D_ab| (no cancellation counted)."""
+        assert self._update is not None, "the bound follows update()"
         D = self._update[1]
         absc = self._absL @ np.ones(self.n)  # sum_l |c_l| per jump row
         w = (np.abs(D) * absc.reshape(-1, 2)[:, None, :]).sum(axis=2).ravel()

@@ -36,13 +36,14 @@ import dataclasses
 import logging
 import math
 import time
-from dataclasses import dataclass
+from collections.abc import Callable
+from dataclasses import dataclass, field
 
 import numpy as np
 import scipy.sparse as sp
 
-from xfemslip.case.specs import AUTO_PENALTY, PENALTY_RATIO_MEASURED
 from xfemslip.contact.branches import force_branches
+from xfemslip.contact.defaults import AUTO_PENALTY, PENALTY_RATIO_MEASURED
 from xfemslip.contact.interface import ContactResult, ContactSet
 from xfemslip.contact.predictor import predict_state, predicted_law
 from xfemslip.conventions import (
@@ -83,19 +84,19 @@ class Problem:
     # (fracture index in the case file, mask of its contact points) for each
     # fracture that cuts the domain in two with one part left without any
     # prescribed displacement: that part is held by the fracture alone.
-    floating: list = None
+    floating: list | None = None
     # largest penalty stiffness relative to the bulk, max(kn, kt) * h_min / E [-]
     penalty_ratio: float = 0.0
     # (n_nodes, 2) node coordinates: rigid-body modes of the AMG linear solver
-    node_xy: np.ndarray = None
+    node_xy: np.ndarray | None = None
     # far-field stress (xx, yy, xy) [Pa] added from load factor 0 to 1
     # (predictor.stress_increment), or None: only used to guess the stick/slip
     # set of a step (predictor.py)
-    load_stress: tuple = None
+    load_stress: tuple[float, float, float] | None = None
     # (weights(lam) -> (m,), [F_1 .. F_m]): loads that are not proportional
     # to lam (pressure changes from a file at several times), added to
     # lam F_unit as sum_j weights_j(lam) F_j; None: none
-    load_pieces: tuple = None
+    load_pieces: tuple[Callable[[float], np.ndarray], list[np.ndarray]] | None = None
 
     def load(self, lam: float) -> np.ndarray:
         """The external force at load factor lam (n_dofs,) [N/m]."""
@@ -120,7 +121,7 @@ class StepResult:
     cuts: int = 0  # load-step bisections needed in this step
     substeps: int = 1  # converged sub-steps that make up this step
     freezes: int = 0  # ping-pong freezes (all sub-steps)
-    factors: list = None  # load factors of the converged sub-steps, in order
+    factors: list | None = None  # load factors of the converged sub-steps, in order
     # sub-steps whose first Newton solve used the predicted stick/slip set
     predicted: int = 0
     # Newton steps re-solved with slip-reversing patches held in stick (each
@@ -176,7 +177,7 @@ class NewtonSolver:
         )
         # tangent blocks of the contact evaluations whose tangent is never
         # used (_scratch_blocks)
-        self._scratch = None
+        self._scratch: np.ndarray | None = None
         zero = c.evaluate(
             np.zeros(n),
             self.mode,
@@ -765,12 +766,8 @@ class _NewtonLog:
     searches: int = 0  # local branch searches (xfemslip.contact.branches)
     found: int = 0  # of them, those that found a consistent set
     predicted: int = 0  # 1 if the first solve used the predicted set
-    residuals: list = None
-    switches: list = None
-
-    def __post_init__(self):
-        self.residuals = []
-        self.switches = []
+    residuals: list = field(default_factory=list)
+    switches: list = field(default_factory=list)
 
 
 def _finite(res: ContactResult) -> bool:

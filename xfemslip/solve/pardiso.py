@@ -44,6 +44,7 @@ error.
 from __future__ import annotations
 
 import ctypes
+import importlib.util
 import logging
 import os
 from pathlib import Path
@@ -51,7 +52,6 @@ from pathlib import Path
 import numpy as np
 import scipy.sparse as sp
 
-from xfemslip.case.options import pardiso_installed
 from xfemslip.solve.backward import backward_error, backward_error_of
 
 logger = logging.getLogger(__name__)
@@ -70,9 +70,13 @@ UNSYMMETRIC_MTYPE = 11
 SYMMETRY_RTOL = 1.0e-12
 
 
+# the package that linear_solver = "pardiso" needs (the mkl extra)
+PARDISO_PACKAGE = "pypardiso"
+
+
 def available() -> bool:
-    """Whether the mkl extra (pypardiso) is installed."""
-    return pardiso_installed()
+    """Whether MKL PARDISO (the mkl extra: pypardiso) is installed."""
+    return importlib.util.find_spec(PARDISO_PACKAGE) is not None
 
 
 class PardisoError(RuntimeError):
@@ -401,7 +405,7 @@ class PardisoSystems:
         self.max_error = max_error
         self.stats = stats
         self.handles: dict[int, Handle] = {}
-        self._norm = {}  # mtype -> infinity norm of its factored matrix
+        self._norm: dict[int, float] = {}  # mtype -> infinity norm of its matrix
 
     def _handle(self, mtype: int) -> Handle:
         if mtype not in self.handles:
@@ -432,7 +436,7 @@ class PardisoSystems:
         modes = [UNSYMMETRIC_MTYPE]
         if self.spd_possible and symmetric:
             modes.insert(0, MTYPE_SPD)
-        last = None
+        last: PardisoError | None = None
         for mtype in modes:
             h = self._handle(mtype)
             values = data[p.upper] if mtype == MTYPE_SPD else data
@@ -462,6 +466,7 @@ class PardisoSystems:
                 33, 0, f"PARDISO (mtype {mtype}) backward error {err:.1e}"
             )
             logger.debug("%s", last)
+        assert last is not None  # every mode failed, the last one said why
         raise last
 
 
@@ -522,7 +527,8 @@ class SchurSystems:
         self._row_out = self._row_norm[self.c] - np.abs(self.K_cc).sum(axis=1)
         self.max_error = max_error
         self.stats = stats
-        self._lu = None  # (dense LU, the contact values it is for, norm of A)
+        # (dense LU, the contact values it is for, their dense block, norm of A)
+        self._lu: tuple[tuple, np.ndarray, np.ndarray, float] | None = None
 
     def values(self, entries) -> np.ndarray:
         if entries is None or self.flat.size == 0:
@@ -583,6 +589,7 @@ class SchurSystems:
     def solve(self, values, symmetric: bool, r) -> np.ndarray:
         if self._lu is None or not np.array_equal(self._lu[1], values):
             self._factor(values)
+        assert self._lu is not None
         norm = self._lu[3]
         x = self._solve(r)
         err = backward_error_of(self._apply(x) - r, x, r, norm)

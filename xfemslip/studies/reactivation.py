@@ -40,6 +40,7 @@ from xfemslip.studies.sampling import (
     wilson_interval,
     wilson_samples_needed,
 )
+from xfemslip.studies.uncertainty import UncertaintySpec
 
 logger = logging.getLogger(__name__)
 
@@ -51,7 +52,7 @@ EVALUATED = (OK, SKIPPED)
 class UncertaintyResult:
     """The evaluated samples and what they add up to."""
 
-    spec: object  # UncertaintySpec
+    spec: UncertaintySpec
     path_text: str  # the stress path (screen) or the engine (xfem)
     ids: list  # sample ids (xfem: folder names)
     status: np.ndarray  # (n,) str
@@ -60,13 +61,14 @@ class UncertaintyResult:
     max_slip: np.ndarray | None = None  # (n, n_fractures) [m], xfem only
     slip_length: np.ndarray | None = None  # (n, n_fractures) [m], xfem only
     compute_time_s: float = 0.0
-    slipped: np.ndarray = field(default=None)  # (n_fractures, n_levels) counts
+    # filled by aggregate:
+    slipped: np.ndarray | None = None  # (n_fractures, n_levels) counts
     evaluated: int = 0
-    probability: np.ndarray = field(default=None)  # (n_fractures, n_levels)
-    ci_low: np.ndarray = field(default=None)
-    ci_high: np.ndarray = field(default=None)
-    samples_needed: np.ndarray = field(default=None)  # (n_fractures, n_levels)
-    sensitivity: np.ndarray = field(default=None)  # (n_fractures, n_inputs)
+    probability: np.ndarray | None = None  # (n_fractures, n_levels)
+    ci_low: np.ndarray | None = None
+    ci_high: np.ndarray | None = None
+    samples_needed: np.ndarray | None = None  # (n_fractures, n_levels)
+    sensitivity: np.ndarray | None = None  # (n_fractures, n_inputs)
     written: list = field(default_factory=list)
 
     @property
@@ -80,7 +82,7 @@ class UncertaintyResult:
 # --------------------------------------------------------------------------- #
 
 
-def evaluate_screen(spec) -> UncertaintyResult:
+def evaluate_screen(spec: UncertaintySpec) -> UncertaintyResult:
     """All samples through the closed form (the path was checked on loading)."""
     from xfemslip.studies.slip_screen import (
         critical_changes,
@@ -89,6 +91,7 @@ def evaluate_screen(spec) -> UncertaintyResult:
     )
 
     path, _ = stress_path(spec.base_spec)
+    assert path is not None  # the path was checked when the study was read
     start = time.perf_counter()
     errors = sample_problems(spec.keys, spec.values)
     bad = np.array([bool(e) for e in errors], dtype=bool)
@@ -310,20 +313,22 @@ def aggregate(result: UncertaintyResult) -> UncertaintyResult:
     n = int(use.sum())
     result.evaluated = n
     dp = result.dp_critical[use]
-    result.slipped = slipped_counts(dp, spec.levels)
+    slipped = result.slipped = slipped_counts(dp, spec.levels)
     if n == 0:
-        shape = result.slipped.shape
+        shape = slipped.shape
         for name in ("probability", "ci_low", "ci_high"):
             setattr(result, name, np.full(shape, np.nan))
         result.samples_needed = np.zeros(shape, int)
         result.sensitivity = np.full((dp.shape[1], len(spec.keys)), np.nan)
         return result
-    result.probability = result.slipped / n
-    result.ci_low, result.ci_high = wilson_interval(result.slipped, n, spec.confidence)
+    probability = result.probability = slipped / n
+    result.ci_low, result.ci_high = wilson_interval(slipped, n, spec.confidence)
     result.samples_needed = wilson_samples_needed(
-        result.probability, spec.half_width, spec.confidence
+        probability, spec.half_width, spec.confidence
     )
-    sign = np.sign(spec.base_spec.pore_pressure.change)
+    pore = spec.base_spec.pore_pressure
+    assert pore is not None and pore.change is not None  # the levels scale it
+    sign = np.sign(pore.change)
     result.sensitivity = sensitivity(spec.values[use], dp, sign)
     return result
 

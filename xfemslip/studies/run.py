@@ -35,7 +35,7 @@ import contextlib
 import logging
 import os
 import traceback
-from collections.abc import Callable, Iterable
+from collections.abc import Callable, Generator
 from dataclasses import dataclass, field
 from pathlib import Path
 from xml.etree import ElementTree
@@ -245,7 +245,7 @@ def lost_task(task, reason: str) -> tuple:
     return task.case_id, "failed", {}, f"worker error: {reason}"
 
 
-def run_local(tasks: list, jobs: int, fn=run_task) -> Iterable[tuple]:
+def run_local(tasks: list, jobs: int, fn=run_task) -> Generator[tuple, None, None]:
     """``fn(task)`` of every task, in completion order: in this process, or
     on ``jobs`` worker processes that stop with the sweep
     (:mod:`xfemslip.studies.workers`; ``fn`` must be importable by the
@@ -279,7 +279,7 @@ def connect(scheduler: str):
         ) from None
 
 
-def run_dask(tasks: list, client, fn=run_task) -> Iterable[tuple]:
+def run_dask(tasks: list, client, fn=run_task) -> Generator[tuple, None, None]:
     """``fn(task)`` of every task, in completion order, from a
     dask.distributed ``client``.  Each task runs in a child process of its
     Dask worker (:func:`dask_task`), stopped when the sweep cancels the task

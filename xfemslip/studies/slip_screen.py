@@ -169,7 +169,7 @@ def _uniaxial(spec, edges) -> tuple[StressPath | None, str]:
         )
     layer = None
     if res is not None:
-        x0, x1 = spec.origin[0], spec.origin[0] + spec.size[0]
+        x0, x1 = spec.box.x0, spec.box.x1
         if res.polygon is not None or len(res.boxes) != 1:
             return None, "the [reservoir] is not one box (a layer)"
         bx0, by0, bx1, by1 = res.boxes[0]
@@ -179,11 +179,11 @@ def _uniaxial(spec, edges) -> tuple[StressPath | None, str]:
                 "around a reservoir of finite extent needs the full solve"
             )
         layer = (float(by0), float(by1))
-    where = (
-        f"in the reservoir layer {layer[0]:g} m < y < {layer[1]:g} m"
-        if pore.region == "reservoir"
-        else "everywhere"
-    )
+    if pore.region == "reservoir":
+        assert layer is not None  # region "reservoir" needs a [reservoir]
+        where = f"in the reservoir layer {layer[0]:g} m < y < {layer[1]:g} m"
+    else:
+        where = "everywhere"
     text = (
         "stress path: uniaxial strain of a laterally confined layer with "
         "constant overburden (rollers on the sides, u_y = 0 at the bottom); "
@@ -231,9 +231,9 @@ def _roller_count(*edges) -> int:
 
 def screen_key_problem(spec, key: str) -> str:
     """Why the screen cannot take ``key`` as an input, or ""."""
-    from xfemslip.studies.vary import parse_key_path
+    from xfemslip.studies.vary import key_parts
 
-    parts = parse_key_path(key)
+    parts = key_parts(key)
     if key in INERT or key in ("pore_pressure.initial", "pore_pressure.biot"):
         return ""
     if key in ("material.nu", "reservoir.nu"):

@@ -43,6 +43,7 @@ import copy
 import itertools
 import logging
 import re
+from collections.abc import Iterable
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -57,6 +58,7 @@ from xfemslip.studies.vary import (
     RANGE_KEYS,
     case_count,
     expand_range,
+    key_parts,
     parse_key_path,
     read_vary,
     set_key_path,
@@ -148,6 +150,7 @@ def case_id(index: int, n_cases: int, params) -> str:
 def _combinations(vary: list, combine: str) -> list[tuple[tuple[str, object], ...]]:
     """The parameter sets, in run order."""
     keys = [k for k, _ in vary]
+    rows: Iterable[tuple]
     if combine == "zip":
         rows = zip(*(v for _, v in vary), strict=True)
     else:
@@ -162,7 +165,7 @@ def build_case(base: dict, base_name: str, index: int, n: int, params, path: Pat
     document = copy.deepcopy(base)
     problems = []
     for key, value in params:
-        message = set_key_path(document, parse_key_path(key), value)
+        message = set_key_path(document, key_parts(key), value)
         if message:
             problems.append((f'vary."{key}"', message))
     short = str(base_name).encode("utf-8")[:MAX_CASE_ID].decode("utf-8", "ignore")
@@ -245,10 +248,13 @@ def loads_sweep(text: str, path: str | Path = "<string>") -> SweepSpec:
     vary = read_vary(root, combine)
     output = root.table("output", ("directory",))
     directory = output.string("directory", None) if output is not None else None
-    if directory is not None and path_problem(directory):
-        output.error("directory", path_problem(directory))
+    problem = path_problem(directory) if directory is not None else None
+    if output is not None and problem:
+        output.error("directory", problem)
     if problems:
         raise CaseError(path, problems)
+    # each reader returns None only after recording a problem
+    assert base is not None
     _check_volume(base, vary, combine, path)  # read_vary has bounded the count
     combos = _combinations(vary, combine)
     cases = _generate(base, base_name, case_path, combos, problems)

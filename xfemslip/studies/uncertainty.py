@@ -40,6 +40,7 @@ import numpy as np
 from scipy import special
 
 from xfemslip.case import loads_case, parse_toml, path_problem, read_text
+from xfemslip.case.specs import CaseSpec
 from xfemslip.case.tables import Range, Table, show
 from xfemslip.errors import CaseError
 from xfemslip.studies.inputs import read_correlation, read_inputs
@@ -48,7 +49,7 @@ from xfemslip.studies.sweep import read_base
 from xfemslip.studies.vary import (
     MAX_CASES,
     expand_range,
-    parse_key_path,
+    key_parts,
     set_key_path,
 )
 
@@ -84,7 +85,7 @@ class UncertaintySpec:
     base: dict  # the base case document (TOML tables)
     base_name: str
     case_path: Path  # the path the cases are loaded as (CSV files relative to it)
-    base_spec: object  # the base case's CaseSpec
+    base_spec: CaseSpec  # the base case
     directory: Path
     samples: int
     method: str
@@ -170,7 +171,7 @@ def _sample_bound(table: Table, evaluate: str | None) -> int | None:
     return n
 
 
-def _check_keys(table: Table, keys: list[str], base: dict) -> None:
+def _check_keys(table: Table, keys: list[str], base: dict | None) -> None:
     """Each input key can be set in the base case; the depletion itself
     (pore_pressure.change) is the axis of the curve, not an input."""
     for key in keys:
@@ -185,13 +186,13 @@ def _check_keys(table: Table, keys: list[str], base: dict) -> None:
             )
             continue
         trial = copy.deepcopy(base) if base is not None else {}
-        message = set_key_path(trial, parse_key_path(key), 0.0)
+        message = set_key_path(trial, key_parts(key), 0.0)
         if message:
             table.problems.append((where, message))
     for a, key in enumerate(keys):
-        parts = parse_key_path(key)
+        parts = key_parts(key)
         for other in keys[a + 1 :]:
-            o = parse_key_path(other)
+            o = key_parts(other)
             n = min(len(parts), len(o))
             if parts[:n] == o[:n]:
                 table.problems.append(
@@ -218,8 +219,9 @@ def loads_uncertainty(text: str, path: str | Path = "<string>") -> UncertaintySp
     base, case_path, base_name = read_base(root, path)
     output = root.table("output", ("directory",))
     directory = output.string("directory", None) if output is not None else None
-    if directory is not None and path_problem(directory):
-        output.error("directory", path_problem(directory))
+    problem = path_problem(directory) if directory is not None else None
+    if output is not None and problem:
+        output.error("directory", problem)
     table = root.table("uncertainty", UNCERTAINTY_KEYS, required=True)
     if table is None or problems:
         raise CaseError(path, problems or [("uncertainty", "expected a table")])
@@ -243,6 +245,8 @@ def loads_uncertainty(text: str, path: str | Path = "<string>") -> UncertaintySp
     _check_keys(table, keys, base)
     if problems:
         raise CaseError(path, problems)
+    # each reader returns None only after recording a problem
+    assert base is not None and levels is not None and samples is not None
     base_spec = _base_spec(base, case_path, path)
     if not base_spec.fractures:
         raise CaseError(
@@ -316,10 +320,16 @@ def _check_screen(table: Table, keys: list[str], base: dict, base_spec) -> None:
         )
     for key in keys:
         why = screen_key_problem(base_spec, key)
-        parts = parse_key_path(key)
-        if not why and parts[0] == "fractures" and parts[-1] in ("angle", "length"):
+        parts = key_parts(key)
+        index = parts[1] if len(parts) > 1 else None
+        if (
+            not why
+            and parts[0] == "fractures"
+            and parts[-1] in ("angle", "length")
+            and isinstance(index, int)
+        ):
             items = base.get("fractures", [])
-            if parts[1] >= len(items) or "center" not in items[parts[1]]:
+            if index >= len(items) or "center" not in items[index]:
                 why = (
                     "the screen varies angle and length of a center-form fracture only"
                 )
@@ -352,7 +362,7 @@ def sample_document(spec: UncertaintySpec, index: int) -> dict:
     """The case document of sample ``index``: the base with its input values."""
     document = copy.deepcopy(spec.base)
     for key, value in zip(spec.keys, spec.values[index], strict=True):
-        set_key_path(document, parse_key_path(key), _toml_value(value))
+        set_key_path(document, key_parts(key), _toml_value(value))
     return document
 
 

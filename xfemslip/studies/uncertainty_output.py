@@ -10,6 +10,7 @@ datasets: docs/sweep-format.md, *Uncertainty*.
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from pathlib import Path
 
 import numpy as np
@@ -174,7 +175,8 @@ def write_outputs(result, directory: Path, *, figure: bool = True) -> list[Path]
         directory.mkdir(parents=True, exist_ok=True)
     except OSError as exc:
         raise OutputError(f"cannot write {directory}: {exc.strerror}") from None
-    writes = {
+    # each writes one file to the path it is given (what it returns is unused)
+    writes: dict[Path, Callable[[Path], object] | None] = {
         directory / SAMPLES_CSV: lambda p: write_samples(p, result),
         directory / PROBABILITY_CSV: lambda p: write_probability(p, result),
         directory / SENSITIVITY_CSV: lambda p: write_sensitivity(p, result),

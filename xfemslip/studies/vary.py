@@ -39,6 +39,14 @@ def parse_key_path(key: str) -> list[str | int] | None:
     return parts
 
 
+def key_parts(key: str) -> list[str | int]:
+    """The parts of a key path that parse_key_path has accepted."""
+    parts = parse_key_path(key)
+    if parts is None:
+        raise ValueError(f"malformed key path {key!r}")
+    return parts
+
+
 def _where(parts: list[str | int], upto: int) -> str:
     """Key path text of ``parts[:upto]``."""
     text = ""
@@ -192,7 +200,8 @@ def expand_range(spec: dict, key: str, problems: list) -> list | None:
         return None
     as_int = all(isinstance(v, int) for v in (start, stop, step))
     return [
-        start + i * step if as_int else float(start + i * step) for i in range(count)
+        start + i * step if as_int else float(start + i * step)
+        for i in range(int(count))
     ]
 
 
@@ -273,12 +282,12 @@ def _check_overlaps(vary: list, problems: list) -> None:
     and after it, so the check is linear in the number of keys."""
     first: dict[tuple, str] = {}
     for key, _ in vary:
-        parts = tuple(parse_key_path(key))
+        parts = tuple(key_parts(key))
         if parts in first:
             problems.append((f'vary."{key}"', f'overlaps vary."{first[parts]}"'))
         first.setdefault(parts, key)
     for key, _ in vary:
-        parts = tuple(parse_key_path(key))
+        parts = tuple(key_parts(key))
         problems.extend(
             (f'vary."{key}"', f'overlaps vary."{first[parts[:n]]}"')
             for n in range(1, len(parts))

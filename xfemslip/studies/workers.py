@@ -40,9 +40,10 @@ import subprocess
 import sys
 import threading
 import time
-from collections.abc import Callable, Iterable
+from collections.abc import Callable, Generator, Iterable
 from multiprocessing import get_context
 from multiprocessing.connection import wait
+from typing import Any
 
 from xfemslip import interrupt
 
@@ -303,7 +304,9 @@ class LocalPool:
         self.workers.clear()
 
 
-def run_local(tasks: list, jobs: int, fn: Callable, lost: Callable) -> Iterable:
+def run_local(
+    tasks: list, jobs: int, fn: Callable, lost: Callable
+) -> Generator[Any, None, None]:
     """``fn(task)`` of every task, in completion order: in this process
     (``jobs`` 1), or on worker processes (module doc).  ``fn`` must be
     importable by the workers and never raise; ``lost(task, reason)`` is the

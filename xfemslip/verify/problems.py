@@ -44,10 +44,11 @@ from pathlib import Path
 import numpy as np
 
 from xfemslip.case import build, load_case
+from xfemslip.contact.interface import ContactResult
 from xfemslip.post.fields import fracture_fields
 from xfemslip.post.jintegral import stress_intensity_factors
 from xfemslip.reference import closed_form as cf
-from xfemslip.simulation import build_model, newton_solver
+from xfemslip.simulation import Model, build_model, newton_solver
 
 logger = logging.getLogger(__name__)
 
@@ -205,7 +206,7 @@ def write_case(
     n: int,
     prob: Problem,
     tip: str | dict | None,
-    penalty: float,
+    penalty: float | None,
     **options,
 ) -> Path:
     """Write case.toml and the four edge CSV files (8 points per element edge);
@@ -223,9 +224,9 @@ def write_case(
 
 @dataclass
 class Solved:
-    model: object
+    model: Model
     u: np.ndarray
-    contact: object
+    contact: ContactResult
     iterations: int
     wall_s: float
 
@@ -338,7 +339,7 @@ def run_problem(
 def observed_orders(rows: list[Row]) -> None:
     """Fill Row.order from consecutive meshes of the same problem (slip error)."""
     kinds = {p.name: p.kind for p in PROBLEMS}
-    by = {}
+    by: dict[str, list[Row]] = {}
     for r in rows:
         if kinds.get(r.problem, "slip") == "slip":  # a stuck crack has no order
             by.setdefault(r.problem, []).append(r)
@@ -486,7 +487,7 @@ def run_verification(
     *,
     quick: bool = False,
     tip: str | None = None,
-    penalty: float = PENALTY,
+    penalty: float | None = PENALTY,
     meshes=None,
     problems=None,
     window: bool = True,

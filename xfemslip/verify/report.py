@@ -113,7 +113,7 @@ def write_plot(report: Report, path: Path, fmt: str | None = None) -> None:
     import matplotlib.ticker
 
     fig, (ax1, ax2) = plt.subplots(1, 2, figsize=(11, 4.5))
-    by = {}
+    by: dict[str, list] = {}
     for r in report.rows:
         if r.problem.startswith("stick"):
             continue

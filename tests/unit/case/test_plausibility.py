@@ -10,8 +10,8 @@ from click.testing import CliRunner
 
 from xfemslip.case import build, load_case, loads_case
 from xfemslip.case.plausibility import E_RANGE, plausibility_warnings
-from xfemslip.case.specs import PENALTY_RATIO_LOWEST, PENALTY_RATIO_MEASURED
 from xfemslip.cli import cli
+from xfemslip.contact.defaults import PENALTY_RATIO_LOWEST, PENALTY_RATIO_MEASURED
 
 CASES = Path(__file__).resolve().parents[3] / "cases"
 RESERVOIR = CASES / "reservoir_depletion.toml"

@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 from xfemslip.case import build, loads_case
-from xfemslip.case.specs import AUTO_PENALTY
+from xfemslip.contact.defaults import AUTO_PENALTY
 from xfemslip.contact.interface import _point_jumps, contact_patches
 from xfemslip.simulation import build_model
 

@@ -179,9 +179,11 @@ def test_result_h5_data_sets_carry_checksums(tmp_path):
     with h5py.File(path, "r") as h5:
         arrays = []
         h5.visititems(
-            lambda name, item: arrays.append(item)
-            if isinstance(item, h5py.Dataset) and item.ndim
-            else None
+            lambda name, item: (
+                arrays.append(item)
+                if isinstance(item, h5py.Dataset) and item.ndim
+                else None
+            )
         )
         assert arrays and all(item.fletcher32 for item in arrays)
         offset = h5["mesh/points"].id.get_chunk_info(0).byte_offset

@@ -57,6 +57,42 @@ def test_rule_on_constructed_inputs():
     assert choose("superlu", 10 * n, square, 0.0) == "superlu"
 
 
+def test_planned_solver_follows_the_rule_on_grid_lines():
+    """planned_solver (grid lines, before the mesh) gives what choose gives on
+    the same mesh's nodes, on both sides of each limit, and asks for the band
+    share only when it decides between AMG and SuperLU."""
+    n = linsolve.AUTO_AMG_MIN_DOFS
+    top = linsolve.AUTO_AMG_MAX_BAND
+    g = np.linspace(0.0, 1.0, 11)
+    calls = []
+
+    def share(value):
+        def ask():
+            calls.append(value)
+            return value
+
+        return ask
+
+    for sy in (1.0, 5.0):  # cells 1:1 and 5:1
+        nodes = _grid(10, sy=sy)
+        for n_free in (n - 1, n, 10 * n):
+            for band in (0.0, top, np.nextafter(top, 1.0)):
+                calls.clear()
+                planned = linsolve.planned_solver(
+                    "auto", n_free, g, sy * g, share(band)
+                )
+                asked = len(calls)
+                assert planned == choose("auto", n_free, nodes, band)
+                assert planned == choose("auto", n_free, nodes, share(band))
+                assert asked == (1 if sy == 1.0 and n_free >= n else 0)
+    assert linsolve.planned_solver("auto", n, g, g) == "amg"  # band not known: 0
+    assert linsolve.planned_solver("superlu", 10 * n, g, g, share(0.0)) == "superlu"
+    assert linsolve.grid_aspect_ratio(g, 5.0 * g) == pytest.approx(5.0)
+    assert linsolve.grid_aspect_ratio(g, 5.0 * g) == linsolve.cell_aspect_ratio(
+        _grid(10, sy=5.0)
+    )
+
+
 def test_system_facts_on_a_chain():
     """A chain matrix (tridiagonal): the band of L layers around the enriched
     dofs is those dofs and the L before them, in the numbering of the free
