@@ -244,8 +244,11 @@ def clip_segment(p0, p1, boxes):
             ta[outside] = 1.0
             tb[outside] = 0.0
             continue
-        t_lo = (boxes[:, lo] - p0[k]) / d[k]
-        t_hi = (boxes[:, hi] - p0[k]) / d[k]
+        # a direction of 1e-310 m overflows to +-inf: the right limits of a
+        # segment that is all but parallel to the edge
+        with np.errstate(over="ignore"):
+            t_lo = (boxes[:, lo] - p0[k]) / d[k]
+            t_hi = (boxes[:, hi] - p0[k]) / d[k]
         ta = np.maximum(ta, np.minimum(t_lo, t_hi))
         tb = np.minimum(tb, np.maximum(t_lo, t_hi))
     return ta, tb
