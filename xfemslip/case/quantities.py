@@ -55,7 +55,7 @@ DIMENSIONS = {
     "area": Dimension("area (permeability)", "m^2", '"1e-15 m^2"'),
     "per area": Dimension("number per area", "1/m^2", '"0.01 1/m^2"'),
     "per length": Dimension("length per area", "1/m", '"0.1 1/m"'),
-    "dimensionless": Dimension("dimensionless number", "", '"0.6" or "60 %"'),
+    "dimensionless": Dimension("dimensionless number", "", '"60 %"'),
 }
 
 _HYDRAULIC = {
@@ -228,8 +228,12 @@ def quantity(text: str, dimension: str) -> tuple[float | None, str | None]:
         return None, f"{expected}, got {show(text)}"
     number = Decimal(match["number"])
     unit = match["unit"]
-    if not unit:  # a number written as a string: in the key's own unit
-        return float(number), None
+    if not unit:  # a number in quotes is a typing slip, as it always was
+        return (
+            None,
+            f"expected a number, or a string with a unit such as {dim.example}, "
+            f"got {show(text)}",
+        )
     try:
         registry = _registry()
         units = registry.parse_units(unit)
@@ -269,8 +273,8 @@ def convert_units(document: dict, problems: list) -> dict:
             }
         if isinstance(value, list):
             return [walk(v, f"{path}[{i}]") for i, v in enumerate(value)]
-        if not isinstance(value, str) or _QUANTITY.match(value) is None:
-            return value
+        if not isinstance(value, str) or not _is_quantity(value):
+            return value  # a number in quotes is left to its reader's message
         dimension = KEY_DIMENSIONS.get(_pattern(path))
         if dimension is None:
             return value
@@ -286,13 +290,19 @@ def convert_units(document: dict, problems: list) -> dict:
 
 
 def _has_quantity(value: Any) -> bool:
-    """Whether any string of ``value`` starts with a number (only then is a
-    copy made and pint imported)."""
+    """Whether any string of ``value`` is a number with a unit (only then is
+    a copy made and pint imported)."""
     if isinstance(value, dict):
         return any(_has_quantity(v) for v in value.values())
     if isinstance(value, list):
         return any(_has_quantity(v) for v in value)
-    return isinstance(value, str) and _QUANTITY.match(value) is not None
+    return isinstance(value, str) and _is_quantity(value)
+
+
+def _is_quantity(text: str) -> bool:
+    """A number followed by a unit."""
+    match = _QUANTITY.fullmatch(text)
+    return match is not None and bool(match["unit"])
 
 
 def first_problems(problems: list) -> list:
