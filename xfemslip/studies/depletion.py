@@ -304,6 +304,11 @@ def _step_and_bisect(solver, model, steps, tolerance, onsets, patch_length) -> N
                     bracket,
                     tolerance / abs(change),
                     lambda r, fi=fi: slipping_length(contact, r, fi) >= patch_length,
+                    change,
+                    (
+                        f"fracture {onsets[fi].fracture} slips over {patch_length:g} m",
+                        "not yet",
+                    ),
                 )
                 onsets[fi].dp_patch = 0.5 * (lo + hi) * change
                 logger.info(
@@ -459,16 +464,18 @@ def _trial(solver, contact, bracket, lam):
     try:
         return solver._newton(bracket.u, lam, bracket.step, bracket.steps)[1]
     except ConvergenceError:
-        logger.info("bisection trial at load factor %.6g: cutting the step", lam)
+        logger.debug("bisection trial at load factor %.6g: cutting the step", lam)
         _restore(contact, bracket.history)
         solver._advance(bracket.u, bracket.lam0, lam, bracket.step, bracket.steps)
         return solver.completed.pop().contact
 
 
-def _bisect(solver, contact, bracket, width, happened):
+def _bisect(solver, contact, bracket, width, happened, change=None, said=("yes", "no")):
     """(lo, hi, lo_res, hi_res, trials): the load factors between which
     ``happened(contact result)`` first holds in the bracket's step, to
-    ``width`` in load factor (lo_res None at the initial state)."""
+    ``width`` in load factor (lo_res None at the initial state); each trial
+    is one log line, at the pore-pressure change lam * ``change`` [Pa] when
+    given, saying ``said[0]`` when it happened and ``said[1]`` when not."""
     lo, hi = bracket.lam0, bracket.lam1
     hi_res = solver.completed[-1].contact
     lo_res = bracket.res0
@@ -485,6 +492,19 @@ def _bisect(solver, contact, bracket, width, happened):
             break
         res = _trial(solver, contact, bracket, mid)
         trials += 1
+        where = (
+            f"dp = {display.pressure_change(mid * change)}"
+            if change is not None
+            else f"load factor {mid:.6g}"
+        )
+        logger.info(
+            "step %d/%d: bisection trial %d at %s: %s",
+            bracket.step,
+            bracket.steps,
+            trials,
+            where,
+            said[0] if happened(res) else said[1],
+        )
         if happened(res):
             hi, hi_res = mid, res
         else:
@@ -503,6 +523,8 @@ def _first_slip(solver, model, onset, fi, bracket, tolerance, centres, others):
         bracket,
         tolerance / abs(change),
         lambda r: _slipping(contact, r, fi).any(),
+        change,
+        (f"fracture {onset.fracture} slips", "stuck"),
     )
     onset.trials += trials
     onset.dp_lower, onset.dp_upper = lo * change, hi * change
@@ -513,11 +535,11 @@ def _first_slip(solver, model, onset, fi, bracket, tolerance, centres, others):
     j = first[np.argmax(util)] if first.size else 0
     onset.x, onset.y = (float(v) for v in centres[j])
     logger.info(
-        "fracture %d: first slip between dp = %.6g and %.6g Pa at (%.4g, %.4g) "
+        "fracture %d: first slip between dp = %s and %s at (%.4g, %.4g) "
         "(%d bisection solves)",
         onset.fracture,
-        onset.dp_lower,
-        onset.dp_upper,
+        display.pressure_change(onset.dp_lower),
+        display.pressure_change(onset.dp_upper),
         onset.x,
         onset.y,
         onset.trials,
