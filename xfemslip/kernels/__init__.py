@@ -92,7 +92,7 @@ def cache_is_cold() -> bool:
     no index of one of the JIT_MODULES."""
     if not NUMBA_CACHE:
         return True
-    indexes = set()
+    indexes: set[str] = set()
     for folder in _cache_folders():
         if folder.is_dir():
             indexes.update(p.name.split(".", 1)[0] for p in folder.rglob("*.nbi"))
