@@ -25,6 +25,7 @@ Resolution rules beyond ``case-format.md`` (see ``describe`` for the printout):
 from __future__ import annotations
 
 import re
+from dataclasses import replace
 from pathlib import Path
 
 from xfemslip.case import options
@@ -67,6 +68,7 @@ from xfemslip.case.specs import (
     MaterialSpec,
     OutputSpec,
     SolverSpec,
+    digest,
 )
 from xfemslip.case.tables import (
     BIOT,
@@ -495,7 +497,7 @@ def loads_case(
         and solver is not None
         and output is not None
     )
-    return CaseSpec(
+    spec = CaseSpec(
         path=path,
         text=text,
         name=name,
@@ -514,3 +516,4 @@ def loads_case(
         events=events,
         permeability=permeability,
     )
+    return replace(spec, loaded=digest(spec))
