@@ -17,7 +17,7 @@ depletion (a drop > 0); a pressure is a pressure in both conventions.
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Collection, Sequence
 
 __all__ = [
     "change_label",
@@ -104,9 +104,14 @@ def convention(compression_positive: bool = False) -> str:
     )
 
 
-def table(headers: Sequence[str], rows: Sequence[Sequence[str]], left: int = 0) -> str:
-    """Rows of text cells under their headers, right-aligned columns (the
-    first ``left`` ones left-aligned), two spaces apart, no trailing blanks."""
+def table(
+    headers: Sequence[str],
+    rows: Sequence[Sequence[str]],
+    left: Collection[int] = (),
+) -> str:
+    """Rows of text cells under their headers, two spaces apart, no trailing
+    blanks; columns right-aligned, those whose index is in ``left``
+    left-aligned."""
     import io
 
     from rich.console import Console
@@ -115,7 +120,7 @@ def table(headers: Sequence[str], rows: Sequence[Sequence[str]], left: int = 0) 
 
     grid = Table(box=None, pad_edge=False, show_edge=False, header_style="")
     for k, head in enumerate(headers):
-        if k < left:
+        if k in left:
             grid.add_column(Text(head), justify="left", no_wrap=True)
         else:
             grid.add_column(Text(head), justify="right", no_wrap=True)
