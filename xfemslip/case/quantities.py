@@ -30,6 +30,7 @@ __all__ = [
     "Dimension",
     "convert_units",
     "first_problems",
+    "key_value",
     "quantity",
 ]
 
@@ -303,6 +304,16 @@ def _is_quantity(text: str) -> bool:
     """A number followed by a unit."""
     match = _QUANTITY.fullmatch(text)
     return match is not None and bool(match["unit"])
+
+
+def key_value(path: str, value: Any) -> tuple[Any, str | None]:
+    """(value, None) with a quantity string at the case key ``path``
+    (``fractures[0].angle``) converted as a case file's would be, anything
+    else unchanged; or (None, why) for a quantity the key refuses."""
+    dimension = KEY_DIMENSIONS.get(_pattern(path))
+    if dimension is None or not isinstance(value, str) or not _is_quantity(value):
+        return value, None
+    return quantity(value, dimension)
 
 
 def first_problems(problems: list) -> list:
