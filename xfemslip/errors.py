@@ -19,8 +19,8 @@ class CaseError(XfemslipError):
     """Invalid case file: every problem of the file, each with its key path.
 
     ``problems`` is a list of ``(key_path, message)``; ``str(err)`` is one line:
-    ``cases/x.toml: fractures[0].friction: must be >= 0, got -0.1`` or, with
-    several problems, ``cases/x.toml: 2 problems: a: ...; b: ...``.
+    ``case.toml: fractures[0].friction: must be >= 0, got -0.1`` or, with
+    several problems, ``case.toml: 2 problems: a: ...; b: ...``.
     """
 
     def __init__(self, path, problems):

@@ -17,6 +17,7 @@ from pathlib import Path
 import numpy as np
 
 from xfemslip import __version__, interrupt, kernels
+from xfemslip.case.record import case_of_record
 from xfemslip.case.specs import CaseSpec
 from xfemslip.contact.interface import ContactSet, build_contact
 from xfemslip.contact.predictor import stress_increment
@@ -389,6 +390,7 @@ def solve_and_write(
     ``annotate(result, model)`` may add to the result before it is written
     (what ``deplete`` found: ``Result.depletion``)."""
     start = time.perf_counter()
+    spec = case_of_record(spec)  # a spec changed in Python records its own text
     folder = (
         run_folder(out_dir, overwrite)
         if out_dir is not None

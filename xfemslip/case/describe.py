@@ -7,6 +7,7 @@ from typing import Any
 
 import numpy as np
 
+from xfemslip import display
 from xfemslip.case.friction import describe_strength
 from xfemslip.case.options import SOLVER_OPTIONS
 from xfemslip.case.specs import (
@@ -15,8 +16,6 @@ from xfemslip.case.specs import (
     EdgeSpec,
     FractureSpec,
     HydraulicSpec,
-    LoadingSpec,
-    MaterialSpec,
     MeshSpec,
     PermeabilitySpec,
     SolverSpec,
@@ -28,9 +27,18 @@ from xfemslip.reference.screen import coulomb_margin, plane_stresses
 
 
 def _with_unit(value: Any, unit: str) -> str:
-    """``5e+09 Pa``; no unit for dimensionless ("-") or unitless ("") values."""
-    text = fmt(value) if isinstance(value, int | float) else str(value)
-    return f"{text} {unit}" if unit not in ("", "-") else text
+    """A value of a spec with its SI ``unit`` in engineering units (``0.5
+    MPa``, ``5000 GPa/m``); no unit for dimensionless ("-") or unitless ("")
+    values."""
+    if not isinstance(value, int | float) or isinstance(value, bool):
+        return str(value)
+    if unit == "Pa":
+        return display.pressure(value)
+    if unit == "Pa/m":  # a penalty stiffness
+        return f"{display.number(value / 1e9)} GPa/m"
+    if unit == "m":
+        return display.length(value)
+    return f"{fmt(value)} {unit}" if unit not in ("", "-") else fmt(value)
 
 
 def _describe_axis(coords: np.ndarray, label: str) -> str:
@@ -40,7 +48,8 @@ def _describe_axis(coords: np.ndarray, label: str) -> str:
     if np.ptp(h) <= 1e-9 * h.max():
         return f"d{label} = {_with_unit(float(h[0]), unit)} (uniform)"
     return (
-        f"d{label} = {fmt(float(h.min()))} .. {_with_unit(float(h.max()), unit)} "
+        f"d{label} = {display.number(float(h.min()))} .. "
+        f"{_with_unit(float(h.max()), unit)} "
         "(graded)"
     )
 
@@ -141,17 +150,18 @@ def in_situ_margin(spec: CaseSpec, fracture: FractureSpec) -> tuple[float, float
     return float(margin[worst]), float(sigma_n[worst])
 
 
-def _margin_text(spec: CaseSpec, fracture: FractureSpec) -> str:
-    """What the in-situ stress does to the fracture, for ``check``."""
+def _margin_text(spec: CaseSpec, fracture: FractureSpec, cp: bool = False) -> str:
+    """What the in-situ stress does to the fracture, for ``check`` (a margin
+    > 0 is stable in either sign convention)."""
     margin, sigma_n = in_situ_margin(spec, fracture)
     if math.isnan(margin):
         return ""
     if sigma_n > 0.0:
         return (
-            f"in-situ: in tension across it (sigma_n' = {fmt(sigma_n / 1e6)} MPa): "
-            "it opens in load step 1"
+            f"in-situ: in tension across it (sigma_n' = {display.stress(sigma_n, cp)})"
+            ": it opens in load step 1"
         )
-    text = f"in-situ Coulomb margin {fmt(margin / 1e6)} MPa"
+    text = f"in-situ Coulomb margin {display.pressure(margin)}"
     if margin < 0.0:
         return text + (
             " (shear above the friction limit: the excess is released and the "
@@ -179,13 +189,11 @@ def _describe_edge(name: str, edge: EdgeSpec, in_situ=False) -> str:
             extra = " (traction = loading.stress . n)" if edge.traction else ""
             parts.append(f"{label} free{extra}")
         elif np.ptp(column) == 0.0:
-            parts.append(
-                f"{label} = {_with_unit(float(column[0]), EdgeSpec.UNITS['values'])}"
-            )
+            parts.append(f"{label} = {display.slip(float(column[0]))}")
         else:
             parts.append(
-                f"{label} = {fmt(float(column.min()))} .. "
-                f"{_with_unit(float(column.max()), EdgeSpec.UNITS['values'])}"
+                f"{label} = {display.number(float(column.min()) * 1e3)} .. "
+                f"{display.slip(float(column.max()))}"
             )
     return (
         f"  {name}: displacement {', '.join(parts)} at {len(values)} nodes "
@@ -193,38 +201,47 @@ def _describe_edge(name: str, edge: EdgeSpec, in_situ=False) -> str:
     )
 
 
-def _describe_stress(stress: tuple[float, float, float] | None) -> str:
-    """``(xx, yy, xy) = (...) Pa`` or none."""
+def _describe_stress(stress: tuple[float, float, float] | None, cp=False) -> str:
+    """``(xx, yy, xy) = (...) MPa`` or none."""
     if stress is None:
         return "none"
-    values = ", ".join(fmt(v) for v in stress)
-    return f"(xx, yy, xy) = ({values}) {LoadingSpec.UNITS['stress']}"
+    values = ", ".join(display.number(display.megapascals(v, cp)) for v in stress)
+    return f"(xx, yy, xy) = ({values}) MPa"
 
 
-def _describe_in_situ(spec: CaseSpec) -> str:
+def _describe_in_situ(spec: CaseSpec, cp: bool = False) -> str:
     """The in-situ stress: uniform, or how it grows with depth."""
     s = spec.loading.in_situ
     if s is None:
-        return f"initial_stress {_describe_stress(spec.loading.initial_stress)}"
+        return f"initial_stress {_describe_stress(spec.loading.initial_stress, cp)}"
     if s.gravity is not None:
-        yy = f"{fmt(s.yy)} Pa - g = {fmt(s.gravity)} m/s^2 x the rock above"
+        yy = (
+            f"{display.stress(s.yy, cp)} {'+' if cp else '-'} g = {fmt(s.gravity)} "
+            "m/s^2 x the rock above"
+        )
     else:
         assert s.gradient_yy is not None  # gravity or a gradient (case/load.py)
-        yy = f"{fmt(s.yy)} Pa + {fmt(s.gradient_yy)} Pa/m x depth"
+        yy = (
+            f"{display.stress(s.yy, cp)} + {display.gradient(s.gradient_yy, cp)} "
+            "x depth"
+        )
     if s.ratio_xx is None:
         assert s.xx is not None and s.gradient_xx is not None
-        xx = f"sigma_xx = {fmt(s.xx)} Pa + {fmt(s.gradient_xx)} Pa/m x depth"
+        xx = (
+            f"sigma_xx = {display.stress(s.xx, cp)} + "
+            f"{display.gradient(s.gradient_xx, cp)} x depth"
+        )
     elif isinstance(s.ratio_xx, str):
         xx = "sigma'_xx = nu / (1 - nu) sigma'_yy in each unit"
     else:
         xx = f"sigma'_xx = {fmt(s.ratio_xx)} sigma'_yy"
     return (
-        f"initial_stress with depth below y = {fmt(s.datum)} m: sigma_yy = {yy}; "
-        f"{xx}; sigma_xy = {fmt(s.xy)} Pa"
+        f"initial_stress with depth below y = {display.length(s.datum)}: "
+        f"sigma_yy = {yy}; {xx}; sigma_xy = {display.stress(s.xy, cp)}"
     )
 
 
-def _describe_units(spec: CaseSpec) -> list[str]:
+def _describe_units(spec: CaseSpec, cp: bool = False) -> list[str]:
     """One line per rock unit of [[units]]."""
     lines: list[str] = []
     if spec.reservoir is not None or not spec.units:
@@ -245,16 +262,19 @@ def _describe_units(spec: CaseSpec) -> list[str]:
             where = f"polygon of {len(r.vertices)} vertices"
         else:
             where = f"{len(r.box_array)} box(es)"
-        dp = ", ".join(f"{zones.names[z]} {fmt(float(zones.change[z]))} Pa" for z in zs)
+        dp = ", ".join(
+            f"{zones.names[z]} {display.pressure_change(float(zones.change[z]), cp)}"
+            for z in zs
+        )
         lines.append(
-            f"unit {unit.name!r}: {where}; E = {fmt(unit.E)} Pa, nu = "
+            f"unit {unit.name!r}: {where}; E = {display.modulus(unit.E)}, nu = "
             f"{fmt(unit.nu)}, biot {fmt(float(zones.biot[zs[0]]))}; "
-            f"pore-pressure change {dp}"
+            f"pore-pressure {display.change_label(cp).replace('dp', 'change')} {dp}"
         )
     return lines
 
 
-def _describe_pore(spec: CaseSpec) -> list[str]:
+def _describe_pore(spec: CaseSpec, cp: bool = False) -> list[str]:
     """[pore_pressure] and [reservoir] lines (none when absent)."""
     lines = []
     p = spec.pore_pressure
@@ -263,7 +283,8 @@ def _describe_pore(spec: CaseSpec) -> list[str]:
             p.region, f"unit {p.region!r}"
         )
         grad = (
-            f" + {fmt(p.gradient)} Pa/m x depth below y = {fmt(p.datum)} m"
+            f" + {display.gradient(p.gradient)} x depth below y = "
+            f"{display.length(p.datum)}"
             if p.gradient
             else ""
         )
@@ -271,14 +292,18 @@ def _describe_pore(spec: CaseSpec) -> list[str]:
             change = f"change from {_describe_field(p.field)}"
         else:
             assert p.change is not None  # without a field, a uniform change
-            change = f"change {fmt(p.change)} Pa"
+            change = (
+                f"depletion {display.pressure_change(p.change, cp)} (a drop > 0)"
+                if cp
+                else f"change {display.pressure_change(p.change)} (< 0 = depletion)"
+            )
         lines.append(
-            f"pore pressure: initial {fmt(p.initial)} Pa{grad}, {change} over "
-            f"the load steps (< 0 = depletion), Biot coefficient "
+            f"pore pressure: initial {display.pressure(p.initial)}{grad}, {change} "
+            f"over the load steps, Biot coefficient "
             f"{fmt(p.biot)}, acting in {where}; "
             "effective stress in the bulk (Biot) and on the fractures (Terzaghi)"
         )
-    lines += _describe_units(spec)
+    lines += _describe_units(spec, cp)
     r = spec.reservoir
     if r is not None:
         rows = r.boxes if r.polygon is None else r.polygon
@@ -287,7 +312,7 @@ def _describe_pore(spec: CaseSpec) -> list[str]:
             "[" + ", ".join(fmt(float(v)) for v in b) + "]" for b in rows
         )
         lines.append(
-            f"reservoir: E = {fmt(r.E)} Pa, nu = {fmt(r.nu)} in {where} "
+            f"reservoir: E = {display.modulus(r.E)}, nu = {fmt(r.nu)} in {where} "
             f"{shapes} m (cells whose centre is inside); [material] is the host rock"
         )
     return lines
@@ -364,7 +389,7 @@ def _network_count(spec: CaseSpec) -> str:
 
 def _describe_field(f) -> str:
     """``dp.csv (columns dp1, dp2: a regular grid of ...; outside: error)``."""
-    outside = f.outside if isinstance(f.outside, str) else f"{fmt(f.outside)} Pa"
+    outside = f.outside if isinstance(f.outside, str) else display.pressure(f.outside)
     return (
         f"{f.file} (columns {', '.join(f.columns)}: {f.field.description}; "
         f"outside: {outside})"
@@ -384,8 +409,10 @@ def _describe_grading(g) -> str:
     )
 
 
-def describe(spec: CaseSpec) -> str:
-    """Human-readable summary of a resolved case (SI units, tension positive).
+def describe(spec: CaseSpec, compression_positive: bool = False) -> str:
+    """Human-readable summary of a resolved case in engineering units (MPa,
+    GPa, MPa/km, m, mm), stresses tension positive unless
+    ``compression_positive`` (:mod:`xfemslip.display`).
 
     Printed by ``xfemslip check``: domain, mesh (element sizes, graded or not),
     material, fractures, loading, every edge's condition (edges not given in the
@@ -395,33 +422,34 @@ def describe(spec: CaseSpec) -> str:
     (x0, y0), (w, h) = spec.origin, spec.size
     nx, ny = spec.mesh.x.size - 1, spec.mesh.y.size - 1
     m = spec.material
+    cp = compression_positive
     lines = [
         f"case {spec.name!r} ({spec.path})",
+        display.convention(cp),
         f"domain: [{fmt(x0)}, {fmt(x0 + w)}] x [{fmt(y0)}, {fmt(y0 + h)}] m "
         f"(size {fmt(w)} x {fmt(h)} m)",
         f"mesh: {nx} x {ny} Q4 elements, {(nx + 1) * (ny + 1)} nodes; "
         f"{_describe_axis(spec.mesh.x, 'x')}; {_describe_axis(spec.mesh.y, 'y')}"
         f"{_describe_grading(spec.mesh.grading)}",
-        f"material: E = {_with_unit(m.E, MaterialSpec.UNITS['E'])}, nu = {fmt(m.nu)}, "
-        f"{m.model}",
+        f"material: E = {display.modulus(m.E)}, nu = {fmt(m.nu)}, {m.model}",
         f"fractures: {len(spec.fractures)}{_network_count(spec)}",
     ]
     for fracture in spec.fractures:
         lines += _describe_fracture(fracture)
-        margin = _margin_text(spec, fracture)
+        margin = _margin_text(spec, fracture, cp)
         if margin:
             lines[-1] += f"; {margin}" if fracture.source else ""
             lines += [] if fracture.source else [f"      {margin}"]
     steps = spec.loading.steps
     lines += [
-        f"loading: stress {_describe_stress(spec.loading.stress)}; "
-        f"{_describe_in_situ(spec)}; "
+        f"loading: stress {_describe_stress(spec.loading.stress, cp)}; "
+        f"{_describe_in_situ(spec, cp)}; "
         f"{steps} step{'' if steps == 1 else 's'}",
         "boundary:",
     ]
     depth = spec.loading.in_situ is not None
     lines += [_describe_edge(e, getattr(spec.boundary, e), depth) for e in EDGES]
-    lines += _describe_pore(spec)
+    lines += _describe_pore(spec, cp)
     lines.append(_describe_events(spec))
     lines += _describe_permeability(spec)
     lines.append("solver:")

@@ -53,7 +53,7 @@ TIP_KINDS = ("branch", "ramp")
 TIP_KEYS = ("kind", "radius")
 DIP_DIRECTIONS = ("right", "left")
 # the fluid pressure in a fracture from the pore pressures of its two faces
-# (xfemslip.fem.zones.fluid_rule), or a number [Pa]
+# (xfemslip.fem.zones.fluid_value), or a number [Pa]
 FLUID_RULES = ("mean", "higher", "lower")
 DIP_KEYS = ("point", "dip", "dip_direction", "top", "base")
 

@@ -16,6 +16,7 @@ slip, screening and the in-situ margin use) and the rest in
 
 from __future__ import annotations
 
+from xfemslip import display
 from xfemslip.case.specs import SlipWeakeningSpec
 from xfemslip.case.tables import (
     NON_NEGATIVE,
@@ -163,10 +164,13 @@ def read_strength(table: Table, friction_default=REQUIRED, cohesion_default=0.0)
 def describe_strength(friction, cohesion, weakening) -> tuple[str, str]:
     """(friction, cohesion) as ``xfemslip check`` prints them."""
     if weakening is None:
-        return fmt(friction), f"{fmt(cohesion)} Pa"
-    over = f"over {fmt(weakening.slip_distance)} m of slip"
+        return fmt(friction), display.pressure(cohesion)
+    over = f"over {display.slip(weakening.slip_distance)} of slip"
     f_text = f"slip weakening {fmt(friction)} -> {fmt(weakening.dynamic_friction)}"
     if weakening.dynamic_cohesion == cohesion:
-        return f"{f_text} {over}", f"{fmt(cohesion)} Pa"
-    c_text = f"{fmt(cohesion)} -> {fmt(weakening.dynamic_cohesion)} Pa {over}"
+        return f"{f_text} {over}", display.pressure(cohesion)
+    c_text = (
+        f"{display.number(cohesion / 1e6)} -> "
+        f"{display.pressure(weakening.dynamic_cohesion)} {over}"
+    )
     return f"{f_text} {over}", c_text

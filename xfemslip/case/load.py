@@ -25,6 +25,7 @@ Resolution rules beyond ``case-format.md`` (see ``describe`` for the printout):
 from __future__ import annotations
 
 import re
+from dataclasses import replace
 from pathlib import Path
 
 from xfemslip.case import options
@@ -58,6 +59,7 @@ from xfemslip.case.options import (
     TOP_KEYS,
 )
 from xfemslip.case.pore import check_region, read_pore_pressure
+from xfemslip.case.quantities import convert_units, first_problems
 from xfemslip.case.segments import PROPERTY_RULES
 from xfemslip.case.specs import (
     CaseSpec,
@@ -66,6 +68,7 @@ from xfemslip.case.specs import (
     MaterialSpec,
     OutputSpec,
     SolverSpec,
+    digest,
 )
 from xfemslip.case.tables import (
     BIOT,
@@ -458,8 +461,9 @@ def loads_case(
     (default: the folder of ``path``) the folder of CSV files."""
     path = Path(path)
     folder = path.parent if folder is None else Path(folder)
-    document = parse_toml(text, path)
     problems: list[tuple[str, str]] = []
+    document = convert_units(parse_toml(text, path), problems)
+    refused = len(problems)
     root = Table(document, "", problems, TOP_KEYS)
     name = _read_name(root, path)
     grid = read_grid(root)
@@ -483,7 +487,7 @@ def loads_case(
     events = read_events(root)
     permeability = read_permeability(root, grid, fractures)
     if problems:
-        raise CaseError(path, problems)
+        raise CaseError(path, first_problems(problems) if refused else problems)
     # each reader returns None only after recording a problem
     assert (
         name is not None
@@ -493,7 +497,7 @@ def loads_case(
         and solver is not None
         and output is not None
     )
-    return CaseSpec(
+    spec = CaseSpec(
         path=path,
         text=text,
         name=name,
@@ -512,3 +516,4 @@ def loads_case(
         events=events,
         permeability=permeability,
     )
+    return replace(spec, loaded=digest(spec))

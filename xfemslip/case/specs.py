@@ -2,9 +2,11 @@
 
 from __future__ import annotations
 
+import dataclasses
+import hashlib
 from dataclasses import dataclass, field
-from pathlib import Path
-from typing import ClassVar
+from pathlib import Path, PurePath
+from typing import Any, ClassVar
 
 import numpy as np
 
@@ -427,8 +429,58 @@ class CaseSpec:
     units: tuple[UnitSpec, ...] = ()
     events: EventsSpec | None = None  # None: no [events] table
     permeability: PermeabilitySpec | None = None  # None: no [permeability] table
+    # digest of the values as loaded from ``text`` (xfemslip.case.record): a
+    # spec changed with dataclasses.replace no longer matches it
+    loaded: str = field(default="", compare=False, repr=False)
 
     @property
     def box(self) -> Box:
         """The domain ([domain] origin and size) [m]."""
         return Box.from_origin_size(self.origin, self.size)
+
+
+# CaseSpec fields that are not values of the case
+NOT_VALUES = ("path", "text", "loaded")
+
+
+def _feed(h, value: Any) -> None:
+    """Hash ``value`` into ``h`` by type and content."""
+    if dataclasses.is_dataclass(value) and not isinstance(value, type):
+        h.update(type(value).__name__.encode())
+        for f in dataclasses.fields(value):
+            if f.name not in NOT_VALUES:
+                h.update(f.name.encode())
+                _feed(h, getattr(value, f.name))
+    elif isinstance(value, np.ndarray):
+        h.update(f"array{value.dtype.str}{value.shape}".encode())
+        h.update(np.ascontiguousarray(value).tobytes())
+    elif isinstance(value, list | tuple):
+        h.update(f"seq{len(value)}".encode())
+        for item in value:
+            _feed(h, item)
+    elif isinstance(value, dict):
+        h.update(f"map{len(value)}".encode())
+        for key in sorted(value, key=str):
+            _feed(h, key)
+            _feed(h, value[key])
+    elif value is None or isinstance(value, bool | int | float | str | PurePath):
+        h.update(f"{type(value).__name__}:{value!r}".encode())
+    elif hasattr(value, "__dict__"):  # a sampled pressure field
+        h.update(type(value).__name__.encode())
+        _feed(h, vars(value))
+    else:
+        h.update(repr(value).encode())
+
+
+def digest(spec: CaseSpec) -> str:
+    """A digest of every value of ``spec`` (not its path, text or stamp)."""
+    h = hashlib.blake2b(digest_size=16)
+    _feed(h, spec)
+    return h.hexdigest()
+
+
+def digest_of(value: Any) -> str:
+    """A digest of ``value`` (a spec, a field of one) by type and content."""
+    h = hashlib.blake2b(digest_size=16)
+    _feed(h, value)
+    return h.hexdigest()

@@ -15,7 +15,7 @@ from xfemslip import __version__, interrupt
 from xfemslip.cli.common import EXIT_USAGE, Group, one_line
 from xfemslip.cli.deplete import deplete
 from xfemslip.cli.dfn import dfn
-from xfemslip.cli.env import check_environment
+from xfemslip.cli.env import check_environment, check_platform
 from xfemslip.cli.run import check, info, run
 from xfemslip.cli.studies import plot, screen, sweep
 from xfemslip.cli.summary import summary
@@ -30,6 +30,7 @@ __all__ = ["cli", "main"]
 def cli() -> None:
     """XFEM frictional contact on 2D fractures, driven by TOML case files."""
     try:  # not inside reported_errors: the command installs the signal handlers
+        check_platform()
         check_environment()
     except UsageError as err:
         click.echo(f"Error: {one_line(err)}", err=True)

@@ -236,6 +236,13 @@ debug_option = click.option(
     "--debug", is_flag=True, help="Show the traceback of a reported error."
 )
 case_argument = click.argument("case", type=PathParam(path_type=Path))
+compression_option = click.option(
+    "--compression-positive",
+    is_flag=True,
+    help="Print stresses and tractions compression positive and pore-pressure "
+    "changes as depletions (a drop > 0) [default: tension positive, as the "
+    "files are].",
+)
 
 
 def solve_options(command):

@@ -10,6 +10,7 @@ import click
 from xfemslip.cli.common import (
     FiniteFloat,
     case_argument,
+    compression_option,
     configure_logging,
     debug_option,
     load_case_file,
@@ -44,9 +45,19 @@ from xfemslip.cli.common import (
     is_flag=True,
     help="Also draw slip_vs_depletion.png and depletion_field.png.",
 )
+@compression_option
 @debug_option
 def deplete(
-    case, output, tolerance, patch_length, plot, overwrite, verbose, quiet, debug
+    case,
+    output,
+    tolerance,
+    patch_length,
+    plot,
+    overwrite,
+    verbose,
+    quiet,
+    compression_positive,
+    debug,
 ) -> None:
     """Critical depletion of every fracture of CASE: the pore-pressure change
     at which it first slips (bisection on the load), and slip vs depletion
@@ -65,6 +76,6 @@ def deplete(
             overwrite=overwrite,
             patch_length=patch_length,
         )
-        click.echo(format_report(report))
+        click.echo(format_report(report, compression_positive))
         for path in report.written:
             click.echo(str(path))

@@ -1,5 +1,5 @@
-"""The environment variables xfemslip and Numba read, checked before a command
-runs (by the command group of :mod:`xfemslip.cli`).
+"""The platform, and the environment variables xfemslip and Numba read,
+checked before a command runs (by the command group of :mod:`xfemslip.cli`).
 
 Numba parses its variables when it is first imported: ``NUMBA_NUM_THREADS=0``
 then raises ``ValueError`` from inside ``import numba``, and a value it cannot
@@ -13,8 +13,10 @@ importing Numba, and a bad value is one line naming the variable (exit 2).
 from __future__ import annotations
 
 import os
+import sys
 
 from xfemslip.errors import UsageError
+from xfemslip.io.lock import UNSUPPORTED_PLATFORM
 from xfemslip.memory import parse_bytes
 
 
@@ -64,3 +66,10 @@ def check_environment(environ=None) -> None:
             raise UsageError(
                 f"environment variable {name} = {shown!r}: expected {expected}"
             )
+
+
+def check_platform(platform: str | None = None) -> None:
+    """UsageError on a platform the command line does not run on (Windows:
+    the output lock needs POSIX file locks); Linux and macOS pass."""
+    if (sys.platform if platform is None else platform) == "win32":
+        raise UsageError(UNSUPPORTED_PLATFORM)

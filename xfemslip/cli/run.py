@@ -16,6 +16,7 @@ from xfemslip import __version__
 from xfemslip.cli.common import (
     EXIT_FAILURE,
     case_argument,
+    compression_option,
     configure_logging,
     debug_option,
     load_case_file,
@@ -75,9 +76,11 @@ def run(
 
 @click.command()
 @case_argument
+@compression_option
 @debug_option
-def check(case: Path, debug: bool) -> None:
-    """Validate CASE and print its settings in SI units.
+def check(case: Path, compression_positive: bool, debug: bool) -> None:
+    """Validate CASE and print its settings in engineering units (MPa, GPa,
+    m, mm), stresses tension positive unless --compression-positive.
 
     Besides the keys, the geometry is checked (fractures against the mesh,
     boundary corners); nothing is assembled or solved.
@@ -89,7 +92,7 @@ def check(case: Path, debug: bool) -> None:
         from xfemslip.simulation import check_geometry
 
         check_geometry(spec)
-        click.echo(describe(spec))
+        click.echo(describe(spec, compression_positive))
 
 
 @click.command()

@@ -24,6 +24,7 @@ from xfemslip.cli.common import (
     EXIT_FAILURE,
     FiniteFloat,
     PathParam,
+    compression_option,
     configure_logging,
     debug_option,
     load_case_file,
@@ -364,6 +365,7 @@ def plot_run(out_dir: Path) -> None:
     type=click.Choice(("png", "pdf")),
     help="Format of the --plot files (repeatable) [default: png and pdf].",
 )
+@compression_option
 @debug_option
 def screen(
     case,
@@ -376,13 +378,15 @@ def screen(
     csv_path,
     plot_dir,
     formats,
+    compression_positive,
     debug,
 ) -> None:
     """Closed-form slip screening of every orientation (and of the fractures of
     CASE): slip tendency, Coulomb margin, the band that slips and the
     pore-pressure change at which each fracture slips or opens, along CASE's
     own stress path when it changes the pore pressure (else at constant
-    total stress, the pressure rising).  Stresses in Pa, tension positive."""
+    total stress, the pressure rising).  Options in Pa; the report in MPa,
+    tension positive unless --compression-positive (the CSV keeps Pa)."""
     with reported_errors(debug):
         from xfemslip.reference import screen as scr
         from xfemslip.studies.slip_screen import screen_plan
@@ -405,7 +409,14 @@ def screen(
         ]
         click.echo(
             scr.format_report(
-                plan.stress, plan.pore_pressure, f0, c0, step, screened, plan.text
+                plan.stress,
+                plan.pore_pressure,
+                f0,
+                c0,
+                step,
+                screened,
+                plan.text,
+                compression_positive,
             )
         )
         if csv_path is not None:

@@ -13,7 +13,8 @@ from pathlib import Path
 
 import click
 
-from xfemslip.cli.common import debug_option, reported_errors
+from xfemslip import display
+from xfemslip.cli.common import compression_option, debug_option, reported_errors
 
 __all__ = ["event_report", "summary"]
 
@@ -60,8 +61,11 @@ def event_report(result, spec=None, every_step: bool = False) -> list[str]:
     help="A table for every converged load step, not only the last, with "
     "what the step's own slip adds.",
 )
+@compression_option
 @debug_option
-def summary(result_path: Path, every_step: bool, debug: bool) -> None:
+def summary(
+    result_path: Path, every_step: bool, compression_positive: bool, debug: bool
+) -> None:
     """Print what happened in the run that wrote RESULT (a result.h5 or its
     folder): per fracture whether it slipped, max slip, slipping length,
     moment per unit length, stress drop and magnitude with its extent W; with
@@ -78,12 +82,14 @@ def summary(result_path: Path, every_step: bool, debug: bool) -> None:
         )
         if not result.steps:
             click.echo("no converged load step: nothing to report on the fractures")
+        else:
+            click.echo(display.convention(compression_positive))
         for line in event_report(result, every_step=every_step):
             click.echo(line)
         if result.depletion is not None:
             from xfemslip.studies.depletion import depletion_lines
 
-            for line in depletion_lines(result.depletion):
+            for line in depletion_lines(result.depletion, compression_positive):
                 click.echo(line)
 
 

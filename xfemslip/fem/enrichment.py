@@ -7,7 +7,8 @@ Enrichment function of fracture f (paper eqs. 11-12, with a tip ramp):
 and each enriched node a contributes N_a(x) (F(x) - F(x_a)) a_a (shifted, so
 the nodal dofs stay the displacement at the node).  The jump across the
 fracture is [[u]] = 2 R sum_a N_a a_a (eq. 14 with the ramp).  R = 1 except in
-the tip cell, where it falls linearly to 0 at the geometric tip (geometry.py):
+the tip cell, where it falls linearly to 0 at the geometric tip
+(xfemslip/geometry/fracture.py, ``Fracture.ramp``):
 the modelled discontinuity ends exactly at the tip, wherever the tip lies.
 A node x_a exactly on the fracture takes H = +1 (eq. 12).
 

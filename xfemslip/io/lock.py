@@ -15,16 +15,29 @@ from __future__ import annotations
 
 import contextlib
 import errno
-import fcntl
 import logging
 import os
 import shutil
+import sys
 from collections.abc import Iterator
 from pathlib import Path
 
 from xfemslip.errors import OutputError, UsageError
 
+if sys.platform == "win32":
+    fcntl = None  # no POSIX file locks: writing an output set is refused
+else:
+    import fcntl
+
 logger = logging.getLogger(__name__)
+
+# Why a Windows process cannot write an output set (the command line refuses
+# to start there, xfemslip.cli.env.check_platform, with the same words).
+UNSUPPORTED_PLATFORM = (
+    "xfemslip runs on Linux and macOS; on Windows, run it in WSL (Windows "
+    "Subsystem for Linux): its output folders are locked with POSIX file "
+    "locks (fcntl), which Windows does not have"
+)
 
 
 def sibling(final: Path, kind: str, pid: int | None = None) -> Path:
@@ -65,6 +78,8 @@ def folder_lock(final: Path, display: Path) -> Iterator[None]:
     OutputError
         The lock file cannot be created (read-only or missing parent).
     """
+    if fcntl is None:
+        raise UsageError(f"cannot write {display}: {UNSUPPORTED_PLATFORM}")
     path = sibling(final, "lock")
     while True:
         try:

@@ -20,8 +20,10 @@ from __future__ import annotations
 import importlib
 import logging
 import os
+import sys
+from pathlib import Path
 
-from xfemslip.kernels._config import numba_settings
+from xfemslip.kernels._config import NUMBA_CACHE, numba_settings
 
 logger = logging.getLogger(__name__)
 
@@ -53,10 +55,48 @@ _MODULES = {"numba": "xfemslip.kernels.jit", "numpy": "xfemslip.kernels.vectoriz
 
 def backend(name: str):
     """The kernel namespace of backend ``name`` ("numba" | "numpy"): a module
-    with the functions named in KERNELS."""
+    with the functions named in KERNELS.  The first use of the Numba kernels
+    in a process whose on-disk cache lacks them says so (their compilation
+    is a silent pause otherwise)."""
     if name not in _MODULES:
         raise ValueError(f"unknown kernel backend {name!r}; expected numba or numpy")
+    if name == "numba" and _MODULES[name] not in sys.modules and cache_is_cold():
+        logger.info(COMPILING)
     return importlib.import_module(_MODULES[name])
+
+
+# The compilation of every kernel, timed as a run of
+# cases/reservoir_depletion.toml with kernels = "numba" and an empty
+# NUMBA_CACHE_DIR: 9 s on a free core, 43 s on two cores busy with other work.
+COMPILING = (
+    "compiling kernels (first run, about 15 s; longer on a busy machine): "
+    "later runs load them from Numba's cache"
+)
+# the modules whose functions Numba compiles (one cache index per function)
+JIT_MODULES = ("bulk", "contact", "scatter", "shape", "subcells")
+
+
+def _cache_folders() -> list[Path]:
+    """Where Numba keeps the compiled kernels: NUMBA_CACHE_DIR when set, else
+    __pycache__ beside the sources or, when that is not writable, the user's
+    cache folder."""
+    given = os.environ.get("NUMBA_CACHE_DIR", "").strip()
+    if given:
+        return [Path(given)]
+    home = os.environ.get("XDG_CACHE_HOME") or str(Path.home() / ".cache")
+    return [Path(__file__).parent / "__pycache__", Path(home) / "numba"]
+
+
+def cache_is_cold() -> bool:
+    """Whether a Numba run would compile: the on-disk cache is off, or holds
+    no index of one of the JIT_MODULES."""
+    if not NUMBA_CACHE:
+        return True
+    indexes: set[str] = set()
+    for folder in _cache_folders():
+        if folder.is_dir():
+            indexes.update(p.name.split(".", 1)[0] for p in folder.rglob("*.nbi"))
+    return not indexes.issuperset(JIT_MODULES)
 
 
 def choose(requested: str, work: float) -> str:
@@ -74,7 +114,9 @@ def choose(requested: str, work: float) -> str:
 
 __all__ = [
     "BACKENDS",
+    "COMPILING",
     "backend",
+    "cache_is_cold",
     "choose",
     "numba_settings",
 ]

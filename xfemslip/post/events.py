@@ -33,6 +33,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from xfemslip import display
 from xfemslip.case.specs import CaseSpec
 from xfemslip.conventions import SLIP
 from xfemslip.post.metrics import point_stretches
@@ -279,23 +280,36 @@ def summary_lines(
     (``also`` appended to it after a semicolon, e.g. the permeability)."""
     if not events:
         return ["no fracture in this result"]
-    head = (
-        f"{'fracture':>8}  {'slipped':>7}  {'max slip [mm]':>13}  "
-        f"{'slipping [m]':>12}  {MOMENT_HEAD:>12}  {'drop [MPa]':>10}  "
-        f"{'Mw':>6}  W [m] ({W_SOURCE[inputs.extent is not None]})"
-    )
-    lines = [head]
+    head = [
+        "fracture",
+        "slipped",
+        "max slip [mm]",
+        "slipping [m]",
+        MOMENT_HEAD,
+        "drop [MPa]",
+        "Mw",
+        f"W [m] ({W_SOURCE[inputs.extent is not None]})",
+    ]
+    rows = []
     for e in events:
         drop = f"{e.stress_drop / 1e6:.3g}" if math.isfinite(e.stress_drop) else "-"
         m0 = e.moment_per_length
         moment = f"{m0:.4g}" if math.isfinite(m0) else "-"
         # W only beside a magnitude
         w = f"{e.extent:.3g}" if math.isfinite(e.magnitude) else "-"
-        lines.append(
-            f"{e.fracture:>8}  {'yes' if e.slipped else 'no':>7}  "
-            f"{e.max_slip * 1e3:>13.4g}  {e.slipping_length:>12.4g}  "
-            f"{moment:>12}  {drop:>10}  {_mw_text(e):>6}  {w}"
+        rows.append(
+            [
+                str(e.fracture),
+                "yes" if e.slipped else "no",
+                f"{e.max_slip * 1e3:.4g}",
+                f"{e.slipping_length:.4g}",
+                moment,
+                drop,
+                _mw_text(e),
+                w,
+            ]
         )
+    lines = display.table(head, rows, left=(7,)).splitlines()
     lines.append(what_happened(events, inputs) + (f"; {also}" if also else ""))
     if inputs.note:
         lines.append(f"note: {inputs.note}")

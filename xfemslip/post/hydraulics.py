@@ -32,6 +32,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from xfemslip import display
 from xfemslip.case.specs import CaseSpec
 from xfemslip.conventions import OPEN
 from xfemslip.fem.poro import FACE_OFFSET
@@ -193,24 +194,28 @@ def permeability_lines(result: Result, index: int = -1) -> list[str]:
     if history is None:
         return []
     step = result.steps[index]
-    lines = [
-        f"{'fracture':>8}  {'a0 [mm]':>8}  {'mean a [mm]':>11}  {'max a [mm]':>10}  "
-        f"{'T/T0':>8}"
-    ]
+    rows = []
     for i, ff in enumerate(step.fractures):
         a0 = float(history.initial_aperture[i])
         if ff.aperture is None or not np.size(ff.aperture):
-            lines.append(f"{i:>8}  {a0 * 1e3:>8.4g}  {'-':>11}  {'-':>10}  {'-':>8}")
+            rows.append([str(i), f"{a0 * 1e3:.4g}", "-", "-", "-"])
             continue
         s = np.asarray(ff.s, float)
         w = point_stretches(s, s[0], s[-1]) if s.size > 1 else np.ones(1)
         mean_a = float(np.sum(w * ff.aperture) / np.sum(w))
         assert ff.transmissivity is not None  # filled with the aperture
         ratio = float(np.sum(w * ff.transmissivity) / np.sum(w)) / (a0**3 / 12.0)
-        lines.append(
-            f"{i:>8}  {a0 * 1e3:>8.4g}  {mean_a * 1e3:>11.4g}  "
-            f"{float(np.max(ff.aperture)) * 1e3:>10.4g}  {ratio:>8.4g}"
+        rows.append(
+            [
+                str(i),
+                f"{a0 * 1e3:.4g}",
+                f"{mean_a * 1e3:.4g}",
+                f"{float(np.max(ff.aperture)) * 1e3:.4g}",
+                f"{ratio:.4g}",
+            ]
         )
+    head = ["fracture", "a0 [mm]", "mean a [mm]", "max a [mm]", "T/T0"]
+    lines = display.table(head, rows).splitlines()
     x0, x1, y0, y1 = Box.from_corners(*history.block)
     k0, k = history.in_situ, history.tensors[index]
     lines.append(

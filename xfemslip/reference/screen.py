@@ -37,6 +37,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from xfemslip import display
 from xfemslip.reference.closed_form import angle_to_sigma1, principal, slip_window
 from xfemslip.reference.onset import (
     INJECTION,
@@ -203,19 +204,26 @@ def format_report(
     step,
     fractures,
     path_text,
+    compression_positive=False,
 ) -> str:
     """The text report of ``xfemslip screen``: state, band, table, fractures;
-    ``path_text`` the sentence naming the stress path of the dp to slip."""
+    ``path_text`` the sentence naming the stress path of the dp to slip.
+    Stresses in MPa (:mod:`xfemslip.display`), tension positive unless
+    ``compression_positive``."""
+    cp = compression_positive
     eff = effective_stress(stress, pore_pressure)
     band = slip_band(eff, friction, cohesion)
     phi = math.degrees(math.atan(friction))
+    xx, yy, xy = (display.stress(v, cp) for v in stress)
     lines = [
-        "Stresses in Pa, tension positive; effective stress sigma' = sigma + p I.",
-        f"total stress xx = {stress[0]:.6g}, yy = {stress[1]:.6g}, "
-        f"xy = {stress[2]:.6g}; pore pressure p = {pore_pressure:.6g}",
-        f"effective principal stresses (compression): sigma1' = {band.sigma1:.6g} "
-        f"at {band.dir1:.2f} deg from +x, sigma3' = {band.sigma3:.6g}",
-        f"friction f = {friction:g} (phi = {phi:.2f} deg), cohesion c = {cohesion:g}",
+        f"{display.convention(cp)}; effective stress sigma' = sigma + p I.",
+        f"total stress xx = {xx}, yy = {yy}, xy = {xy}; pore pressure p = "
+        f"{display.pressure(pore_pressure)}",
+        "effective principal stresses (compression): sigma1' = "
+        f"{display.pressure(band.sigma1)} at {band.dir1:.2f} deg from +x, "
+        f"sigma3' = {display.pressure(band.sigma3)}",
+        f"friction f = {friction:g} (phi = {phi:.2f} deg), cohesion c = "
+        f"{display.pressure(cohesion)}",
         path_text,
     ]
     if band.beta is None:
@@ -230,28 +238,45 @@ def format_report(
     table = orientation_table(
         stress, pore_pressure, friction, cohesion, np.arange(0.0, 180.0, step)
     )
-    lines += ["", _orientation_text(table)]
+    lines += ["", _orientation_text(table, cp)]
     if fractures:
-        lines += ["", _fracture_text(fractures)]
+        lines += ["", _fracture_text(fractures, cp)]
     return "\n".join(lines)
 
 
-def _orientation_text(table) -> str:
-    """The per-orientation table as aligned text."""
-    header = (
-        "theta[deg]  beta[deg]  sigma_n'[Pa]  tau[Pa]     T_s      margin[Pa]  slips"
+def _orientation_text(table, cp: bool = False) -> str:
+    """The per-orientation table as aligned text (the CSV keeps Pa)."""
+
+    def mpa(value, signed=True) -> str:
+        value = display.megapascals(value, cp) if signed else value / 1e6
+        return display.number(value, 4)
+
+    return display.table(
+        [
+            "theta [deg]",
+            "beta [deg]",
+            "sigma_n' [MPa]",
+            "tau [MPa]",
+            "T_s",
+            "margin [MPa]",
+            "slips",
+        ],
+        [
+            [
+                f"{table['theta_deg'][i]:.2f}",
+                f"{table['beta_deg'][i]:.2f}",
+                mpa(table["sigma_n_eff_Pa"][i]),
+                mpa(table["tau_Pa"][i]),
+                f"{table['slip_tendency'][i]:.4f}",
+                mpa(table["margin_Pa"][i], signed=False),
+                "yes" if table["slips"][i] else "no",
+            ]
+            for i in range(table["theta_deg"].size)
+        ],
     )
-    rows = [
-        f"{table['theta_deg'][i]:10.2f}  {table['beta_deg'][i]:9.2f}  "
-        f"{table['sigma_n_eff_Pa'][i]:12.4g}  {table['tau_Pa'][i]:10.4g}  "
-        f"{table['slip_tendency'][i]:7.4f}  {table['margin_Pa'][i]:11.4g}  "
-        f"{'yes' if table['slips'][i] else 'no'}"
-        for i in range(table["theta_deg"].size)
-    ]
-    return "\n".join([header, *rows])
 
 
-def _fracture_text(fractures: list[FractureScreen]) -> str:
+def _fracture_text(fractures: list[FractureScreen], cp: bool = False) -> str:
     """The per-fracture lines, with the pore-pressure change to slip."""
     lines = []
     for fs in fractures:
@@ -261,13 +286,17 @@ def _fracture_text(fractures: list[FractureScreen]) -> str:
         elif math.isnan(fs.dp_critical):
             change = "stable; neither slips nor opens along the path"
         else:
-            change = f"stable; {limit} at a pore-pressure change dp = " + (
-                f"{fs.dp_critical:.6g} Pa"
+            at = display.pressure_change(fs.dp_critical, cp)
+            change = (
+                f"stable; {limit} at a depletion of {at}"
+                if cp
+                else f"stable; {limit} at a pore-pressure change dp = {at}"
             )
         lines.append(
             f"{fs.label}: theta = {fs.theta:.2f} deg (beta = {fs.beta:.2f} deg), "
-            f"f = {fs.friction:g}, c = {fs.cohesion:g}: sigma_n' = "
-            f"{fs.sigma_n_eff:.6g}, tau = {fs.tau:.6g}, T_s = "
-            f"{fs.slip_tendency:.4f}, margin = {fs.margin:.6g} -> {change}"
+            f"f = {fs.friction:g}, c = {display.pressure(fs.cohesion)}: sigma_n' = "
+            f"{display.stress(fs.sigma_n_eff, cp)}, tau = "
+            f"{display.stress(fs.tau, cp)}, T_s = {fs.slip_tendency:.4f}, margin = "
+            f"{display.pressure(fs.margin)} -> {change}"
         )
     return "\n".join(lines)

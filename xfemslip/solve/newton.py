@@ -28,6 +28,10 @@ restores the true law, the line search and the failure messages share the
 solver's state (free dofs, reduced stiffness, committed history, linear
 solver) from one iteration to the next; cut apart they would pass that
 state back and forth without making either half readable on its own.
+
+Logging: one INFO line per converged load step (its iterations, cuts and
+contact states); every Newton iteration, cut, prediction and remedy at DEBUG
+(``-v`` on the command line).
 """
 
 from __future__ import annotations
@@ -299,7 +303,7 @@ class NewtonSolver:
                 cuts += 1
                 lam_from = lam0 + (lam1 - lam0) * done / units
                 lam_to = lam0 + (lam1 - lam0) * (done + size) / units
-                logger.info(
+                logger.debug(
                     "step %d/%d: cutting the load step (cut %d of at most %d): "
                     "load factor %.6g -> %.6g (%s)",
                     k,
@@ -326,7 +330,7 @@ class NewtonSolver:
             reversals += log.reversals
             searches += log.found
         if cuts:
-            logger.info(
+            logger.debug(
                 "step %d/%d converged in %d sub-steps after %d cut(s)",
                 k,
                 steps,
@@ -334,6 +338,17 @@ class NewtonSolver:
                 cuts,
             )
         self._log_step_time(k, steps, start, solve_start)
+        logger.info(
+            "step %d/%d: converged in %d Newton iteration(s)%s; contact points: "
+            "%d slip, %d stick, %d open",
+            k,
+            steps,
+            iterations,
+            f" over {substeps} sub-steps after {cuts} cut(s)" if cuts else "",
+            np.count_nonzero(res.state == SLIP),
+            np.count_nonzero(res.state == STICK),
+            np.count_nonzero(res.state == OPEN),
+        )
         self.completed.append(
             StepResult(
                 k,
@@ -418,7 +433,7 @@ class NewtonSolver:
             log.residuals.append(eta)
             log.switches.append(flips)
             history.append(regime)
-            logger.info(
+            logger.debug(
                 "step %d/%d iteration %d: eta = %.3e; contact points: %d slip, %d "
                 "stick, "
                 "%d open; %d switched%s",
@@ -436,7 +451,7 @@ class NewtonSolver:
                 raise self._fail(k, it, eta, flips, "the residual is not finite")
             if eta <= self.tol and (frozen is not None or forced):
                 # converged with frozen points: restore the true law, go on
-                logger.info(
+                logger.debug(
                     "step %d/%d: converged with %d frozen point(s)%s; "
                     "releasing them and checking the true contact law",
                     k,
@@ -466,7 +481,7 @@ class NewtonSolver:
                 frozen = cycling if frozen is None else (frozen | cycling)
                 law = force_branches(c, stick_at=frozen)
                 log.freezes += 1
-                logger.info(
+                logger.debug(
                     "step %d/%d iteration %d: %d contact point(s) ping-pong "
                     "between stick and slip; freezing their state (freeze %d of "
                     "at most %d)",
@@ -520,7 +535,7 @@ class NewtonSolver:
                     if searched is not None:
                         law, forced = searched, True
                         log.found += 1
-                        logger.info(
+                        logger.debug(
                             "step %d/%d iteration %d: the Newton step reverses "
                             "the slip of %d contact patch(es) held %d times "
                             "already; a consistent stick/slip set of them and "
@@ -540,7 +555,7 @@ class NewtonSolver:
                     frozen = flipped if frozen is None else (frozen | flipped)
                     law = force_branches(c, stick_at=frozen)
                     log.reversals += 1
-                    logger.info(
+                    logger.debug(
                         "step %d/%d iteration %d: the Newton step reverses the "
                         "slip of %d contact patch(es) (forward <-> backward); "
                         "holding them in stick, the state between the two",
@@ -559,7 +574,7 @@ class NewtonSolver:
             if self.mode == TANGENT_SECANT and not eta < eta_before:
                 # the secant direction is no descent direction (it drops the
                 # n-t coupling of the slip law): one consistent iteration
-                logger.info(
+                logger.debug(
                     "step %d/%d iteration %d: the secant tangent gave no descent; "
                     "the next iteration uses the consistent tangent",
                     k,
@@ -585,7 +600,7 @@ class NewtonSolver:
         guess = remedies.regimes(res.state, res.pt)
         if np.array_equal(guess, regime):
             return None
-        logger.info(
+        logger.debug(
             "predicted stick/slip set: %d slip, %d stick, %d open (%d differ "
             "from the state at the start); first solve with it",
             np.count_nonzero(res.state == SLIP),
@@ -631,7 +646,7 @@ class NewtonSolver:
                 *best[2:],
             )
         if alpha < 1.0:
-            logger.info(
+            logger.debug(
                 "line search: step length %.3g (eta %.3e -> %.3e)", alpha, eta0, best[3]
             )
         return best

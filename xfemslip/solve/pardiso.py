@@ -35,7 +35,7 @@ fixed for the run.  Two ways to use that:
 PARDISO is called directly through ctypes (MKL located by pypardiso), with
 0-based int32 index arrays made once: pypardiso's own ``solve`` copies and
 re-checks the whole matrix on every call.  Every solve is checked like the
-SuperLU path's (xfemslip.linsolve.lu_factor): normwise backward error at most
+SuperLU path's (xfemslip.solve.linear.lu_factor): normwise backward error at most
 LU_BACKWARD_ERROR, one step of iterative refinement if not, and the caller
 falls back to SuperLU (with a log line) when that fails or PARDISO reports an
 error.

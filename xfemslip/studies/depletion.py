@@ -34,6 +34,7 @@ from pathlib import Path
 
 import numpy as np
 
+from xfemslip import display
 from xfemslip.contact.interface import COMMITTED
 from xfemslip.conventions import SLIP
 from xfemslip.errors import ConvergenceError, UsageError
@@ -303,6 +304,11 @@ def _step_and_bisect(solver, model, steps, tolerance, onsets, patch_length) -> N
                     bracket,
                     tolerance / abs(change),
                     lambda r, fi=fi: slipping_length(contact, r, fi) >= patch_length,
+                    change,
+                    (
+                        f"fracture {onsets[fi].fracture} slips over {patch_length:g} m",
+                        "not yet",
+                    ),
                 )
                 onsets[fi].dp_patch = 0.5 * (lo + hi) * change
                 logger.info(
@@ -458,16 +464,18 @@ def _trial(solver, contact, bracket, lam):
     try:
         return solver._newton(bracket.u, lam, bracket.step, bracket.steps)[1]
     except ConvergenceError:
-        logger.info("bisection trial at load factor %.6g: cutting the step", lam)
+        logger.debug("bisection trial at load factor %.6g: cutting the step", lam)
         _restore(contact, bracket.history)
         solver._advance(bracket.u, bracket.lam0, lam, bracket.step, bracket.steps)
         return solver.completed.pop().contact
 
 
-def _bisect(solver, contact, bracket, width, happened):
+def _bisect(solver, contact, bracket, width, happened, change=None, said=("yes", "no")):
     """(lo, hi, lo_res, hi_res, trials): the load factors between which
     ``happened(contact result)`` first holds in the bracket's step, to
-    ``width`` in load factor (lo_res None at the initial state)."""
+    ``width`` in load factor (lo_res None at the initial state); each trial
+    is one log line, at the pore-pressure change lam * ``change`` [Pa] when
+    given, saying ``said[0]`` when it happened and ``said[1]`` when not."""
     lo, hi = bracket.lam0, bracket.lam1
     hi_res = solver.completed[-1].contact
     lo_res = bracket.res0
@@ -484,6 +492,19 @@ def _bisect(solver, contact, bracket, width, happened):
             break
         res = _trial(solver, contact, bracket, mid)
         trials += 1
+        where = (
+            f"dp = {display.pressure_change(mid * change)}"
+            if change is not None
+            else f"load factor {mid:.6g}"
+        )
+        logger.info(
+            "step %d/%d: bisection trial %d at %s: %s",
+            bracket.step,
+            bracket.steps,
+            trials,
+            where,
+            said[0] if happened(res) else said[1],
+        )
         if happened(res):
             hi, hi_res = mid, res
         else:
@@ -502,6 +523,8 @@ def _first_slip(solver, model, onset, fi, bracket, tolerance, centres, others):
         bracket,
         tolerance / abs(change),
         lambda r: _slipping(contact, r, fi).any(),
+        change,
+        (f"fracture {onset.fracture} slips", "stuck"),
     )
     onset.trials += trials
     onset.dp_lower, onset.dp_upper = lo * change, hi * change
@@ -512,11 +535,11 @@ def _first_slip(solver, model, onset, fi, bracket, tolerance, centres, others):
     j = first[np.argmax(util)] if first.size else 0
     onset.x, onset.y = (float(v) for v in centres[j])
     logger.info(
-        "fracture %d: first slip between dp = %.6g and %.6g Pa at (%.4g, %.4g) "
+        "fracture %d: first slip between dp = %s and %s at (%.4g, %.4g) "
         "(%d bisection solves)",
         onset.fracture,
-        onset.dp_lower,
-        onset.dp_upper,
+        display.pressure_change(onset.dp_lower),
+        display.pressure_change(onset.dp_upper),
         onset.x,
         onset.y,
         onset.trials,
@@ -730,19 +753,28 @@ def write_tables(report: DepletionReport, out_dir: Path) -> list:
     return [crit, table]
 
 
-def depletion_lines(table: DepletionTable) -> list[str]:
+def depletion_lines(table: DepletionTable, compression_positive=False) -> list[str]:
     """What ``deplete`` found, in words, from what result.h5 keeps
     (``/depletion``): per fracture its first slip, whether it sits at a
     singular point (then mesh-dependent), and the change at which the
     slipping patch reached the asked length."""
-    lines = [f"critical depletion (bisection to {table.tolerance:.4g} Pa):"]
+    cp = compression_positive
+    name = display.change_label(cp)
+
+    def change(dp: float) -> str:
+        return display.pressure_change(dp, cp)
+
+    lines = [
+        f"critical depletion (bisection to {display.pressure(table.tolerance)}; "
+        f"{name} {'> 0: a drop' if cp else '< 0: a depletion'}):"
+    ]
     for i, dp in enumerate(table.dp_critical):
         if not np.isfinite(dp):
             lines.append(f"  fracture {i}: does not slip")
             continue
         text = (
-            f"  fracture {i}: first slip at dp = {dp / 1e6:.4g} MPa at "
-            f"({table.x[i]:.4g}, {table.y[i]:.4g}) m"
+            f"  fracture {i}: first slip at {name} = {change(dp)} at "
+            f"({display.number(table.x[i], 4)}, {display.number(table.y[i], 4)}) m"
         )
         if table.at_singularity[i]:
             text += (
@@ -752,15 +784,15 @@ def depletion_lines(table: DepletionTable) -> list[str]:
         lines.append(text)
         if np.isfinite(table.dp_seismic[i]):
             lines.append(
-                f"    the slip turns seismic at dp = {table.dp_seismic[i] / 1e6:.4g} "
-                f"MPa (nucleation length {table.nucleation_length[i]:.4g} m)"
+                f"    the slip turns seismic at {name} = {change(table.dp_seismic[i])} "
+                f"(nucleation length {display.length(table.nucleation_length[i])})"
             )
         if np.isfinite(table.patch_length):
             reached = table.dp_patch[i]
             lines.append(
-                f"    slipping over {table.patch_length:g} m "
+                f"    slipping over {display.length(table.patch_length)} "
                 + (
-                    f"from dp = {reached / 1e6:.4g} MPa"
+                    f"from {name} = {change(reached)}"
                     if np.isfinite(reached)
                     else "not reached"
                 )
@@ -768,41 +800,68 @@ def depletion_lines(table: DepletionTable) -> list[str]:
     return lines
 
 
-def format_report(report: DepletionReport) -> str:
-    """The two tables as text, for the CLI."""
-    lines = [
-        "critical depletion (pore-pressure change at first slip; < 0 = depletion), "
-        f"bisection tolerance {report.tolerance:.4g} Pa:",
-        f"{'fracture':>8} {'dp_critical [Pa]':>17} {'bracket [Pa]':>27} "
-        f"{'first slip at (x, y) [m]':>26} {'dp_linear [Pa]':>15}",
-    ]
+def format_report(report: DepletionReport, compression_positive=False) -> str:
+    """The two tables as text, for the CLI, in MPa, m and mm
+    (:mod:`xfemslip.display`)."""
+    cp = compression_positive
+    name = display.change_label(cp)
+
+    def mpa(dp: float) -> str:
+        return display.number(display.megapascals(dp, cp))
+
+    rows, notes = [], []
     for o in report.onsets:
         if np.isnan(o.dp_upper):
-            lines.append(f"{o.fracture:>8} {'no slip':>17}")
+            rows.append([str(o.fracture), "no slip", "", "", ""])
             continue
-        lines.append(
-            f"{o.fracture:>8} {o.dp_critical:>17.6g} "
-            f"{f'[{o.dp_lower:.6g}, {o.dp_upper:.6g}]':>27} "
-            f"{f'({o.x:.4g}, {o.y:.4g})':>26} {o.dp_linear:>15.6g}"
+        lo, hi = sorted((mpa(o.dp_lower), mpa(o.dp_upper)), key=float)
+        rows.append(
+            [
+                str(o.fracture),
+                mpa(o.dp_critical),
+                f"[{lo}, {hi}]",
+                f"({display.number(o.x, 4)}, {display.number(o.y, 4)})",
+                mpa(o.dp_linear),
+            ]
         )
         if o.at_singularity:
-            lines.append(
-                f"{'':>8} first slip at {o.singularity}, where the stress is "
-                "singular: this depletion depends on the mesh"
+            notes.append(
+                f"fracture {o.fracture}: first slip at {o.singularity}, where the "
+                "stress is singular: this depletion depends on the mesh"
             )
         if np.isfinite(o.dp_seismic):
-            lines.append(
-                f"{'':>8} the slip turns seismic at dp = {o.dp_seismic:.6g} Pa: "
-                f"nucleation length {o.nucleation_length:.4g} m at "
-                f"({o.x_nucleation:.4g}, {o.y_nucleation:.4g})"
+            notes.append(
+                f"fracture {o.fracture}: the slip turns seismic at {name} = "
+                f"{display.pressure_change(o.dp_seismic, cp)}: nucleation length "
+                f"{display.length(o.nucleation_length)} at "
+                f"({display.number(o.x_nucleation, 4)}, "
+                f"{display.number(o.y_nucleation, 4)})"
             )
+    sense = "a drop > 0" if cp else "< 0 = depletion"
+    lines = [
+        display.convention(cp),
+        f"critical depletion (pore-pressure change at first slip; {sense}), "
+        f"bisection tolerance {display.pressure(report.tolerance)}:",
+        display.table(
+            [
+                "fracture",
+                f"{name}_critical [MPa]",
+                "bracket [MPa]",
+                "first slip at (x, y) [m]",
+                f"{name}_linear [MPa]",
+            ],
+            rows,
+        ),
+        *notes,
+    ]
     if report.patch_length is not None:
         lines.append(
-            f"slipping over {report.patch_length:g} m (converges with the mesh): "
+            f"slipping over {display.length(report.patch_length)} (converges with "
+            "the mesh): "
             + ", ".join(
                 f"fracture {o.fracture} "
                 + (
-                    f"at dp = {o.dp_patch:.6g} Pa"
+                    f"at {name} = {display.pressure_change(o.dp_patch, cp)}"
                     if np.isfinite(o.dp_patch)
                     else "not reached"
                 )
@@ -810,17 +869,24 @@ def format_report(report: DepletionReport) -> str:
             )
         )
     lines.append(
-        "slip vs depletion (max |slip| that slid [m] / slipping length [m] per "
+        "slip vs depletion (max |slip| that slid [mm] / slipping length [m] per "
         "fracture):"
     )
     n = len(report.onsets)
     lines.append(
-        f"{'step':>5} {'dp [Pa]':>12} "
-        + " ".join(f"{f'frac {i}':>23}" for i in range(n))
-    )
-    for step, _lam, dp, per, _means in report.rows:
-        lines.append(
-            f"{step:>5} {dp:>12.5g} "
-            + " ".join(f"{s:>11.4g} / {length:>9.4g}" for s, length in per)
+        display.table(
+            ["step", f"{name} [MPa]", *(f"frac {i}" for i in range(n))],
+            [
+                [
+                    str(step),
+                    display.number(display.megapascals(dp, cp), 5),
+                    *(
+                        f"{display.number(s * 1e3, 4)} / {display.number(length, 4)}"
+                        for s, length in per
+                    ),
+                ]
+                for step, _lam, dp, per, _means in report.rows
+            ],
         )
+    )
     return "\n".join(lines)

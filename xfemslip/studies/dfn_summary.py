@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from xfemslip import display
 from xfemslip.io.csv import write_csv
 
 DFN_SUMMARY = "dfn_summary.csv"
@@ -67,9 +68,5 @@ def write_dfn_summary(path, rows) -> list[dict]:
 
 def format_aggregate(table: list[dict]) -> str:
     """The aggregate as an aligned text table."""
-    cells = [list(COLUMNS)] + [[_text(row[c]) for c in COLUMNS] for row in table]
-    widths = [max(len(r[i]) for r in cells) for i in range(len(COLUMNS))]
-    return "\n".join(
-        "  ".join(c.ljust(w) for c, w in zip(r, widths, strict=True)).rstrip()
-        for r in cells
-    )
+    rows = [[_text(row[c]) for c in COLUMNS] for row in table]
+    return display.table(COLUMNS, rows, left=range(len(COLUMNS)))

@@ -40,6 +40,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from xml.etree import ElementTree
 
+from xfemslip import display
 from xfemslip.errors import OutputError, ResultError, UsageError, XfemslipError
 from xfemslip.io.csv import write_rows
 from xfemslip.io.fileset import replace_files
@@ -461,9 +462,4 @@ def format_table(keys, rows: list[CaseRow]) -> str:
     header, body = summary_table(keys, rows, per_fracture=False)
     header = header[1:-1]  # the case id is long; the parameters say it all
     body = [[*cells[1:-1], cells[-1]] for cells in body]
-    widths = [max(len(r[i]) for r in [header, *body]) for i in range(len(header))]
-    lines = ["  ".join(h.ljust(w) for h, w in zip(header, widths, strict=True))]
-    for cells in body:
-        text = "  ".join(c.ljust(w) for c, w in zip(cells[:-1], widths, strict=True))
-        lines.append(f"{text}  {cells[-1]}".rstrip())
-    return "\n".join(lines)
+    return display.table(header, body, left=range(len(header)))

@@ -15,6 +15,7 @@ from pathlib import Path
 
 import numpy as np
 
+from xfemslip import display
 from xfemslip.io.csv import write_rows
 from xfemslip.io.fileset import replace_files
 
@@ -218,13 +219,17 @@ def format_summary(result) -> str:
     )
     for j, fi in enumerate(result.fractures):
         lines.append(f"  fracture {fi}:")
-        lines.append(f"    {'dp [MPa]':>9} {'P':>7} {'interval':>17} {'needs':>7}")
-        lines.extend(
-            f"    {spec.levels[k] / 1e6:>9.3g} {result.probability[j, k]:>7.3f} "
-            f"[{result.ci_low[j, k]:.3f}, {result.ci_high[j, k]:.3f}] "
-            f"{result.samples_needed[j, k]:>7d}"
+        rows = [
+            [
+                f"{spec.levels[k] / 1e6:.3g}",
+                f"{result.probability[j, k]:.3f}",
+                f"[{result.ci_low[j, k]:.3f}, {result.ci_high[j, k]:.3f}]",
+                str(result.samples_needed[j, k]),
+            ]
             for k in shown
-        )
+        ]
+        table = display.table(["dp [MPa]", "P", "interval", "needs"], rows)
+        lines.extend(f"    {line}" for line in table.splitlines())
         if len(spec.keys):
             lines.append(_sensitivity_line(spec.keys, result.sensitivity[j]))
         if result.max_slip is not None:

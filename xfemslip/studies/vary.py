@@ -12,6 +12,7 @@ from __future__ import annotations
 import math
 import re
 
+from xfemslip.case.quantities import key_value
 from xfemslip.case.tables import Table, show
 
 RANGE_KEYS = ("start", "stop", "step", "num")
@@ -205,6 +206,35 @@ def expand_range(spec: dict, key: str, problems: list) -> list | None:
     ]
 
 
+def _in_si(spec: dict, key: str, where: str, problems: list) -> dict | None:
+    """A range's start, stop and step written with units ("-40 MPa") in the
+    unit of the case key they vary; None after recording a unit the key
+    refuses."""
+    out = dict(spec)
+    for name in ("start", "stop", "step"):
+        if name in out:
+            value, why = key_value(key, out[name])
+            if why is not None:
+                problems.append((f"{where}.{name}", why))
+                return None
+            out[name] = value
+    return out
+
+
+def _values_in_si(values: list, key: str, where: str, problems: list) -> list | None:
+    """The listed values, those written with units ("5 GPa") in the unit of
+    the case key (so the parameters, case names and summary.csv hold SI
+    numbers); None after recording a unit the key refuses."""
+    out = []
+    for i, item in enumerate(values):
+        value, why = key_value(key, item)
+        if why is not None:
+            problems.append((f"{where}[{i}]", why))
+            return None
+        out.append(value)
+    return out
+
+
 def read_vary(root: Table, combine: str | None) -> list[tuple[str, list]]:
     """[vary] -> [(key path, values)], checked: paths, lists, ranges, overlaps."""
     table = root.table("vary", None, required=True)
@@ -226,9 +256,10 @@ def read_vary(root: Table, combine: str | None) -> list[tuple[str, list]]:
             )
             continue
         if isinstance(spec, dict):
-            values = expand_range(spec, where, root.problems)
+            si = _in_si(spec, key, where, root.problems)
+            values = None if si is None else expand_range(si, where, root.problems)
         elif isinstance(spec, list) and spec:
-            values = spec
+            values = _values_in_si(spec, key, where, root.problems)
         else:
             root.problems.append(
                 (

@@ -11,6 +11,7 @@ from pathlib import Path
 
 import numpy as np
 
+from xfemslip import display
 from xfemslip.io.csv import write_rows
 from xfemslip.io.fileset import replace_files
 from xfemslip.verify.problems import (
@@ -30,20 +31,37 @@ def _pct(x: float) -> str:
 
 def format_table(report: Report) -> str:
     """The table printed by ``xfemslip verify``."""
-    head = (
-        f"{'problem':<16} {'mesh':>6} {'dofs':>7} {'slip L2 %':>9} "
-        f"{'K_II err %':>10} {'|K_I|/K %':>9} {'osc t_N %':>9} {'order':>6} "
-        f"{'Newton':>6} {'wall s':>7}  note"
-    )
-    lines = [head, "-" * len(head)]
-    for r in report.rows:
-        order = "-" if not math.isfinite(r.order) else f"{r.order:.2f}"
-        lines.append(
-            f"{r.problem:<16} {'a/' + str(r.a_over_h):>6} {r.dofs:>7} "
-            f"{_pct(r.slip_error):>9} {_pct(r.kii_error):>10} "
-            f"{_pct(r.ki_ratio):>9} {_pct(r.oscillation):>9} {order:>6} "
-            f"{r.newton:>6} {r.wall_s:>7.2f}  {r.note}"
-        )
+    head = [
+        "problem",
+        "mesh",
+        "dofs",
+        "slip L2 %",
+        "K_II err %",
+        "|K_I|/K %",
+        "osc t_N %",
+        "order",
+        "Newton",
+        "wall s",
+        "note",
+    ]
+    rows = [
+        [
+            r.problem,
+            f"a/{r.a_over_h}",
+            str(r.dofs),
+            _pct(r.slip_error),
+            _pct(r.kii_error),
+            _pct(r.ki_ratio),
+            _pct(r.oscillation),
+            "-" if not math.isfinite(r.order) else f"{r.order:.2f}",
+            str(r.newton),
+            f"{r.wall_s:.2f}",
+            r.note,
+        ]
+        for r in report.rows
+    ]
+    table = display.table(head, rows, left=(0, 10)).splitlines()
+    lines = [table[0], "-" * len(table[0]), *table[1:]]
     if report.window:
         (lo, hi), _ = window_edges()
         bad = [w for w in report.window if w.misclassified]

@@ -297,18 +297,19 @@ def test_describe_summarises_the_resolved_case(tmp_path):
         "[1, 3] x [-1, 0] m",
         "4 x 2 Q4 elements",
         "uniform",
-        "E = 1e+09 Pa",
+        "signs: tension positive",
+        "E = 1 GPa",
         "nu = 0.25",
         "plane_strain",
         "[0] points [m]",
         "(1.5, -0.5) -> (2.5, -0.5)",
         "length 1 m",
         "angle 0 deg",
-        "kn = 1e+12 Pa/m",
+        "kn = 1000 GPa/m",
         "friction = 0.6",
-        "(-1e+06, -2e+06, 0) Pa",
+        "(xx, yy, xy) = (-1, -2, 0) MPa",
         "1 step",
-        "uy = 0 m",
+        "uy = 0 mm",
         "ux free",
         "[table]",
         "top: traction = loading.stress . n",
@@ -319,6 +320,10 @@ def test_describe_summarises_the_resolved_case(tmp_path):
         "output: out/desc (h5, vtu, csv)",
     ):
         assert part in text, part
+    # compression positive: the stresses turn sign, nothing else does
+    other = describe(load_case(tmp_path / "desc.toml"), compression_positive=True)
+    assert "signs: compression positive" in other
+    assert "(xx, yy, xy) = (1, 2, 0) MPa" in other and "E = 1 GPa" in other
 
 
 # --------------------------------------------------------------------------- #

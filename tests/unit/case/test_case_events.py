@@ -46,7 +46,7 @@ def test_an_empty_events_table_leaves_the_extent_to_the_slipping_length(tmp_path
         ({"extent": -5.0}, "events.extent"),
         ({"extent": 1e300}, "events.extent: must satisfy 0.001 <= extent <= 1e+07"),
         ({"extent": 5e-324}, "events.extent: must satisfy 0.001 <= extent <= 1e+07"),
-        ({"extent": "100 m"}, "events.extent"),
+        ({"extent": "100 MPa"}, "events.extent"),
         ({"extent": 100.0, "width": 3.0}, "events.width"),
     ],
 )

@@ -172,6 +172,6 @@ def test_check_prints_the_law(tmp_path):
     spec = load_case(_write(tmp_path, {"friction": LAW, "cohesion": cohesion}))
     text = describe(spec)
     assert (
-        "friction = slip weakening 0.6 -> 0.45 over 0.005 m of slip, "
-        "cohesion = 2e+06 -> 0 Pa over 0.005 m of slip" in text
+        "friction = slip weakening 0.6 -> 0.45 over 5 mm of slip, "
+        "cohesion = 2 -> 0 MPa over 5 mm of slip" in text
     )

@@ -164,8 +164,8 @@ def test_check_prints_the_new_tables(runner, tmp_path):
     case.write_text(_case(FRACTURE, PORE))
     result = runner.invoke(cli, ["check", str(case)])
     assert result.exit_code == 0, result.output
-    assert "pore pressure: initial 3e+07 Pa, change -2e+07 Pa" in result.output
-    assert "reservoir: E = 8e+09 Pa, nu = 0.2 in box(es) [0, 20, 100, 40] m" in (
+    assert "pore pressure: initial 30 MPa, change -20 MPa" in result.output
+    assert "reservoir: E = 8 GPa, nu = 0.2 in box(es) [0, 20, 100, 40] m" in (
         result.output
     )
 
@@ -256,7 +256,7 @@ def test_plots_and_screen_use_the_effective_stress(runner, tmp_path):
     default = runner.invoke(cli, ["screen", str(case)])
     given = runner.invoke(cli, ["screen", str(case), "-p", "30.0e6"])
     assert default.exit_code == 0, default.output
-    assert "pore pressure p = 3e+07" in default.output
+    assert "pore pressure p = 30 MPa" in default.output
     assert default.output == given.output
 
 

@@ -161,10 +161,32 @@ def test_cli_screen_options(runner):
     assert result.exit_code == 0, result.stderr
     assert "slip band: no orientation slips" in result.stdout
     assert "angle 45: theta = 45.00 deg" in result.stdout
-    assert "margin = 2e+06 -> stable; slips at a pore-pressure change dp = " in (
+    assert "margin = 2 MPa -> stable; slips at a pore-pressure change dp = " in (
         result.stdout
     )
-    assert "slips at a pore-pressure change dp = 3.33333e+06 Pa" in result.stdout
+    assert "slips at a pore-pressure change dp = 3.33333 MPa" in result.stdout
+    assert result.stdout.startswith("signs: tension positive")
+    assert "total stress xx = -20 MPa, yy = -40 MPa" in result.stdout
+
+
+def test_cli_screen_compression_positive(runner):
+    """The same screen compression positive: stresses and tractions turn
+    sign, pressures and margins do not; the table turns with them."""
+    args = ["screen", "--stress", "-20e6", "-40e6", "0", "-p", "10e6"]
+    args += ["--friction", "0.6", "--angle", "45", "--step", "45"]
+    tension = runner.invoke(cli, args).stdout
+    compression = runner.invoke(cli, [*args, "--compression-positive"]).stdout
+    assert compression.startswith("signs: compression positive")
+    assert "total stress xx = 20 MPa, yy = 40 MPa, xy = 0 MPa" in compression
+    assert "pore pressure p = 10 MPa" in compression
+    # at 45 deg: sigma_n' = -30 + 10 = -20 MPa, tau = -10 MPa (by hand)
+    assert "sigma_n' = -20 MPa, tau = -10 MPa" in tension
+    assert "sigma_n' = 20 MPa, tau = 10 MPa" in compression
+    row_t = [ln.split() for ln in tension.splitlines() if ln.split()[:1] == ["45.00"]]
+    row_c = [
+        ln.split() for ln in compression.splitlines() if ln.split()[:1] == ["45.00"]
+    ]
+    assert row_t[0][2:4] == ["-20", "-10"] and row_c[0][2:4] == ["20", "10"]
 
 
 def test_cli_screen_needs_a_stress_and_a_friction(runner):
@@ -190,7 +212,9 @@ def test_cli_screen_states_its_stress_path(runner):
 
 def _dp_line(text: str, label: str) -> float:
     (line,) = [ln for ln in text.splitlines() if ln.startswith(label + ":")]
-    return float(line.rsplit("dp = ", 1)[1].split()[0])
+    value, unit = line.rsplit("dp = ", 1)[1].split()[:2]
+    assert unit == "MPa"
+    return float(value) * 1e6
 
 
 def test_cli_screen_follows_the_depleting_reservoir_path(runner):
@@ -209,7 +233,7 @@ def test_cli_screen_follows_the_depleting_reservoir_path(runner):
     assert "WARNING" not in result.stderr
     assert "stress path: uniaxial strain of a laterally confined layer" in text
     assert "200 m < y < 300 m" in text and "depletion (dp < 0)" in text
-    assert "pore pressure p = 3e+07" in text
+    assert "pore pressure p = 30 MPa" in text
     k = (1 - 2 * 0.2) / (1 - 0.2)
     s, c = math.sin(math.radians(60)), math.cos(math.radians(60))
     a0, a1 = -44e6 * s * s - 62e6 * c * c + 30e6, 1.0 - k * s * s

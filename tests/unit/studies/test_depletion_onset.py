@@ -51,6 +51,30 @@ def test_first_slip_at_a_reservoir_corner_is_said(fault_run):
     assert "slipping over 60 m from dp =" in text
 
 
+def test_report_in_megapascals_either_sign_convention(fault_run):
+    """The deplete table prints dp_critical in MPa (the report's own value /
+    1e6 to 6 digits); compression positive prints the depletion, a drop > 0,
+    and summary says which convention it uses."""
+    from xfemslip.studies.depletion import format_report
+
+    _, report, out = fault_run
+    (onset,) = report.onsets
+    tension = format_report(report).splitlines()
+    compression = format_report(report, compression_positive=True).splitlines()
+    assert tension[0].startswith("signs: tension positive")
+    assert compression[0].startswith("signs: compression positive")
+    row_t = next(ln.split() for ln in tension if ln.split()[:1] == ["0"])
+    row_c = next(ln.split() for ln in compression if ln.split()[:1] == ["0"])
+    assert float(row_t[1]) == pytest.approx(onset.dp_critical / 1e6, rel=1e-5)
+    assert onset.dp_critical < 0 and float(row_c[1]) == -float(row_t[1])
+    assert "dp_critical [MPa]" in tension[2] and "depletion_critical" in compression[2]
+    text = CliRunner().invoke(cli, ["summary", str(out), "--compression-positive"])
+    assert "signs: compression positive" in text.output
+    assert f"first slip at depletion = {-onset.dp_critical / 1e6:.6g} MPa" in (
+        text.output
+    )
+
+
 def test_patch_length_change_brackets_the_growth(fault_run):
     """Solved in one step to just below and just above dp_patch: the
     slipping length is below 60 m, then at least 60 m."""

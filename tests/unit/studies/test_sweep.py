@@ -170,6 +170,26 @@ def test_product_and_zip(tmp_path, base):
     assert product.directory == Path("out/sweeps/p")
 
 
+def test_values_and_ranges_with_units(tmp_path, base):
+    """Values and range ends written with units vary the key in its SI unit:
+    the same specs as the numbers; a unit the key refuses names the range end."""
+    body = 'base = "base.toml"\n[vary]\n"material.E" = ["5 GPa", "20 GPa"]\n'
+    body += '"fractures[0].angle" = { start = "30 deg", stop = "60 deg", num = 2 }\n'
+    sweep = loads_sweep(body, tmp_path / "u.toml")
+    assert [c.params for c in sweep.cases] == [
+        (("material.E", 5e9), ("fractures[0].angle", 30.0)),
+        (("material.E", 5e9), ("fractures[0].angle", 60.0)),
+        (("material.E", 20e9), ("fractures[0].angle", 30.0)),
+        (("material.E", 20e9), ("fractures[0].angle", 60.0)),
+    ]
+    assert sweep.cases[-1].spec.material.E == 20e9
+    assert sweep.cases[0].case_id == "000_E=5e9_angle=30"
+    bad = body.replace('stop = "60 deg"', 'stop = "60 MPa"')
+    with pytest.raises(CaseError) as err:
+        loads_sweep(bad, tmp_path / "bad.toml")
+    assert 'vary."fractures[0].angle".stop: expected an angle' in str(err.value)
+
+
 def test_unquoted_dotted_keys_and_inline_base(tmp_path):
     inline = build.case_text({"base": build.with_keys(CASE, name=None)})
     body = "[vary]\nmaterial.E = { start = 1e9, stop = 3e9, num = 3 }\n" + inline
