@@ -29,8 +29,9 @@ inside PARDISO's factorization).  For one run the kept SuperLU factorization
 of ``linear`` is the better choice (the m back-solves cost more than the
 few refactorizations of one run on the meshes SuperLU is chosen for);
 across runs, S0 is formed once for all of them.  It is used only inside
-:func:`sharing` (``xfemslip.studies`` enters it in every worker) and kept
-per process for at most MAX_KEPT bulk matrices, recognised by their content
+:func:`sharing` (``xfemslip.studies`` enters it in every worker), formed
+when a bulk matrix comes back for a second run and kept per process for at
+most MAX_KEPT bulk matrices, recognised by their content
 (:func:`matrix_key`).
 """
 
@@ -63,6 +64,8 @@ MAX_KEPT = 2
 _state = {"depth": 0}
 _kept: OrderedDict = OrderedDict()
 _values: OrderedDict = OrderedDict()  # kept_value's
+_seen: OrderedDict = OrderedDict()  # keys of the bulk matrices met once
+MAX_SEEN = 64
 
 
 @contextlib.contextmanager
@@ -85,6 +88,7 @@ def forget() -> None:
     """Drop the kept factors and values (tests; memory)."""
     _kept.clear()
     _values.clear()
+    _seen.clear()
 
 
 def kept_value(key: tuple, make):
@@ -159,8 +163,9 @@ class SchurLU:
 
 
 def kept_schur(K: sp.csr_matrix, c: np.ndarray, lu_settings: dict, stats: dict):
-    """The SchurLU of (K, c), kept from an earlier run or made (and kept);
-    None when it would be too large (MAX_CONTACT_DOFS, MAX_WORK)."""
+    """The SchurLU of (K, c), kept from an earlier run or made (and kept)
+    when (K, c) comes for the second time; None the first time, and when
+    it would be too large (MAX_CONTACT_DOFS, MAX_WORK)."""
     m = c.size
     if not 0 < m <= MAX_CONTACT_DOFS or K.shape[0] * m > MAX_WORK:
         return None
@@ -170,6 +175,14 @@ def kept_schur(K: sp.csr_matrix, c: np.ndarray, lu_settings: dict, stats: dict):
         _kept.move_to_end(key)
         stats["shared_reuses"] = stats.get("shared_reuses", 0) + 1
         return found
+    if key not in _seen:
+        # the first run of a matrix takes the run's own solver: forming S0
+        # pays only for a matrix that comes back (a sweep over geometries
+        # never sees one twice)
+        _seen[key] = None
+        while len(_seen) > MAX_SEEN:
+            _seen.popitem(last=False)
+        return None
     t = time.perf_counter()
     made = SchurLU(K, c, lu_settings)
     stats["factorizations"] += 1

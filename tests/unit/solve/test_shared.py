@@ -45,12 +45,19 @@ def test_shared_solves_match_a_direct_solve_and_are_kept():
     reference = spsolve((K + dense_contact(n, dofs, blocks)).tocsc(), r)
     shared.forget()
     with shared.sharing():
+        # the first run of a matrix: its own SuperLU path, nothing formed
+        alone = LinearSolver(K, "superlu", contact_dofs=dofs)
+        np.testing.assert_allclose(
+            alone.solve_contact(blocks, r), reference, rtol=1e-10, atol=1e-12
+        )
+        assert alone.stats["schur_factorizations"] == 0
+        # it comes back: K_ii and S0 formed once, kept
         first = LinearSolver(K, "superlu", contact_dofs=dofs)
         x = first.solve_contact(blocks, r)
         np.testing.assert_allclose(x, reference, rtol=1e-10, atol=1e-12)
         assert first.stats["factorizations"] == 1  # K_ii and S0, once
         assert first.stats["schur_factorizations"] == 1
-        # a second run of the same matrix (another object, same values)
+        # a third run of the same matrix (another object, same values)
         second = LinearSolver(K.copy(), "superlu", contact_dofs=dofs)
         blocks2 = blocks * 0.5
         x2 = second.solve_contact(blocks2, r)
@@ -60,7 +67,9 @@ def test_shared_solves_match_a_direct_solve_and_are_kept():
     np.testing.assert_allclose(x2, reference2, rtol=1e-10, atol=1e-12)
     # without contact blocks: K x = r
     with shared.sharing():
-        x0 = LinearSolver(K, "superlu", contact_dofs=dofs).solve_contact(None, r)
+        zero = LinearSolver(K, "superlu", contact_dofs=dofs)
+        x0 = zero.solve_contact(None, r)
+    assert zero.stats["shared_reuses"] == 1
     np.testing.assert_allclose(x0, spsolve(K.tocsc(), r), rtol=1e-10, atol=1e-12)
 
 
@@ -85,9 +94,11 @@ def test_a_changed_matrix_is_not_taken_for_the_kept_one():
     K2.data = K2.data * 1.5  # another rock: the same pattern, other values
     shared.forget()
     with shared.sharing():
-        LinearSolver(K, "superlu", contact_dofs=dofs).solve_contact(blocks, r)
+        for _ in range(2):  # K formed and kept
+            LinearSolver(K, "superlu", contact_dofs=dofs).solve_contact(blocks, r)
         other = LinearSolver(K2, "superlu", contact_dofs=dofs)
         x = other.solve_contact(blocks, r)
     assert other.stats["shared_reuses"] == 0
+    assert other.stats["schur_factorizations"] == 0  # met once: its own path
     expected = spsolve((K2 + dense_contact(n, dofs, blocks)).tocsc(), r)
     np.testing.assert_allclose(x, expected, rtol=1e-10, atol=1e-12)
