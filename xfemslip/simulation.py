@@ -133,7 +133,7 @@ class _Geometry:
     fractures: tuple[Fracture, ...]
     cand: Candidates
     ec: dict  # backend -> EnrichedCells
-    bulk: dict  # (backend, E, nu, model) -> BulkSystem
+    bulk: dict  # (backends, E, nu, model, interface points) -> BulkSystem
     bbar: dict  # the Biot load's average strain operators (fem.poro.body_load)
 
 
@@ -152,7 +152,7 @@ def _shared_geometry(spec: CaseSpec) -> tuple[_Geometry, tuple[Fracture, ...]]:
     geo = (
         kept_value(("geometry", geometry_key(spec)), make)
         if cells <= MAX_SHARED_CELLS
-        else make()  # kept, a large model would double the next one's memory
+        else make()  # not kept: a large model would double the next one's memory
     )
     check_memory(spec)
     own = tuple(
