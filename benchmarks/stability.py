@@ -1,9 +1,9 @@
 """The numerical stress matrix: every case, both tangents.
 
 Writes a table (case, converged, Newton iterations, stick/slip switches,
-load-step cuts / ping-pong freezes, max |slip|, result vs reference) into its
-section of docs/performance.md (between the stability markers, replaced
-in place) and prints it; --no-write only prints.  The case builders and
+load-step cuts / ping-pong freezes, max |slip|, result vs reference) to
+docs/performance/stability.md (which docs/performance.md names) and prints
+it; --no-write only prints.  The case builders and
 references are tests/support/matrix.py.
 
 Usage (from the project root):  python benchmarks/stability.py [--quick]
@@ -299,15 +299,9 @@ def main() -> int:
     )
     print(text)
     if not args.no_write:
-        path = ROOT / "docs" / "performance.md"
-        doc = path.read_text()
-        if BEGIN in doc:
-            doc = doc[: doc.index(BEGIN)] + text + doc[doc.index(END) + len(END) :]
-        else:
-            doc = (
-                doc.rstrip("\n") + "\n\n## Numerical stability matrix\n\n" + text + "\n"
-            )
-        path.write_text(doc)
+        path = ROOT / "docs" / "performance" / "stability.md"
+        path.parent.mkdir(parents=True, exist_ok=True)
+        path.write_text(text + "\n")
     return 0
 
 

@@ -9,6 +9,7 @@ set, swapped into the output folder whole (:mod:`xfemslip.io.folder`).
 from __future__ import annotations
 
 import contextlib
+import dataclasses
 import logging
 import time
 from dataclasses import dataclass
@@ -25,7 +26,12 @@ from xfemslip.conventions import OPEN, SLIP, STATE_CODES, STICK
 from xfemslip.errors import ConvergenceError, GeometryError, UsageError
 from xfemslip.fem.assembly import BulkSystem, assemble_bulk
 from xfemslip.fem.boundary import dirichlet, hold_enriched, traction_load
-from xfemslip.fem.enrichment import EnrichedCells, build_enriched_cells, find_candidates
+from xfemslip.fem.enrichment import (
+    Candidates,
+    EnrichedCells,
+    build_enriched_cells,
+    find_candidates,
+)
 from xfemslip.fem.material import elasticity_matrix
 from xfemslip.fem.mesh import Mesh, build_mesh
 from xfemslip.fem.poro import (
@@ -54,6 +60,7 @@ from xfemslip.post.fields import (
 from xfemslip.post.hydraulics import add_permeability
 from xfemslip.post.result import Result, run_id
 from xfemslip.solve.newton import NewtonSolver, Problem
+from xfemslip.solve.shared import digest
 
 logger = logging.getLogger(__name__)
 
@@ -97,6 +104,72 @@ def _geometry(spec: CaseSpec) -> tuple[Mesh, tuple[Fracture, ...]]:
         return mesh, build_fractures(mesh, spec.fractures, mesh.box)
 
 
+def geometry_key(spec: CaseSpec) -> tuple:
+    """What the mesh, the fractures' geometry and their enrichment are made
+    of: the mesh lines, and per fracture its polyline and tip treatment
+    (not its friction, cohesion or stiffness, which the model takes from
+    the case: :func:`_shared_geometry`)."""
+    return (
+        spec.mesh.x.tobytes(),
+        spec.mesh.y.tobytes(),
+        tuple(
+            (f.index, np.asarray(f.points, float).tobytes(), f.tip, f.tip_radius)
+            for f in spec.fractures
+        ),
+    )
+
+
+# Models of up to this many cells keep their geometry and bulk stiffness
+# for the next case (xfemslip.solve.shared.sharing): the kept pieces of a
+# 450 x 450 mesh are a few hundred MB.
+MAX_SHARED_CELLS = 200_000
+
+
+@dataclass
+class _Geometry:
+    """The pieces of a model that depend on its geometry only, kept between
+    the samples of a study (xfemslip.solve.shared.kept_value)."""
+
+    mesh: Mesh
+    fractures: tuple[Fracture, ...]
+    cand: Candidates
+    ec: dict  # backend -> EnrichedCells
+    bulk: dict  # (backends, E, nu, model, interface points) -> BulkSystem
+    bbar: dict  # the Biot load's average strain operators (fem.poro.body_load)
+
+
+def _shared_geometry(spec: CaseSpec) -> tuple[_Geometry, tuple[Fracture, ...]]:
+    """The geometry of a case, kept between runs of the same geometry
+    within xfemslip.solve.shared.sharing (made anew outside it), and its
+    fractures with this case's friction, cohesion, stiffnesses and
+    weakening."""
+    from xfemslip.solve.shared import kept_value
+
+    def make() -> _Geometry:
+        mesh, fractures = _geometry(spec)
+        return _Geometry(mesh, fractures, find_candidates(mesh, fractures), {}, {}, {})
+
+    cells = (spec.mesh.x.size - 1) * (spec.mesh.y.size - 1)
+    geo = (
+        kept_value(("geometry", geometry_key(spec)), make)
+        if cells <= MAX_SHARED_CELLS
+        else make()  # not kept: a large model would double the next one's memory
+    )
+    check_memory(spec)
+    own = tuple(
+        dataclasses.replace(
+            fr,
+            friction=fs.friction,
+            cohesion=fs.cohesion,
+            kn=fs.kn,
+            kt=fs.kt,
+            weakening=fs.weakening,
+        )
+        for fr, fs in zip(geo.fractures, spec.fractures, strict=True)
+    )
+    return geo, own
+
+
 def _contact_in_situ(spec, zones, ip, eps):
     """The in-situ stress the fractures start with: ``initial_stress`` (xx,
     yy, xy) when uniform (or None), else (n_ip, 3) [Pa] at every interface
@@ -113,7 +186,11 @@ def _contact_in_situ(spec, zones, ip, eps):
 def check_geometry(spec: CaseSpec) -> None:
     """What ``xfemslip check`` adds to key validation: fractures against the
     mesh and the prescribed values at boundary corners (GeometryError)."""
-    mesh, _ = _geometry(spec)
+    from xfemslip.solve.shared import active
+
+    # within shared.sharing (a study), the geometry checked is kept for the
+    # runs of the samples
+    mesh = _shared_geometry(spec)[0].mesh if active() else _geometry(spec)[0]
     with _naming_the_file(spec):
         dirichlet(mesh, spec.boundary)
 
@@ -127,26 +204,34 @@ def kernel_work(ec) -> float:
 
 
 def build_model(spec: CaseSpec) -> Model:
-    """Build the discrete problem of a validated case."""
-    mesh, fractures = _geometry(spec)
+    """Build the discrete problem of a validated case (within
+    xfemslip.solve.shared.sharing, the mesh, enrichment and bulk stiffness
+    of an earlier case with the same geometry and rock are reused)."""
+    geo, fractures = _shared_geometry(spec)
+    mesh, cand = geo.mesh, geo.cand
     mat = spec.material
     D = elasticity_matrix(mat.E, mat.nu, mat.model)
-    cand = find_candidates(mesh, fractures)
     estimate = enriched_footprint(spec, mesh, fractures, cand)
     check_memory(spec, estimate)
     # the sub-cells are cut by the backend the estimate expects the model
     # to take (kernels.choose on the estimated kernel work)
-    ec = build_enriched_cells(
-        mesh, fractures, cand, "numba" if estimate.numba else "numpy"
-    )
+    cut = "numba" if estimate.numba else "numpy"
+    if cut not in geo.ec:
+        geo.ec[cut] = build_enriched_cells(mesh, fractures, cand, cut)
+    ec = geo.ec[cut]
     kernel_backend = kernels.choose(spec.solver.kernels, kernel_work(ec))
     zones = build_zones(spec)
     eps = FACE_OFFSET * mesh.h_min
     breaks = loading_breaks(zones, fractures, mesh.box, eps)
     ip = interface_points(fractures, mesh.h_min, breaks)
     materials = build_materials(spec, mesh, ec, fractures)
+    rock = (cut, kernel_backend, mat.E, mat.nu, mat.model, digest(ip.cell, ip.ramp))
     if not spec.units:
-        bulk = assemble_bulk(mesh, D, cand, ec, ip, backend=kernel_backend)
+        if rock not in geo.bulk:
+            geo.bulk[rock] = assemble_bulk(
+                mesh, D, cand, ec, ip, backend=kernel_backend
+            )
+        bulk = geo.bulk[rock]
     else:
         bulk = assemble_bulk(
             mesh,
@@ -183,14 +268,14 @@ def build_model(spec: CaseSpec) -> Model:
         if not pore.later:
             F = (
                 F
-                + body_load(mesh, bulk, pore, ec, kernel_backend)
+                + body_load(mesh, bulk, pore, ec, kernel_backend, geo.bbar)
                 + fracture_load(contact, ip, pore)
             )
         else:  # several fields from a file: reached in turn (PorePressure.weights)
             pieces = (
                 pore.weights,
                 [
-                    body_load(mesh, bulk, p, ec, kernel_backend)
+                    body_load(mesh, bulk, p, ec, kernel_backend, geo.bbar)
                     + fracture_load(contact, ip, p)
                     for p in (pore, *pore.later)
                 ],

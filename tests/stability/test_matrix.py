@@ -1,5 +1,5 @@
 """The numerical stress matrix, fast subset (the whole matrix is
-``benchmarks/stability.py``; its table is in ``docs/performance.md``).
+``benchmarks/stability.py``; its table is in ``docs/performance/stability.md``).
 
 Every case converges and matches its independent reference, or fails with a
 ConvergenceError that says why and what to change.  Never NaN or inf.

@@ -1,7 +1,7 @@
 """The numerical stress matrix: case builders, one runner, references.
 
 Shared by the tests in this folder (a fast subset) and ``benchmarks/stability.py``
-(the whole matrix, written to ``docs/performance.md``).  Every case either
+(the whole matrix, written to ``docs/performance/stability.md``).  Every case either
 converges or fails with a ``ConvergenceError`` whose message says why and what
 to change; ``run`` records which, with the Newton iterations, the stick/slip
 switches, the load-step cuts and ping-pong freezes, and max |slip|.

@@ -488,7 +488,9 @@ def _fluid(spec, zones, ip, eps, ratio, uniform, fractures, values=None):
     return start, (end - start) / scale
 
 
-def body_load(mesh, bulk, pore: PorePressure, ec, backend: str) -> np.ndarray:
+def body_load(
+    mesh, bulk, pore: PorePressure, ec, backend: str, kept: dict | None = None
+) -> np.ndarray:
     """F_body of eq. (1) at load factor 1, (n_dofs,) [N/m].
 
     Intact rectangle: int dN_a/dx dOmega = x_a hy / 2, int dN_a/dy = y_a hx / 2
@@ -496,7 +498,10 @@ def body_load(mesh, bulk, pore: PorePressure, ec, backend: str) -> np.ndarray:
     ``bulk.enriched_cells``): sum_q w_q B_q^T m alpha dp(x_q), by groups of
     QPs with one (alpha, dp): alpha dp A_g Bbar_g^T m, Bbar_g the average
     strain operator over the group's part of the cell (its area A_g),
-    computed by the model's kernel ``backend``.
+    computed by the model's kernel ``backend``.  ``kept``: a dict in which
+    those operators are kept for the next call on the same mesh and enriched
+    cells (the samples of a study, xfemslip.simulation), keyed by the QP
+    weights of their group.
     """
     F = np.zeros(bulk.dofmap.n_dofs)
     std = bulk.std_cells
@@ -515,7 +520,7 @@ def body_load(mesh, bulk, pore: PorePressure, ec, backend: str) -> np.ndarray:
     np.add.at(F, 2 * nodes + 1, fy)
     if ec.cells.size:
         for w, factor in _load_groups(ec, pore):
-            _add_enriched_load(F, mesh, bulk, ec, w, factor, pore.scale, backend)
+            _add_enriched_load(F, mesh, bulk, ec, w, factor, pore.scale, backend, kept)
     return F
 
 
@@ -539,7 +544,11 @@ def _load_groups(ec, pore: PorePressure):
     (factor alpha scale and the ratio), or, with many distinct values, one per
     sign of alpha dp (weights w |alpha dp / scale|, factor +-scale)."""
     pairs = np.column_stack([pore.qp_alpha, pore.qp_ratio])
-    values = np.unique(pairs[pairs[:, 1] != 0.0], axis=0)
+    loaded = pairs[pairs[:, 1] != 0.0]
+    if loaded.size and np.all(loaded == loaded[0]):  # one rock, one change
+        values = loaded[:1]
+    else:
+        values = np.unique(loaded, axis=0)
     if len(values) <= MAX_LOAD_GROUPS:
         for a, r in values:
             mine = (pore.qp_alpha == a) & (pore.qp_ratio == r)
@@ -553,7 +562,11 @@ def _load_groups(ec, pore: PorePressure):
             yield w, (sign, 1.0)
 
 
-def _add_enriched_load(F, mesh, bulk, ec, w, factor, scale, backend) -> None:
+# Biot-load operators body_load keeps for the next case (``kept``)
+MAX_KEPT_LOADS = 8
+
+
+def _add_enriched_load(F, mesh, bulk, ec, w, factor, scale, backend, kept=None) -> None:
     """F += (alpha scale A) r Bbar^T m over the enriched cells holding weight
     w, (alpha, r) = ``factor``."""
     a, r = factor
@@ -562,7 +575,15 @@ def _add_enriched_load(F, mesh, bulk, ec, w, factor, scale, backend) -> None:
     rows = np.nonzero(area > 0.0)[0]
     if rows.size == 0:
         return
-    Bbar = enriched_part_bbar(mesh, ec, rows, w, backend)
+    key = (backend, w.tobytes()) if kept is not None else None
+    if key is not None and key in kept:
+        Bbar = kept[key]
+    else:
+        Bbar = enriched_part_bbar(mesh, ec, rows, w, backend)
+        if key is not None:
+            if len(kept) >= MAX_KEPT_LOADS:  # loads that change with every case
+                kept.clear()
+            kept[key] = Bbar
     # Bbar^T m = rows exx + eyy of the average operator
     fe = ((a * scale * area[rows]) * r)[:, None] * (Bbar[:, 0] + Bbar[:, 1])
     dofs = bulk.enr_dofs[rows]

@@ -82,7 +82,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from xfemslip.fem.assembly import coo_block
-from xfemslip.solve import lowrank, pardiso
+from xfemslip.solve import lowrank, pardiso, shared
 from xfemslip.solve.backward import backward_error
 from xfemslip.solve.guess import KEEP, PreviousSolutions
 
@@ -594,12 +594,15 @@ class LinearSolver:
             "pardiso_lowrank": 0,
             "lowrank_updates": 0,
             "lowrank_rank": 0,
+            "shared_reuses": 0,
         }
         # pardiso.SchurSystems or PardisoSystems, made on the first solve, and
         # the pattern of the sparse Kc they were made for (None: the blocks')
         self._pardiso = None
         self._pardiso_key = None
         self._lu = None  # (SuperLU object, checked solve, K_c it factors)
+        # shared.SharedSchurSystems within shared.sharing(); False: not usable
+        self._shared: shared.SharedSchurSystems | bool | None = None
         self._amg = None  # V-cycle on the standard dofs
         # the Krylov solves start from the best combination of the last
         # solutions (solve/guess.py)
@@ -647,10 +650,46 @@ class LinearSolver:
                 self.stats["solves"] += 1
                 self.stats["solve_time"] += time.perf_counter() - start
                 return x
+        if self.method == "superlu" and shared.active():
+            start = time.perf_counter()
+            x = self._solve_shared(blocks, r)
+            if x is not None:
+                self.stats["solves"] += 1
+                self.stats["solve_time"] += time.perf_counter() - start
+                return x
         Kc = None
         if blocks is not None and np.size(blocks):
             Kc = coo_block(self.contact_dofs, blocks, self.K.shape[0], self.kernels)
         return self.solve(Kc, r)
+
+    def _solve_shared(self, blocks, r):
+        """The solve on the Schur factors kept between runs of the same
+        bulk matrix (xfemslip.solve.shared), or None: none apply (too many
+        contact dofs, K_ii singular) or the solve missed LU_BACKWARD_ERROR
+        (then this and the later systems of the run take the kept SuperLU
+        path)."""
+        if self._shared is None:
+            dofs = np.asarray(self.contact_dofs, dtype=np.int64)
+            if dofs.ndim != 2:
+                dofs = dofs.reshape(len(dofs), -1)
+            c = np.unique(dofs[dofs >= 0])
+            try:
+                schur = shared.kept_schur(self.K, c, LU_FAST, self.stats)
+            except RuntimeError:  # K_ii singular: a part held by contact only
+                schur = None
+            if schur is None:
+                self._shared = False
+                return None
+            self._shared = shared.SharedSchurSystems(
+                schur, dofs, LU_BACKWARD_ERROR, self.stats
+            )
+        if self._shared is False:
+            return None
+        x = self._shared.solve(blocks, r)
+        if x is None:
+            logger.debug("shared Schur solve missed the backward error; SuperLU")
+            self._shared = False
+        return x
 
     def _symmetric(self, blocks) -> bool:
         """Whether the contact blocks are symmetric (pardiso.symmetric_blocks;

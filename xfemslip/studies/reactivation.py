@@ -129,12 +129,14 @@ def deplete_task(task: SampleTask) -> tuple[str, str, dict, str]:
     final step), read from the files ``deplete`` wrote.
     """
     from xfemslip.case import loads_case
+    from xfemslip.solve.shared import sharing
     from xfemslip.studies.depletion import deplete
 
     out_dir = Path(task.out_dir)
     try:
         spec = loads_case(task.text, Path(task.path))
-        deplete(spec, out_dir, overwrite=True)
+        with sharing():  # the samples of a study share their bulk matrix
+            deplete(spec, out_dir, overwrite=True)
         return task.case_id, OK, read_sample(out_dir), ""
     except XfemslipError as err:
         error = " ".join(str(err).split())
@@ -177,9 +179,14 @@ def sample_cases(spec) -> list:
         cid = case_id(i, spec.samples, params)
         document = sample_document(spec, i)
         document["name"] = f"{short}-{cid}"
-        output = document.get("output")
+        output = document.setdefault("output", {})
         if isinstance(output, dict):
             output.pop("directory", None)  # the study chooses the folder
+            # the study reads the tables of deplete; the fields of a sample
+            # are in its result.h5 (`xfemslip run` of its case.toml writes
+            # them as VTU), not written as VTU for every sample (a third of
+            # a sample's time)
+            output["formats"] = ["h5"]
         try:
             text = tomli_w.dumps(document)
         except (TypeError, ValueError) as exc:
@@ -194,10 +201,12 @@ def evaluate_xfem(
     spec, directory: Path, *, jobs=1, client=None, force=False, progress=None
 ) -> UncertaintyResult:
     """Every sample through ``deplete`` (see the module doc)."""
+    from xfemslip.solve.shared import sharing
     from xfemslip.studies.run import run_dask, run_local, write_case
 
     start = time.perf_counter()
-    cases = sample_cases(spec)
+    with sharing():  # the geometry checked once is the one the samples solve
+        cases = sample_cases(spec)
     n, nf = spec.samples, len(spec.base_spec.fractures)
     ids = [c[0] for c in cases]
     status = np.full(n, OK, dtype=object)

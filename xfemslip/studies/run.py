@@ -163,12 +163,14 @@ def run_task(task: CaseTask) -> tuple[str, str, dict, str]:
     """
     from xfemslip.case import loads_case
     from xfemslip.simulation import run_case
+    from xfemslip.solve.shared import sharing
 
     out_dir = Path(task.out_dir)
     spec = None
     try:
         spec = loads_case(task.text, Path(task.path))
-        result = run_case(spec, out_dir, overwrite=True)
+        with sharing():  # members of the same geometry share their build
+            result = run_case(spec, out_dir, overwrite=True)
         return task.case_id, "ok", case_metrics(result, spec), ""
     except XfemslipError as err:
         error = " ".join(str(err).split())
