@@ -3,7 +3,8 @@
 mesh, whole processes, alternated, medians of --runs.
 
     MKL_NUM_THREADS=2 OPENBLAS_NUM_THREADS=1 NUMBA_NUM_THREADS=2 \\
-    python benchmarks/field_section.py --sizes 10 5 --runs 3
+    python benchmarks/field_section.py --sizes 10 5 --runs 3 \\
+        --markdown docs/performance/field_section.md
 
 Per mesh size (``[mesh] size``), each configuration in its own process, wall
 time from start to exit as the parent sees it:
@@ -22,6 +23,7 @@ from __future__ import annotations
 
 import argparse
 import os
+import platform
 import statistics
 import subprocess
 import sys
@@ -96,14 +98,21 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--sizes", type=float, nargs="+", default=[10.0, 5.0])
     parser.add_argument("--runs", type=int, default=3)
+    parser.add_argument(
+        "--markdown", type=Path, help="also write the table to this file"
+    )
     args = parser.parse_args()
     import numpy as np
 
     from xfemslip.case import build, load_case
 
-    print(f"# {time.strftime('%Y-%m-%d')}, load {os.getloadavg()[0]:.1f}")
-    print("| size [m] | cells | run mkl [s] | run default [s] | floor [s] | mkl / floor | default / floor |")
-    print("| --- | --- | --- | --- | --- | --- | --- |")
+    lines = [
+        "| size [m] | cells | run mkl [s] | run default [s] | floor [s] "
+        "| mkl / floor | default / floor |",
+        "| --- | --- | --- | --- | --- | --- | --- |",
+    ]
+    loads = [os.getloadavg()[0]]
+    print("\n".join(lines), flush=True)
     with tempfile.TemporaryDirectory() as tmp:
         work = Path(tmp)
         for size in args.sizes:
@@ -132,12 +141,23 @@ def main() -> None:
                     times[k].append(child(code, work))
             med = {k: statistics.median(v) for k, v in times.items()}
             cells = f"{mesh.x.size - 1} x {mesh.y.size - 1}"
-            print(
+            lines.append(
                 f"| {size:g} | {cells} | {med['mkl']:.2f} | {med['default']:.2f} | "
                 f"{med['floor']:.2f} | {med['mkl'] / med['floor']:.2f} | "
-                f"{med['default'] / med['floor']:.2f} |",
-                flush=True,
+                f"{med['default'] / med['floor']:.2f} |"
             )
+            loads.append(os.getloadavg()[0])
+            print(lines[-1], flush=True)
+    note = (
+        f"\nMedians of {args.runs} whole processes per configuration, "
+        f"alternated; {platform.machine()}, {os.cpu_count()} cores, "
+        f"{time.strftime('%Y-%m-%d')}, load average "
+        f"{min(loads):.1f}-{max(loads):.1f}.\n"
+    )
+    print(note)
+    if args.markdown:
+        args.markdown.parent.mkdir(parents=True, exist_ok=True)
+        args.markdown.write_text("\n".join(lines) + "\n" + note, encoding="utf-8")
 
 
 if __name__ == "__main__":

@@ -40,7 +40,6 @@ import math
 from typing import NamedTuple
 
 import numpy as np
-from scipy.optimize import brentq
 
 __all__ = [
     "GROWTH_MARGIN",
@@ -386,6 +385,10 @@ def _round(seg: _Segment, mu: float) -> tuple[int, _Field]:
     hi, lo = top, 0.5 * top  # bracket the root by halving (reachable: it ends)
     while excess(lo) < 0.0 and lo > top * 1e-280:
         hi, lo = lo, 0.5 * lo
+    # imported here: scipy.optimize takes 0.3 s to import, and a uniform
+    # mesh never gets here
+    from scipy.optimize import brentq
+
     T = brentq(excess, lo, hi, xtol=1e-300, rtol=4 * np.finfo(float).eps)
     return n, _capped(seg, mu, T)
 
