@@ -143,7 +143,7 @@ def test_cli_screen_case(runner, tmp_path):
     text = result.stdout
     assert "slip band: beta = 5.83..78.46 deg from sigma1" in text
     assert "fractures[0]: theta = 45.00 deg (beta = 45.00 deg)" in text
-    assert "margin = -7e+06 -> SLIPS already" in text
+    assert "margin = -7 MPa -> SLIPS already" in text
     assert (out / "mohr.png").stat().st_size > 10_000
     assert (out / "mohr.pdf").read_bytes()[:4] == b"%PDF"
     rows = csv_path.read_text().splitlines()
