@@ -133,12 +133,14 @@ def label_log_axis(axis) -> None:
     if lo <= 0.0 or hi / lo >= 10.0:
         return
     axis.set_major_locator(LogLocator(base=10.0, subs=(1.0, 2.0, 5.0)))
-    axis.set_minor_locator(LogLocator(base=10.0, subs=np.arange(1.0, 10.0)))
+    axis.set_minor_locator(LogLocator(base=10.0, subs=[float(k) for k in range(1, 10)]))
     axis.set_major_formatter(FuncFormatter(lambda value, _: f"{value:g}"))
     axis.set_minor_formatter(NullFormatter())
     shown = [t for t in axis.get_majorticklocs() if lo <= t <= hi]
     if len(shown) < 2:  # less than a factor 2.5: every minor tick named
-        axis.set_major_locator(LogLocator(base=10.0, subs=np.arange(1.0, 10.0)))
+        axis.set_major_locator(
+            LogLocator(base=10.0, subs=[float(k) for k in range(1, 10)])
+        )
 
 
 # --------------------------------------------------------------------------- #
@@ -160,7 +162,7 @@ def _candidates(direction, gap: float) -> list[tuple[float, float]]:
     """Offsets [points] to try around an anchor: beside a line of unit
     ``direction`` (display), on either side and slid along it; else the
     eight compass points, nearest first."""
-    out = []
+    out: list[tuple[float, float]] = []
     for scale in (1.0, 2.0, 3.5, 5.0):
         d = gap * scale
         if direction is not None:
