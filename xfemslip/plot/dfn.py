@@ -204,10 +204,16 @@ def _draw_rose(ax, angles: np.ndarray) -> None:
 
 
 def _draw_lengths(ax, lengths: np.ndarray) -> None:
-    """Histogram of the fracture lengths [m]."""
-    ax.hist(
-        lengths, bins="auto" if lengths.size > 1 else 1, color="tab:blue", edgecolor="k"
-    )
+    """Histogram of the fracture lengths [m]: about sqrt(n) bins (at most
+    30); lengths all equal (to rounding) make one bar 10 % wide."""
+    lengths = lengths[np.isfinite(lengths)]
+    lo, hi = (float(lengths.min()), float(lengths.max())) if lengths.size else (0, 1)
+    if hi - lo <= 1e-6 * max(abs(hi), 1e-300):
+        pad = 0.05 * abs(hi) or 0.5
+        lo, hi, bins = lo - pad, hi + pad, 1
+    else:
+        bins = int(np.clip(np.ceil(np.sqrt(lengths.size)), 1, 30))
+    ax.hist(lengths, bins=bins, range=(lo, hi), color="tab:blue", edgecolor="k")
     ax.set_xlabel("fracture length [m]")
     ax.set_ylabel("fractures")
     ax.yaxis.set_major_locator(MaxNLocator(integer=True))

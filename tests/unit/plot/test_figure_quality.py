@@ -490,6 +490,24 @@ def test_network_figures_have_metres_mm_a_rose_and_lengths(depleted):
     assert_no_overlap([ax.title for ax in (ax_net, rose, lengths)], renderer, "titles")
 
 
+def test_length_histogram_of_equal_lengths_is_one_bar():
+    """Lengths equal to rounding (a corrupted or regular network): one bar
+    holding them all, not numpy's refusal to make bins of zero width."""
+    from matplotlib.figure import Figure
+
+    from xfemslip.plot.dfn import _draw_lengths
+
+    for lengths in ([1.0, 1.0, 1.0 + 1e-15], [0.0, 0.0], [2.0], [np.nan, 3.0]):
+        ax = Figure().subplots()
+        _draw_lengths(ax, np.array(lengths))
+        heights = [p.get_height() for p in ax.patches]
+        finite = int(np.isfinite(lengths).sum())
+        assert heights == [finite]
+    ax = Figure().subplots()
+    _draw_lengths(ax, np.array([1.0, 2.0, 3.0, 4.0]))
+    assert [p.get_height() for p in ax.patches] == [2, 2]
+
+
 def _slid(out: Path) -> list[np.ndarray]:
     from xfemslip import read_result
 
