@@ -255,6 +255,8 @@ def plot(results, case, output, kinds, formats, labels, scale, dpi, debug) -> No
     With --case, draw a case file before it runs (the paper's Fig. 5)."""
     with reported_errors(debug):
         configure_logging(False, True)  # the warnings; the paths are printed
+        # and one line per figure on stderr: a large result takes a minute
+        logging.getLogger("xfemslip.plot.progress").setLevel(logging.INFO)
         if case is not None:
             spec = load_case_file(case)
             from xfemslip.plot.case import plot_case

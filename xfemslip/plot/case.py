@@ -32,6 +32,7 @@ from matplotlib.patches import Rectangle
 from xfemslip.case.specs import CaseSpec
 from xfemslip.fem.zones import build_zones
 from xfemslip.geometry.regions import edges
+from xfemslip.plot.style import line_styles, place_labels
 
 __all__ = ["figure_case", "plot_case"]
 
@@ -54,14 +55,6 @@ def _edge_points(spec: CaseSpec, name: str, n: int) -> np.ndarray:
         return np.column_stack([box.x0 + t * w, np.full(n, y)])
     x = box.x0 if name == "left" else box.x1
     return np.column_stack([np.full(n, x), box.y0 + t * h])
-
-
-def _colours(n: int) -> list:
-    if n <= 10:
-        return [f"C{i}" for i in range(10)]
-    if n <= 20:
-        return [matplotlib.colormaps["tab20"](i) for i in range(20)]
-    return list(matplotlib.colormaps["turbo"](np.linspace(0.0, 1.0, n)))
 
 
 def _mesh_lines(ax, spec: CaseSpec) -> str:
@@ -129,33 +122,48 @@ def _regions(ax, spec: CaseSpec) -> list[str]:
 
 
 def _fractures(ax, spec: CaseSpec) -> None:
-    colours = _colours(len(spec.fractures))
-    many = len(spec.fractures) > 10
+    """Each fracture in its own style (:func:`xfemslip.plot.style.line_styles`:
+    neighbours in different hues, repeated hues in different dashes)."""
+    styles = line_styles(len(spec.fractures))
     for k, fr in enumerate(spec.fractures):
         p = np.asarray(fr.points)
-        colour = colours[k % len(colours)]
-        ax.plot(p[:, 0], p[:, 1], color=colour, lw=2.0, solid_capstyle="round")
-        at = p[0] + (p[-1] - p[0]) / 3.0  # not the middle: crossings meet there
-        ax.annotate(
-            str(fr.index),
-            at,
-            fontsize=7 if many else 8,
-            xytext=(3, 3),
-            textcoords="offset points",
-            color="k",
-            bbox={
-                "boxstyle": "round,pad=0.1",
-                "fc": "white",
-                "ec": "none",
-                "alpha": 0.7,
-            },
+        style = styles[k]
+        ax.plot(
+            p[:, 0],
+            p[:, 1],
+            color=style["color"],
+            ls=style["linestyle"],
+            lw=2.0,
+            solid_capstyle="round",
         )
     if spec.fractures:
         frictions = sorted({fr.friction for fr in spec.fractures})
         text = ", ".join(f"{f:g}" for f in frictions)
         ax.plot(
-            [], [], color=colours[0], lw=2.0, label=f"fractures (numbered), f = {text}"
+            [],
+            [],
+            color=styles[0]["color"],
+            lw=2.0,
+            label=f"fractures (numbered), f = {text}",
         )
+
+
+def _number_fractures(ax, spec: CaseSpec) -> None:
+    """Each fracture's number beside its line, a third of the way along it
+    (crossing fractures often meet at their middles), on no other line or
+    number (:func:`xfemslip.plot.style.place_labels`)."""
+    lines = [np.asarray(fr.points, dtype=float) for fr in spec.fractures]
+    place_labels(
+        ax,
+        [
+            (p[0] + (p[-1] - p[0]) / 3.0, str(fr.index))
+            for p, fr in zip(lines, spec.fractures, strict=True)
+        ],
+        directions=[p[-1] - p[0] for p in lines],
+        avoid=lines,
+        join_within=0.0,
+        fontsize=7 if len(lines) > 10 else 8,
+    )
 
 
 def _arrows(ax, points, vectors, colour, label: str | None) -> None:
@@ -297,6 +305,7 @@ def figure_case(spec: CaseSpec) -> Figure:
         va="top",
         family="monospace",
     )
+    _number_fractures(ax, spec)
     return fig
 
 

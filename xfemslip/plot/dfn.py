@@ -2,10 +2,11 @@
 a figure is drawn; ``matplotlib.figure.Figure``, no pyplot, no GUI backend).
 
 ``figure_network``: the fractures of a case in its domain, coloured by
-the ``|slip|`` that slid (the plastic slip) at the contact points when a
-``result.h5`` is given (slipping
-fractures drawn thicker), else by origin; with a sweep's ``summary.csv`` a
-second panel shows how many fractures slip over the realizations.
+the ``|slip|`` that slid (the plastic slip) [mm] at the contact points when
+a ``result.h5`` is given (slipping fractures drawn thicker), else by origin;
+beside it a rose diagram of the fractures' orientations and a histogram of
+their lengths; with a sweep's ``summary.csv`` a last panel shows how many
+fractures slip over the realizations.
 """
 
 from __future__ import annotations
@@ -39,8 +40,8 @@ def _domain_frame(ax, spec: CaseSpec) -> None:
     ax.set_aspect("equal")
     ax.set_xlim(x0 - 0.02 * w, x0 + 1.02 * w)
     ax.set_ylim(y0 - 0.02 * h, y0 + 1.02 * h)
-    ax.set_xlabel("x (m)")
-    ax.set_ylabel("y (m)")
+    ax.set_xlabel("x [m]")
+    ax.set_ylabel("y [m]")
 
 
 def read_result_slip(result: Path, n_fractures: int) -> list[tuple]:
@@ -59,13 +60,13 @@ def read_result_slip(result: Path, n_fractures: int) -> list[tuple]:
 def _draw_slip(fig, ax, fields) -> None:
     """Contact-point polylines coloured by |slip|; slipping fractures thicker."""
     top = max((float(np.abs(s).max()) for _, s, _ in fields if s.size), default=0.0)
-    norm = Normalize(0.0, top if top > 0 else 1.0)
+    norm = Normalize(0.0, 1e3 * top if top > 0 else 1.0)
     collection = None
     for points, slip, state in fields:
         if len(points) < 2:
             continue
         pieces = np.stack([points[:-1], points[1:]], axis=1)
-        value = 0.5 * (np.abs(slip[:-1]) + np.abs(slip[1:]))
+        value = 0.5e3 * (np.abs(slip[:-1]) + np.abs(slip[1:]))  # [mm]
         width = 2.6 if np.any(state == SLIP) else 1.0
         collection = LineCollection(
             list(pieces), cmap="viridis", norm=norm, linewidths=width
@@ -73,7 +74,7 @@ def _draw_slip(fig, ax, fields) -> None:
         collection.set_array(value)
         ax.add_collection(collection)
     if collection is not None:
-        fig.colorbar(collection, ax=ax, label="|slip| (m)", shrink=0.8)
+        fig.colorbar(collection, ax=ax, label="|slip| that slid [mm]", shrink=0.8)
 
 
 def _draw_plain(ax, spec: CaseSpec) -> None:
@@ -159,24 +160,93 @@ def _draw_counts(ax, counts: np.ndarray, totals: np.ndarray) -> None:
         )
 
 
+ROSE_BIN_DEG = 10.0
+
+
+def orientations_and_lengths(spec: CaseSpec) -> tuple[np.ndarray, np.ndarray]:
+    """(angle of each fracture's chord in [0, 180) deg, length along its
+    polyline [m])."""
+    angles, lengths = [], []
+    for fracture in spec.fractures:
+        p = np.asarray(fracture.points, dtype=float)
+        d = p[-1] - p[0]
+        angles.append(np.degrees(np.arctan2(d[1], d[0])) % 180.0)
+        lengths.append(float(np.sum(np.linalg.norm(np.diff(p, axis=0), axis=1))))
+    return np.array(angles), np.array(lengths)
+
+
+def _draw_rose(ax, angles: np.ndarray) -> None:
+    """Rose diagram: how many fractures per ROSE_BIN_DEG of orientation,
+    drawn at theta and theta + 180 (a line has no direction)."""
+    edges = np.arange(0.0, 180.0 + ROSE_BIN_DEG, ROSE_BIN_DEG)
+    counts, _ = np.histogram(angles, bins=edges)
+    width = np.radians(ROSE_BIN_DEG)
+    for turn in (0.0, np.pi):
+        ax.bar(
+            np.radians(edges[:-1]) + turn,
+            counts,
+            width=width,
+            align="edge",
+            color="tab:blue",
+            edgecolor="k",
+            lw=0.5,
+        )
+    ax.set_theta_zero_location("E")
+    ax.set_theta_direction(1)
+    ax.set_thetagrids(range(0, 360, 45), fontsize=7)
+    ax.yaxis.set_major_locator(MaxNLocator(3, integer=True))
+    ax.tick_params(axis="y", labelsize=7)
+    ax.set_title(
+        f"orientations ({ROSE_BIN_DEG:g} deg bins, count;\nangle from x, "
+        "counter-clockwise)",
+        fontsize=9,
+    )
+
+
+def _draw_lengths(ax, lengths: np.ndarray) -> None:
+    """Histogram of the fracture lengths [m]: about sqrt(n) bins (at most
+    30); lengths all equal (to rounding) make one bar 10 % wide."""
+    lengths = lengths[np.isfinite(lengths)]
+    lo, hi = (float(lengths.min()), float(lengths.max())) if lengths.size else (0, 1)
+    if hi - lo <= 1e-6 * max(abs(hi), 1e-300):
+        pad = 0.05 * abs(hi) or 0.5
+        lo, hi, bins = lo - pad, hi + pad, 1
+    else:
+        bins = int(np.clip(np.ceil(np.sqrt(lengths.size)), 1, 30))
+    ax.hist(lengths, bins=bins, range=(lo, hi), color="tab:blue", edgecolor="k")
+    ax.set_xlabel("fracture length [m]")
+    ax.set_ylabel("fractures")
+    ax.yaxis.set_major_locator(MaxNLocator(integer=True))
+    if lengths.size:
+        ax.set_title(
+            f"{lengths.size} lengths: {lengths.min():.3g} to {lengths.max():.3g} m",
+            fontsize=9,
+        )
+
+
 def figure_network(
     spec: CaseSpec, result: Path | None = None, summary: Path | None = None
 ):
-    """The network of ``spec`` (slip from ``result``), plus the slipping-count
+    """The network of ``spec`` (slip from ``result``), the rose diagram of
+    its orientations, the histogram of its lengths, and the slipping-count
     histogram of a sweep ``summary`` when given."""
-    n = 2 if summary is not None else 1
-    fig = Figure(figsize=(PANEL * n + 1.0 * (result is not None), PANEL))
-    axes = fig.subplots(1, n, squeeze=False)[0]
-    _domain_frame(axes[0], spec)
+    n = 4 if summary is not None else 3
+    width = PANEL * (1.0 + 0.75 * (n - 1)) + 1.0 * (result is not None)
+    fig = Figure(figsize=(width, PANEL), layout="constrained")
+    grid = fig.add_gridspec(1, n, width_ratios=[1.35] + [1.0] * (n - 1))
+    ax_net = fig.add_subplot(grid[0])
+    _domain_frame(ax_net, spec)
     if result is not None:
-        _draw_slip(fig, axes[0], read_result_slip(result, len(spec.fractures)))
-        axes[0].set_title(f"{spec.name}: |slip| (thick: slipping)", fontsize=9)
+        _draw_slip(fig, ax_net, read_result_slip(result, len(spec.fractures)))
+        ax_net.set_title(f"{spec.name}: |slip| (thick: slipping)", fontsize=9)
     else:
-        _draw_plain(axes[0], spec)
-        axes[0].set_title(f"{spec.name}: {len(spec.fractures)} fractures", fontsize=9)
+        _draw_plain(ax_net, spec)
+        ax_net.set_title(f"{spec.name}: {len(spec.fractures)} fractures", fontsize=9)
+    angles, lengths = orientations_and_lengths(spec)
+    _draw_rose(fig.add_subplot(grid[1], projection="polar"), angles)
+    _draw_lengths(fig.add_subplot(grid[2]), lengths)
     if summary is not None:
-        _draw_counts(axes[1], *read_slipping_counts(summary))
-    fig.tight_layout()
+        _draw_counts(fig.add_subplot(grid[3]), *read_slipping_counts(summary))
     return fig
 
 

@@ -29,10 +29,10 @@ from __future__ import annotations
 
 import logging
 import math
+import time
 from collections.abc import Sequence
 from pathlib import Path
 
-import matplotlib
 import numpy as np
 from matplotlib.collections import LineCollection, PolyCollection
 from matplotlib.colors import Normalize
@@ -53,8 +53,16 @@ from xfemslip.plot.mohr import (
 )
 from xfemslip.plot.permeability import figure_permeability
 from xfemslip.plot.profile import figure_profile
+from xfemslip.plot.style import (
+    colourbar_label,
+    line_styles,
+    place_labels,
+    robust_norm,
+)
 
 logger = logging.getLogger(__name__)
+# one line per figure written; ``xfemslip plot`` shows it even when quiet
+progress = logging.getLogger("xfemslip.plot.progress")
 
 KINDS = (
     "displacement",
@@ -104,13 +112,21 @@ def _case_title(fig, results: Sequence[ResultData]) -> None:
         fig.suptitle(", ".join(names), fontsize=10)
 
 
-def _row_colorbar(fig, mappable, axes_row, label: str) -> None:
+def _row_colorbar(fig, mappable, axes_row, label: str, extend="neither") -> None:
     """One colour bar for a row of panels that share a colour scale (beside
-    the single panel of a row of one)."""
+    the single panel of a row of one); ``extend``: arrows at the ends whose
+    values lie beyond the range."""
     if len(axes_row) > 1:
-        fig.colorbar(mappable, ax=list(axes_row), label=label, shrink=0.85, aspect=25)
+        fig.colorbar(
+            mappable,
+            ax=list(axes_row),
+            label=label,
+            shrink=0.85,
+            aspect=25,
+            extend=extend,
+        )
     else:
-        fig.colorbar(mappable, ax=axes_row[0], label=label, shrink=0.8)
+        fig.colorbar(mappable, ax=axes_row[0], label=label, shrink=0.8, extend=extend)
 
 
 def _triangulation(data: ResultData):
@@ -126,16 +142,6 @@ def _triangulation(data: ResultData):
         pts, u = data.points, data.displacement
         tri = np.concatenate([c[:, [0, 1, 2]], c[:, [0, 2, 3]]])
     return Triangulation(pts[:, 0], pts[:, 1], tri), u
-
-
-def _norm(values: np.ndarray):
-    """(norm, colormap): when the sign changes, blue-red symmetric about 0
-    (compression blue, tension red); else a sequential map."""
-    lo, hi = float(np.min(values)), float(np.max(values))
-    if lo < 0.0 < hi:
-        bound = max(-lo, hi)
-        return Normalize(-bound, bound), "RdBu_r"
-    return Normalize(lo, hi), "viridis"
 
 
 # --------------------------------------------------------------------------- #
@@ -172,7 +178,10 @@ def figure_displacement(results: Sequence[ResultData]) -> Figure:
 
 def figure_principal(results: Sequence[ResultData]) -> Figure:
     """Principal stresses per element [MPa], tension positive; each row
-    shares one colour scale across the results."""
+    shares one colour scale across the results, from the 1st to the 99th
+    percentile of its values (:func:`xfemslip.plot.style.robust_norm`: the
+    stress singularity at a tip does not set it, a nearly uniform field is
+    not magnified into colour), white at zero when the range holds it."""
     fig, axes = _grid(2, len(results))
     rows = (
         (1, r"$\sigma_{min}$ (most compressive)"),
@@ -180,13 +189,13 @@ def figure_principal(results: Sequence[ResultData]) -> Figure:
     )
     for i, (col, title) in enumerate(rows):
         values = [1e-6 * data.principal[:, col] for data in results]
-        norm, cmap = _norm(np.concatenate(values))
+        scale = robust_norm(np.concatenate(values))
         for j, data in enumerate(results):
             coll = PolyCollection(
                 data.points[data.cells],
                 array=values[j],
-                cmap=cmap,
-                norm=norm,
+                cmap=scale.cmap,
+                norm=scale.norm,
                 edgecolors="face",
                 linewidths=0.1,
             )
@@ -195,8 +204,8 @@ def figure_principal(results: Sequence[ResultData]) -> Figure:
             ax.margins(0.0)
             ax.autoscale_view()
             _frame(ax, data, f"{data.label}\n{title}")
-        label = f"{title} [MPa], tension positive"
-        _row_colorbar(fig, coll, axes[i, :], label)
+        label = colourbar_label(f"{title} [MPa], tension positive", scale)
+        _row_colorbar(fig, coll, axes[i, :], label, scale.extend)
     _case_title(fig, results)
     return fig
 
@@ -214,49 +223,110 @@ def auto_scale(data: ResultData) -> float:
     return max(1.0, min(scale, 0.15 * size / u_max))
 
 
-def _draw_mesh(ax, data: ResultData, factor: float) -> str:
-    """The deformed element outlines; returns a note for the title."""
+# Mesh lines closer than this many pixels (at DPI, on a panel PANEL wide)
+# beat with the pixel grid into moire: the overview draws every k-th line.
+MESH_LINE_PIXELS = 10.0
+
+
+def _cell_size(data: ResultData) -> float:
+    """The median edge length of the (undeformed) elements [m]."""
+    c = data.points[data.cells]
+    return float(np.median(np.linalg.norm(c[:, 1] - c[:, 0], axis=1)))
+
+
+def _line_stride(data: ResultData) -> int:
+    """Every how many grid lines the overview draws (1: all)."""
+    size = float(np.ptp(data.points, axis=0).max())
+    spacing = PANEL * DPI * _cell_size(data) / size
+    return max(1, math.ceil(MESH_LINE_PIXELS / spacing))
+
+
+def _thinned_edges(points: np.ndarray, edges: np.ndarray, h: float, every: int):
+    """The edges of ``edges`` (E, 2) to draw with every ``every``-th grid
+    line: an edge along x or y is kept when it lies on a kept grid line
+    (grid spacing ``h``); the edges of the pieces of cut elements along a
+    fracture are never axis-aligned and are all kept."""
+    if every == 1:
+        return edges
+    a, b = points[edges[:, 0]], points[edges[:, 1]]
+    tol = 1e-6 * h
+    origin = points.min(axis=0)
+
+    def on_kept(coord: np.ndarray, axis: int) -> np.ndarray:
+        k = (coord - origin[axis]) / h
+        return (np.abs(k - np.round(k)) < 1e-6) & (np.round(k) % every == 0)
+
+    horizontal = np.abs(a[:, 1] - b[:, 1]) < tol
+    vertical = np.abs(a[:, 0] - b[:, 0]) < tol
+    keep = (horizontal & on_kept(a[:, 1], 1)) | (vertical & on_kept(a[:, 0], 0))
+    keep |= ~horizontal & ~vertical
+    return edges[keep]
+
+
+def _draw_mesh(ax, data: ResultData, factor: float, every: int = 1) -> str:
+    """The deformed element outlines (every ``every``-th grid line); returns
+    a note for the title."""
     if (
         data.vis_edges is None
         or data.vis_points is None
         or data.vis_displacement is None
     ):
         moved = data.points + factor * data.displacement
+        h = _cell_size(data)
+        cells = data.cells
+        edges = np.concatenate([cells[:, [k, (k + 1) % 4]] for k in range(4)])
+        edges = _thinned_edges(data.points, np.unique(np.sort(edges), axis=0), h, every)
         ax.add_collection(
-            PolyCollection(
-                moved[data.cells], facecolors="none", edgecolors="0.25", linewidths=0.3
-            )
+            LineCollection(list(moved[edges]), colors="0.25", linewidths=0.3)
         )
         return "no result.vtu: the jump is not shown"
     moved = data.vis_points + factor * data.vis_displacement
-    ax.add_collection(
-        LineCollection(list(moved[data.vis_edges]), colors="0.2", linewidths=0.35)
-    )
+    edges = _thinned_edges(data.vis_points, data.vis_edges, _cell_size(data), every)
+    ax.add_collection(LineCollection(list(moved[edges]), colors="0.2", linewidths=0.35))
     return "cut elements split along the fracture"
 
 
 def _zoom_box(data: ResultData, factor: float):
-    """(x0, x1, y0, y1) around the first fracture's middle, deformed."""
+    """(x0, x1, y0, y1) around the first fracture's middle, deformed, its
+    edges half-way between grid lines (a mesh line along the frame would
+    look like a second frame)."""
     fr = next((f for f in data.fractures if f.points.size), None)
     size = float(np.ptp(data.points, axis=0).max())
     centre = fr.points[len(fr.points) // 2] if fr is not None else data.points.mean(0)
     near = np.argmin(np.linalg.norm(data.points - centre, axis=1))
-    centre = centre + factor * data.displacement[near]
-    half = 0.1 * size
-    return centre[0] - half, centre[0] + half, centre[1] - half, centre[1] + half
+    h = _cell_size(data)
+    origin = data.points.min(axis=0)
+    half = max(0.1 * size, 2.0 * h)
+    lo = origin + (np.floor((centre - half - origin) / h) + 0.5) * h
+    hi = origin + (np.ceil((centre + half - origin) / h) - 0.5) * h
+    shift = factor * data.displacement[near]
+    (x0, y0), (x1, y1) = lo + shift, hi + shift
+    return x0, x1, y0, y1
+
+
+def _every(k: int) -> str:
+    """The words for every k-th: "every other", "every 3rd", "every 4th"."""
+    if k == 2:
+        return "every other"
+    teen = k % 100 in (11, 12, 13)
+    suffix = "th" if teen else {1: "st", 2: "nd", 3: "rd"}.get(k % 10, "th")
+    return f"every {k}{suffix}"
 
 
 def figure_deformed(
     results: Sequence[ResultData], scale: float | None = None
 ) -> Figure:
     """The deformed mesh, displacement magnified, and a zoom on the fracture's
-    middle; cut elements are drawn split so the jump shows (paper Fig. 3)."""
+    middle; cut elements are drawn split so the jump shows (paper Fig. 3).
+    The overview draws every k-th grid line when the lines would lie closer
+    than MESH_LINE_PIXELS (moire); the zoom draws them all."""
     fig, axes = _grid(2, len(results), height=PANEL + 0.3)
     for j, data in enumerate(results):
         factor = scale if scale is not None else auto_scale(data)
         for i, zoom in enumerate((False, True)):
             ax = axes[i, j]
-            note = _draw_mesh(ax, data, factor)
+            every = 1 if zoom else _line_stride(data)
+            note = _draw_mesh(ax, data, factor, every)
             if zoom:
                 x0, x1, y0, y1 = _zoom_box(data, factor)
                 ax.set_xlim(x0, x1)
@@ -265,9 +335,10 @@ def figure_deformed(
                 title = f"{data.label}\nzoom on the middle of the fracture"
             else:
                 ax.autoscale_view()
+                lines = "" if every == 1 else f", {_every(every)} mesh line"
                 title = (
                     f"{data.label}\ndeformed mesh, displacement x {factor:.3g}"
-                    f"\n({note})"
+                    f"\n({note}{lines})"
                 )
             _frame(ax, data, title, fractures=False)
     return fig
@@ -276,12 +347,13 @@ def figure_deformed(
 def figure_slip(results: Sequence[ResultData]) -> Figure:
     """The |slip| that slid [mm] along every fracture against arc length
     (solid; dashed: the tangential jump, which adds the elastic give of the
-    penalty), results overlaid; one colour per result (or per fracture of a
-    single result), distinct for any number of them."""
+    penalty), results overlaid; one style per result (or per fracture of a
+    single result): :func:`xfemslip.plot.style.line_styles`, neighbours in
+    different hues, repeated hues in different dashes."""
     fig = Figure(figsize=(6.4, 4.2), layout="constrained")
     ax = fig.subplots()
     many = len(results) if len(results) > 1 else max(len(results[0].fractures), 1)
-    colours = _distinct_colours(many)
+    styles = line_styles(many)
     for k, data in enumerate(results):
         for fr in data.fractures:
             # the title names the case: one result's fractures by number
@@ -292,15 +364,18 @@ def figure_slip(results: Sequence[ResultData]) -> Figure:
             else:
                 label = f"{data.label}, fracture {fr.index}"
             s = fr.s - fr.s.min() if fr.s.size else fr.s
-            # one result with several fractures (a network): one colour each
-            colour = colours[(k if len(results) > 1 else fr.index) % len(colours)]
+            # one result with several fractures (a network): one style each
+            style = styles[(k if len(results) > 1 else fr.index) % len(styles)]
+            colour = style["color"]
             mm = 1e3 * np.abs(fr.slid)
-            (line,) = ax.plot(s, mm, lw=1.4, color=colour, label=label)
-            ax.plot(s, 1e3 * np.abs(fr.slip), lw=0.7, ls="--", color=colour)
+            (line,) = ax.plot(
+                s, mm, lw=1.4, color=colour, ls=style["linestyle"], label=label
+            )
+            ax.plot(s, 1e3 * np.abs(fr.slip), lw=0.7, ls=(0, (2, 2)), color=colour)
             in_slip = fr.state == SLIP
             ax.plot(s[in_slip], mm[in_slip], ".", ms=3, color=line.get_color())
     ax.set_xlabel("distance from the first tip along the fracture x_0 [m]")
-    ax.set_ylabel("slip that slid [mm] (dashed: jump |[[u]] . t|)")
+    ax.set_ylabel("slip that slid [mm] (thin dotted: jump |[[u]] . t|)")
     names = ", ".join(dict.fromkeys(data.name for data in results if data.name))
     ax.set_title(
         f"{names}\nslip along the fracture (dots: points in slip)", fontsize=10
@@ -312,16 +387,6 @@ def figure_slip(results: Sequence[ResultData]) -> Figure:
     else:
         ax.legend(fontsize=8)
     return fig
-
-
-def _distinct_colours(n: int) -> list:
-    """n colours that can be told apart: matplotlib's ten-colour cycle up to
-    10, then tab20, then evenly spaced hues of the turbo map."""
-    if n <= 10:
-        return [f"C{i}" for i in range(10)]
-    if n <= 20:
-        return [matplotlib.colormaps["tab20"](i) for i in range(20)]
-    return list(matplotlib.colormaps["turbo"](np.linspace(0.0, 1.0, n)))
 
 
 STATE_COLOURS = {0: "0.6", 1: "tab:blue", 2: "tab:red"}  # open, stick, slip
@@ -356,11 +421,12 @@ def figure_network(data: ResultData, scale: float | None = None) -> Figure:
     fig, axes = _grid(1, 2)
     ax_slip, ax_state = axes[0]
     factor = scale if scale is not None else auto_scale(data)
-    _draw_mesh(ax_slip, data, factor)
+    _draw_mesh(ax_slip, data, factor, _line_stride(data))
     slips = [np.abs(f.slid) for f in data.fractures if f.slid.size]
     top = max((float(v.max()) for v in slips), default=0.0) or 1.0
     norm = Normalize(0.0, 1e3 * top)
     mappable = None
+    numbers = []
     for fr in data.fractures:
         pieces, owner = fracture_pieces(fr)
         if not pieces.size:
@@ -386,10 +452,7 @@ def figure_network(data: ResultData, scale: float | None = None) -> Figure:
                 list(pieces), colors=colours, linewidths=2.2, capstyle="butt"
             )
         )
-        m = fr.points[len(fr.points) // 3]  # not the middle: Xs cross there
-        ax_state.annotate(
-            str(fr.index), m, fontsize=7, xytext=(3, 3), textcoords="offset points"
-        )
+        numbers.append(_number_label(fr))
     fig.colorbar(mappable, ax=ax_slip, label="|slip| that slid [mm]", shrink=0.8)
     ax_slip.autoscale_view()
     _frame(
@@ -405,7 +468,25 @@ def figure_network(data: ResultData, scale: float | None = None) -> Figure:
         ax_state.plot([], [], color=STATE_COLOURS[code], lw=2.2, label=name)
     ax_state.legend(fontsize=7, loc="lower right")
     _frame(ax_state, data, f"{data.label}\ncontact state", fractures=False)
+    lines = [fr.points for fr in data.fractures if len(fr.points) > 1]
+    place_labels(
+        ax_state,
+        [(at, text) for at, text, _ in numbers],
+        directions=[d for _, _, d in numbers],
+        avoid=lines,
+        join_within=0.0,
+    )
     return fig
+
+
+def _number_label(fr) -> tuple:
+    """(anchor, number, direction) of a fracture's number: a third of the
+    way along it (crossing fractures often meet at their middles), beside
+    its line."""
+    p = np.asarray(fr.points, dtype=float)
+    k = len(p) // 3
+    direction = p[-1] - p[0]
+    return p[k], str(fr.index), direction
 
 
 def _point_labels(results: Sequence[ResultData]) -> dict:
@@ -480,6 +561,8 @@ def figure_mohr(results: Sequence[ResultData]) -> Figure:
     circles: set[tuple] = set()
     criteria: set[tuple] = set()
     labels = _point_labels(results)
+    pending: list = []  # point labels, placed once the layout is final
+    cloud: list = []  # fractures' numbers at their contact points
     for k, data in enumerate(results):
         stress, pore = _mohr_state(data)
         changed = data.changed_stress is not None
@@ -518,9 +601,10 @@ def figure_mohr(results: Sequence[ResultData]) -> Figure:
                 else "Mohr circle"
             ),
             limits=limits,
+            pending=pending,
         )
         if changed and len(results) == 1 and len(fractures) < NUMBERED_FROM:
-            _cloud_labels(ax, data)
+            cloud = _cloud_labels(data)
         circles.add(stress)
         criteria |= keys
     names = ", ".join(dict.fromkeys(data.name for data in results if data.name))
@@ -537,34 +621,29 @@ def figure_mohr(results: Sequence[ResultData]) -> Figure:
         fontsize=9,
     )
     add_legend(fig)
+    place_labels(ax, pending)
+    place_labels(
+        ax, cloud, prefix=("fracture ", "fractures "), join_within=CLOUD_JOIN_PIXELS
+    )
     return fig
 
 
-def _cloud_labels(ax, data: ResultData) -> None:
-    """Each fracture's name at its contact point of largest |p_T|; fractures
-    whose points are that close (within 3 % of the axes' width) share one."""
-    width = float(np.subtract(*ax.get_xlim()[::-1]))
-    groups: list[tuple[tuple[float, float], list[int]]] = []
+# fractures whose most-sheared contact points lie this close share a label
+CLOUD_JOIN_PIXELS = 12.0
+
+
+def _cloud_labels(data: ResultData) -> list[tuple]:
+    """[(anchor, text)]: each fracture's name at its contact point of
+    largest |p_T| (fractures whose points lie together share one label,
+    :func:`xfemslip.plot.style.place_labels`)."""
+    out = []
     for f in data.fractures:
         if not f.shear_traction.size:
             continue
         k = int(np.argmax(np.abs(f.shear_traction)))
         at = (float(f.normal_traction[k]), float(abs(f.shear_traction[k])))
-        for place, members in groups:
-            if math.dist(place, at) < 0.03 * width:
-                members.append(f.index)
-                break
-        else:
-            groups.append((at, [f.index]))
-    for at, members in groups:
-        ax.annotate(
-            ("fractures " if len(members) > 1 else "fracture ")
-            + ", ".join(str(i) for i in members),
-            at,
-            textcoords="offset points",
-            xytext=(4, 4),
-            fontsize=7,
-        )
+        out.append((at, str(f.index)))
+    return out
 
 
 # --------------------------------------------------------------------------- #
@@ -580,12 +659,25 @@ def _save_all(out_dir: Path, makers: dict, formats, dpi=DPI) -> list[Path]:
     from xfemslip.io.fileset import replace_files
 
     figures: dict[str, Figure] = {}
+    count = len(makers) * len(formats)
+    done: list[str] = []
 
     def writer(name: str, fmt: str):
         def write(tmp: Path) -> None:
+            start = time.perf_counter()
             if name not in figures:
                 figures[name] = makers[name]()
             figures[name].savefig(tmp, format=fmt, dpi=dpi, bbox_inches="tight")
+            done.append(name)
+            # a large result takes seconds per figure
+            progress.info(
+                "figure %d/%d: %s.%s (%.1f s)",
+                len(done),
+                count,
+                name,
+                fmt,
+                time.perf_counter() - start,
+            )
 
         return write
 
@@ -612,7 +704,7 @@ def plot_screen(
     return _save_all(
         Path(out_dir),
         {
-            "mohr": lambda: _screen_figure(
+            "mohr": lambda: figure_screen(
                 stress, pore_pressure, friction, cohesion, fractures
             )
         },
@@ -620,7 +712,7 @@ def plot_screen(
     )
 
 
-def _screen_figure(stress, pore_pressure, friction, cohesion, fractures) -> Figure:
+def figure_screen(stress, pore_pressure, friction, cohesion, fractures) -> Figure:
     """The Mohr diagram of :func:`plot_screen`."""
     fig = Figure(
         figsize=mohr_figsize(mohr_limits(stress, pore_pressure)), layout="constrained"
@@ -633,13 +725,16 @@ def _screen_figure(stress, pore_pressure, friction, cohesion, fractures) -> Figu
             ax, stress, pore_pressure, fractures=fractures, first=False, circle=False
         )
     else:
-        draw_mohr(ax, stress, pore_pressure, fractures=fractures)
+        pending: list = []
+        draw_mohr(ax, stress, pore_pressure, fractures=fractures, pending=pending)
     ax.set_title(
         f"Mohr-Coulomb screening (pore pressure {pore_pressure / 1e6:g} MPa; "
         "tension positive)",
         fontsize=9,
     )
     add_legend(fig)
+    if fractures and pending:
+        place_labels(ax, pending)
     return fig
 
 

@@ -20,6 +20,7 @@ import numpy as np
 from matplotlib.ticker import FuncFormatter
 
 from xfemslip.conventions import SLIP
+from xfemslip.plot.style import place_labels
 from xfemslip.reference.closed_form import angle_to_sigma1
 from xfemslip.reference.screen import effective_stress, slip_band
 
@@ -77,6 +78,7 @@ def draw_mohr(
     markers: bool = True,
     circle_label: str = "Mohr circle",
     limits=None,
+    pending: list | None = None,
 ) -> None:
     """Draw the circle of ``stress`` (+ p), the failure line of each distinct
     (f, c) of ``fractures`` = [(label, theta [deg], f, c)], the slip band, the
@@ -89,6 +91,9 @@ def draw_mohr(
     in ``color``); ``circle`` and
     ``criterion`` switch off parts already drawn for an earlier result.  The
     caller adds the legend (:func:`add_legend`) once everything is drawn.
+    ``pending``: a list to which the points' labels [(anchor, text)] are
+    added, for the caller to place (:func:`xfemslip.plot.style.place_labels`)
+    once the layout is final; without it they are placed at once.
     """
     eff = effective_stress(stress, pore_pressure)
     dir1 = slip_band(eff, 0.0).dir1
@@ -114,7 +119,11 @@ def draw_mohr(
             ax, eff, f, c, color, len(seen) - 1, limits[0], (centre, radius), slipping
         )
     if markers:
-        _markers(ax, fractures, dir1, centre, radius, color)
+        labels = _markers(ax, fractures, dir1, centre, radius, color)
+        if pending is None:
+            place_labels(ax, labels)
+        else:
+            pending.extend(labels)
     for k, (pn, pt, state) in enumerate(contact):
         slip = np.asarray(state) == SLIP
         for mask, c, what in (
@@ -184,9 +193,11 @@ def _criterion(ax, eff, f, c, color, k, x_left, circle, slipping) -> None:
     )
 
 
-def _markers(ax, fractures, dir1, centre, radius, color) -> None:
-    """Each fracture's plane on the circle, labelled (numbered from
-    NUMBERED_FROM on)."""
+def _markers(ax, fractures, dir1, centre, radius, color) -> list[tuple]:
+    """Each fracture's plane on the circle; numbered labels from
+    NUMBERED_FROM on, else returns the labels [(anchor, text)] to place,
+    fractures at one point sharing one ("fractures[0], fractures[1] (beta =
+    45.0 deg)")."""
     labelled = []
     for label, theta, _, _ in fractures:
         beta = angle_to_sigma1(theta, dir1)
@@ -197,15 +208,17 @@ def _markers(ax, fractures, dir1, centre, radius, color) -> None:
             labelled.append((label, theta, beta))
     if len(labelled) >= NUMBERED_FROM:
         _numbered_labels(ax, centre, radius, labelled, color)
-        return
+        return []
+    groups: dict[float, list[str]] = {}
     for label, _, beta in labelled:
-        ax.annotate(
-            f"{label} ($\\beta$ = {beta:.1f} deg)",
-            _circle_point(centre, radius, beta),
-            textcoords="offset points",
-            xytext=(5, 4),
-            fontsize=7,
+        groups.setdefault(round(beta, 6), []).append(label)
+    return [
+        (
+            tuple(float(v) for v in _circle_point(centre, radius, beta)),
+            f"{', '.join(names)} ($\\beta$ = {beta:.1f} deg)",
         )
+        for beta, names in groups.items()
+    ]
 
 
 def mohr_limits(stress, pore_pressure: float = 0.0, points=()) -> tuple[float, ...]:

@@ -121,16 +121,16 @@ def write_csv(report: Report, path: Path) -> None:
     write_rows(path, [*CSV_FIELDS, "tip"], rows)
 
 
-def write_plot(report: Report, path: Path, fmt: str | None = None) -> None:
-    """Error against h and against wall time (``fmt`` png or pdf; default: by
-    the suffix of ``path``)."""
-    import matplotlib
+def figure_verify(report: Report):
+    """Error against h and against wall time (a matplotlib Figure): log axes
+    with their ticks labelled however short their range, the legends below
+    the panels, over no data."""
+    from matplotlib.figure import Figure
 
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-    import matplotlib.ticker
+    from xfemslip.plot.style import label_log_axis
 
-    fig, (ax1, ax2) = plt.subplots(1, 2, figsize=(11, 4.5))
+    fig = Figure(figsize=(11, 5.2), layout="constrained")
+    ax1, ax2 = fig.subplots(1, 2)
     by: dict[str, list] = {}
     for r in report.rows:
         if r.problem.startswith("stick"):
@@ -154,19 +154,30 @@ def write_plot(report: Report, path: Path, fmt: str | None = None) -> None:
             if r.a_over_h == min(r.a_over_h for r in report.rows)
         )
         ax1.loglog(h_all, e_ref * (h_all / h_all.max()), "k:", label="order 1")
+    ax1.axvline(HALF_LENGTH / TARGET_H, color="grey", lw=0.8)
     for ax in (ax1, ax2):
-        ax.xaxis.set_minor_formatter(matplotlib.ticker.NullFormatter())
         ax.axhline(SLIP_TARGET, color="grey", lw=0.8)
         ax.grid(True, which="both", alpha=0.3)
         ax.set_ylabel("relative error")
-    ax1.axvline(HALF_LENGTH / TARGET_H, color="grey", lw=0.8)
+        ax.autoscale_view()
+        label_log_axis(ax.xaxis)
+        label_log_axis(ax.yaxis)
     ax1.set_xlabel("h [m] (a = 0.5 m; grey: h = a/20, 1 %)")
     ax2.set_xlabel("wall time per run [s] (build + solve, in-process)")
     ax1.set_title("error against mesh size")
     ax2.set_title("slip error against wall time")
-    ax1.legend(fontsize=6, ncol=2)
-    ax2.legend(fontsize=7)
+    for ax, ncol in ((ax1, 3), (ax2, 3)):
+        ax.legend(
+            loc="upper center",
+            bbox_to_anchor=(0.5, -0.16),
+            ncol=ncol,
+            fontsize=7,
+        )
     fig.suptitle(f"xfemslip verify (tip = {report.tip or 'default'})")
-    fig.tight_layout()
-    fig.savefig(path, dpi=110, format=fmt)
-    plt.close(fig)
+    return fig
+
+
+def write_plot(report: Report, path: Path, fmt: str | None = None) -> None:
+    """:func:`figure_verify` into ``path`` (``fmt`` png or pdf; default: by
+    the suffix of ``path``)."""
+    figure_verify(report).savefig(path, dpi=110, format=fmt, bbox_inches="tight")

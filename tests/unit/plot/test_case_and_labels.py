@@ -149,14 +149,10 @@ def test_sweep_parameters_read_with_units():
     assert parameter_label("mystery=abc") == "mystery = abc"
 
 
-def test_slip_vs_depletion_is_titled_by_the_case_and_draws_the_table(
-    tmp_path, monkeypatch
-):
+def test_slip_vs_depletion_is_titled_by_the_case_and_draws_the_table(tmp_path):
     """deplete's slip figure: the case's name in its title, and its lines the
-    report's rows (mm against the pressure drop in MPa)."""
-    import matplotlib.pyplot as plt
-
-    from xfemslip.plot.depletion import plot_slip_vs_depletion
+    report's rows (mm against the pressure drop in MPa); the PNG written."""
+    from xfemslip.plot.depletion import figure_slip_vs_depletion, plot_slip_vs_depletion
     from xfemslip.studies.depletion import DepletionReport, FractureOnset
 
     report = DepletionReport(
@@ -167,14 +163,12 @@ def test_slip_vs_depletion_is_titled_by_the_case_and_draws_the_table(
             (2, 1.0, -20e6, [(2.5e-3, 40.0)]),
         ],
     )
-    kept = []
-    monkeypatch.setattr(plt, "close", kept.append)
     path = plot_slip_vs_depletion(report, tmp_path, name="depleting-reservoir")
-    assert path.is_file()
-    (fig,) = kept
+    assert path.read_bytes()[:4] == b"\x89PNG"
+    fig = figure_slip_vs_depletion(report, name="depleting-reservoir")
     assert fig._suptitle.get_text() == "depleting-reservoir: slip against depletion"
     slip_axes = fig.axes[0]
     x, y = slip_axes.lines[0].get_data()
     assert list(x) == [0.0, 10.0, 20.0] and list(y) == [0.0, 0.0, 2.5]
-    # the bracket's midpoint, 12.5 MPa of drop, as the dotted line
+    # the bracket's midpoint, 12.5 MPa of drop, as the vertical line
     assert slip_axes.lines[1].get_xdata()[0] == 12.5

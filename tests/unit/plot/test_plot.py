@@ -11,7 +11,6 @@ import sys
 from pathlib import Path
 
 import h5py
-import matplotlib
 import numpy as np
 import pytest
 from click.testing import CliRunner
@@ -271,7 +270,8 @@ def test_generated_network_gets_its_slip_mohr_and_network_figures(tmp_path, runn
 
 def test_panels_of_a_study_share_their_colour_scale(two_runs):
     """The columns of one figure compare by colour: each row's panels have
-    the same limits, which span every result's values (MPa and mm)."""
+    the same limits, which span the 1st-99th percentile of every result's
+    stresses (MPa; tips clipped) and all of their displacements (mm)."""
     from xfemslip.plot.figures import figure_displacement, figure_principal
 
     results = [figure_data(out / "result.h5") for out in two_runs]
@@ -281,7 +281,8 @@ def test_panels_of_a_study_share_their_colour_scale(two_runs):
         norms = [ax.collections[0].norm for ax in axes[2 * row : 2 * row + 2]]
         assert norms[0].vmin == norms[1].vmin and norms[0].vmax == norms[1].vmax
         values = np.concatenate([1e-6 * r.principal[:, col] for r in results])
-        assert norms[0].vmin <= values.min() and norms[0].vmax >= values.max()
+        lo, hi = np.percentile(values, [1.0, 99.0])
+        assert norms[0].vmin <= lo + 1e-9 and norms[0].vmax >= hi - 1e-9
     fig = figure_displacement(results)
     panels = fig.axes[:4]
     for row in range(2):
@@ -303,19 +304,9 @@ def test_realization_histogram_has_whole_number_ticks(tmp_path):
     rows += [f"{i:03d},ok,{n},15" for i, n in enumerate([1, 2, 2, 3])]
     summary.write_text("\n".join(rows) + "\n")
     spec = load_case(ROOT / "cases" / "fracture_network.toml")
-    hist = figure_network(spec, None, summary).axes[1]
+    hist = figure_network(spec, None, summary).axes[-1]
     for ticks in (hist.get_xticks(), hist.get_yticks()):
         assert len(ticks) >= 2 and np.all(ticks == np.round(ticks))
-
-
-def test_slip_figure_colours_tell_many_fractures_apart():
-    """One colour per fracture of a network, all different up to any count
-    (the ten-colour cycle repeated from the eleventh)."""
-    from xfemslip.plot.figures import _distinct_colours
-
-    for n in (3, 10, 15, 20, 40):
-        colours = {matplotlib.colors.to_rgba(c) for c in _distinct_colours(n)[:n]}
-        assert len(colours) == n
 
 
 def test_permeability_figure_draws_the_apertures_and_the_ratio(tmp_path, runner):
