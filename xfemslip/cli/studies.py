@@ -256,7 +256,7 @@ def plot(results, case, output, kinds, formats, labels, scale, dpi, debug) -> No
     with reported_errors(debug):
         configure_logging(False, True)  # the warnings; the paths are printed
         # and one line per figure on stderr: a large result takes a minute
-        logging.getLogger("xfemslip.plot.progress").setLevel(logging.INFO)
+        logging.getLogger("xfemslip.plot.figures.progress").setLevel(logging.INFO)
         if case is not None:
             spec = load_case_file(case)
             from xfemslip.plot.case import plot_case

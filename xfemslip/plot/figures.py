@@ -62,7 +62,7 @@ from xfemslip.plot.style import (
 
 logger = logging.getLogger(__name__)
 # one line per figure written; ``xfemslip plot`` shows it even when quiet
-progress = logging.getLogger("xfemslip.plot.progress")
+progress = logging.getLogger("xfemslip.plot.figures.progress")
 
 KINDS = (
     "displacement",

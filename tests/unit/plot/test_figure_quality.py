@@ -452,7 +452,7 @@ def test_plot_logs_one_line_per_figure(depleted, tmp_path, caplog):
     how many, file name and seconds."""
     from xfemslip.plot.figures import plot_results
 
-    with caplog.at_level(logging.INFO, logger="xfemslip.plot.progress"):
+    with caplog.at_level(logging.INFO, logger="xfemslip.plot.figures.progress"):
         plot_results([depleted[0]], tmp_path, kinds=["slip", "mohr"], formats=["png"])
     lines = [r.getMessage() for r in caplog.records if r.name.endswith("progress")]
     heads = [ln.split(": ")[0] for ln in lines]
