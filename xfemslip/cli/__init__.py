@@ -51,4 +51,13 @@ def main() -> None:
     # peak is what memory.py estimates (see configure_allocator)
     memory.configure_allocator()
     interrupt.for_process()
-    cli(prog_name="xfemslip")
+    try:
+        cli(prog_name="xfemslip")
+    except KeyboardInterrupt as exc:
+        # a signal whose Python handler ran while the command was already on
+        # its way out (its SystemExit replaced): the command said what the
+        # folder holds; end with the shell's code, not killed by the signal
+        from xfemslip.cli.common import EXIT_INTERRUPTED, EXIT_TERMINATED
+
+        term = isinstance(exc, interrupt.Terminated)
+        raise SystemExit(EXIT_TERMINATED if term else EXIT_INTERRUPTED) from None
