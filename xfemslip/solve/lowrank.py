@@ -51,7 +51,7 @@ import numpy as np
 import scipy.linalg as sla
 import scipy.sparse as sp
 
-from xfemslip.solve.backward import backward_error_of
+from xfemslip.solve.backward import refined
 from xfemslip.solve.pardiso import MTYPE_SPD, Handle, PardisoError
 
 # Largest number of patch jump rows (2 per patch) of the Schur block: it takes
@@ -258,12 +258,7 @@ class LowRankSystems:
         if self._update is None or not np.array_equal(self._update[0], blocks):
             self._set_tangent(blocks)
         norm = self._norm_bound()
-        x = self._solve(r)
-        err = backward_error_of(self._apply(x) - r, x, r, norm)
-        if not err <= self.max_error and np.isfinite(err):
-            self.stats["refinements"] += 1
-            x = x + self._solve(r - self._apply(x))
-            err = backward_error_of(self._apply(x) - r, x, r, norm)
+        x, err = refined(self._solve, self._apply, r, norm, self.max_error, self.stats)
         if err <= self.max_error:
             self.stats["pardiso_lowrank"] += 1
             return x

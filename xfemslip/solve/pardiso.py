@@ -52,7 +52,7 @@ from pathlib import Path
 import numpy as np
 import scipy.sparse as sp
 
-from xfemslip.solve.backward import backward_error, backward_error_of
+from xfemslip.solve.backward import backward_error, refined
 
 logger = logging.getLogger(__name__)
 
@@ -591,12 +591,7 @@ class SchurSystems:
             self._factor(values)
         assert self._lu is not None
         norm = self._lu[3]
-        x = self._solve(r)
-        err = backward_error_of(self._apply(x) - r, x, r, norm)
-        if not err <= self.max_error and np.isfinite(err):
-            self.stats["refinements"] += 1
-            x = x + self._solve(r - self._apply(x))
-            err = backward_error_of(self._apply(x) - r, x, r, norm)
+        x, err = refined(self._solve, self._apply, r, norm, self.max_error, self.stats)
         if err <= self.max_error:
             self.stats["pardiso_schur"] += 1
             return x

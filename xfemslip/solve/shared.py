@@ -46,7 +46,7 @@ from collections.abc import Iterator
 import numpy as np
 import scipy.sparse as sp
 
-from xfemslip.solve.backward import backward_error_of
+from xfemslip.solve.backward import refined
 
 # The dense Schur complement of m contact dofs takes 8 m^2 bytes and its LU
 # 2/3 m^3 flops per contact tangent; forming it takes m back-solves with
@@ -266,10 +266,5 @@ class SharedSchurSystems:
             self._factor(values)
         assert self._lu is not None
         norm = self._lu[3]
-        x = self._solve(r)
-        err = backward_error_of(self._apply(x) - r, x, r, norm)
-        if not err <= self.max_error and np.isfinite(err):
-            self.stats["refinements"] += 1
-            x = x + self._solve(r - self._apply(x))
-            err = backward_error_of(self._apply(x) - r, x, r, norm)
+        x, err = refined(self._solve, self._apply, r, norm, self.max_error, self.stats)
         return x if err <= self.max_error else None
