@@ -435,7 +435,10 @@ class _Follower:
             try:
                 end = self._bordered(here, a, dc, k)
             except ConvergenceError as err:
-                if size * CUT < opt.min_slip_step:
+                # the step may have been capped below the size (the next
+                # patch to slip): cut what was tried
+                tried = min(size, dc / (self.dc * self._control_scale(here.res)))
+                if tried * CUT < opt.min_slip_step:
                     raise self._error(
                         k,
                         err.iteration,
@@ -443,7 +446,7 @@ class _Follower:
                         f"{err.reason} at the smallest control step "
                         f"({opt.min_slip_step:g} D_c)",
                     ) from None
-                size = max(size * CUT, opt.min_slip_step)
+                size = max(tried * CUT, opt.min_slip_step)
                 logger.info(
                     "continuation step %d: no convergence (%s); control step "
                     "cut to %.3g D_c",
@@ -517,22 +520,28 @@ class _Follower:
         u, lam = u0.copy(), start.lam
         res = c.evaluate(u, s.mode, c.pt_committed, c.gt_committed)
         r, eta = s.residual(u, lam, res)
-        seen: list[bytes] = []  # the stick/slip sets of the iterates
+        seen: list[bytes] = []  # the successive stick/slip sets of the iterates
         for it in range(s.max_it + 1):
-            g = dc - float(a @ (u[free] - u0[free]))
-            if it > 0 and eta <= s.tol and abs(g) <= 1e-12 * abs(dc):
+            du = u[free] - u0[free]
+            g = dc - float(a @ du)
+            if (
+                it > 0
+                and eta <= s.tol
+                and abs(g) <= _constraint_tolerance(a, u[free], u0[free], dc)
+            ):
                 self._check_excursion(start, u, lam, res, dc, k, it, eta)
                 x_f = s.solve_tangent(res, self._load_derivative(res), k, it, eta)
                 return _State(u, lam, res, it, self._slope(a, x_f), x_f)
             if it == s.max_it:
                 break
             regime = remedies.regimes(res.state, res.pt).tobytes()
-            if regime in seen[:-1]:
-                # the set came back after another one: the full steps cycle
-                # between sets around the step's end; a shorter step ends
-                # closer to the start's set
-                raise self._error(k, it, eta, "the stick/slip states cycle")
-            seen.append(regime)
+            if not seen or regime != seen[-1]:
+                if regime in seen:
+                    # the set came back after another one: the full steps
+                    # cycle between sets around the step's end; a shorter
+                    # step ends closer to the start's set
+                    raise self._error(k, it, eta, "the stick/slip states cycle")
+                seen.append(regime)
             tangent = converged if it == 0 and converged.blocks is not None else res
             x_r = s.solve_tangent(tangent, r, k, it, eta)
             x_f = s.solve_tangent(tangent, self._load_derivative(tangent), k, it, eta)
@@ -738,6 +747,17 @@ class _Follower:
             reason=why,
             retryable=retryable,
         )
+
+
+def _constraint_tolerance(a, u, u0, dc) -> float:
+    """Tolerance on the control's residual g = dc - a . (u - u0) (u, u0
+    and a on the free dofs): each bordered update satisfies the linear
+    constraint exactly, so g is round-off, of the order of the machine
+    epsilon times sum |a_i| (|u_i| + |u0_i|) (the whole displacement,
+    which can be far larger than a small control step), or a small
+    fraction of dc where that is larger."""
+    roundoff = 64.0 * np.finfo(float).eps * float(np.abs(a) @ (np.abs(u) + np.abs(u0)))
+    return max(1.0e-12 * abs(dc), roundoff)
 
 
 def _run(mask, j) -> np.ndarray:

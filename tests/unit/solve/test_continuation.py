@@ -208,3 +208,24 @@ def test_injection_nucleates_inside_the_pressurized_stretch():
     with pytest.raises(ConvergenceError):
         solver.equilibrium(solver.completed[-1].u, n.load_factor * (1 + 1e-4), 99, 99)
     model.contact.restore(history)
+
+
+def test_a_small_control_step_on_a_large_displacement_converges():
+    """The bordered update meets the linear constraint a . (u - u0) = dc
+    exactly, so what is left of it is the round-off of the difference of
+    two large displacements: a control step many orders below the
+    displacement must still count as met (the path near a patch about to
+    slip takes such steps)."""
+    from xfemslip.solve.continuation import _constraint_tolerance
+
+    rng = np.random.default_rng(7)
+    for dc in (1e-3, 1e-7, 1e-10, 1e-13):
+        a = rng.uniform(-20.0, 20.0, 500) * (rng.random(500) < 0.1)
+        u0 = rng.uniform(-0.5, 0.5, 500)
+        step = rng.normal(size=500)
+        u = u0 + step * (dc / float(a @ step))
+        g = dc - float(a @ (u - u0))
+        assert abs(g) <= _constraint_tolerance(a, u, u0, dc)
+        # and it is of the order of that round-off: a control missed by a
+        # millionth of a step of 1e-3 m^2 is not met
+        assert _constraint_tolerance(a, u, u0, dc) < 1e-9
