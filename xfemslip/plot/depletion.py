@@ -90,10 +90,14 @@ def figure_slip_vs_depletion(report, name: str | None = None) -> Figure:
     fig = Figure(figsize=(9.0, 4.0), layout="constrained")
     a1, a2 = fig.subplots(1, 2)
     styles = line_styles(len(report.onsets), dashes=True)
+    seismic = False
     for i, onset in enumerate(report.onsets):
         style = {**styles[i], "ms": 3}
         slip = np.array([r[3][i][0] for r in rows]) * 1e3
         length = np.array([r[3][i][1] for r in rows])
+        if np.isfinite(onset.dp_seismic):
+            seismic = True
+            _mark_nucleation(a1, a2, sign * onset.dp_seismic / 1e6, slip, length, style)
         a1.plot(x, slip, label=f"fracture {onset.fracture}", **style)
         jump = sign * onset.dp_critical / 1e6 if np.isfinite(onset.dp_upper) else None
         a2.plot(
@@ -108,8 +112,9 @@ def figure_slip_vs_depletion(report, name: str | None = None) -> Figure:
         )
         for ax in (a1, a2):
             ax.axvline(at, color=colour, lw=1.0, ls=CRITICAL_DASHES[g % 4])
+        singular = all(_onset(report, m).at_singularity for m in members)
         a1.annotate(
-            f"{who}: {at:.3g} MPa",
+            f"{who}: {at:.3g} MPa" + (" (singular point)" if singular else ""),
             (at, 1.0),
             xycoords=("data", "axes fraction"),
             xytext=(-3, -4),
@@ -124,15 +129,50 @@ def figure_slip_vs_depletion(report, name: str | None = None) -> Figure:
     a1.set_ylabel("max |slip| that slid [mm]")
     a2.set_xlabel(xlabel)
     a2.set_ylabel("slipping length [m]")
-    a1.set_title("vertical lines: critical depletion (bisection)", fontsize=9)
+    a1.set_title(
+        "vertical lines: critical depletion (bisection)"
+        + ("\nstars: loss of equilibrium, slip turns seismic" if seismic else ""),
+        fontsize=9,
+    )
     a2.set_title("steps: each length held until the next sample", fontsize=9)
+    # a star at the last sample needs room beside it
+    right = float(x.max()) + (0.04 * span if seismic else 0.0)
     for ax in (a1, a2):
-        ax.set_xlim(min(0.0, float(x.min())), float(x.max()))
+        ax.set_xlim(min(0.0, float(x.min())), right)
         ax.grid(alpha=0.3)
     fig.legend(loc="outside lower center", ncol=min(len(report.onsets), 6), fontsize=8)
     if name:
         fig.suptitle(f"{name}: slip against depletion", fontsize=10)
     return fig
+
+
+def _mark_nucleation(a1, a2, at, slip, length, style) -> None:
+    """A star where the slip of a fracture turns seismic (the last state of
+    the path, at the depletion ``at`` on the axis) on both panels, the
+    value written beside it."""
+    colour = style["color"]
+    for ax, values in ((a1, slip), (a2, length)):
+        ax.plot(
+            [at],
+            [values[-1]],
+            ls="",
+            marker="*",
+            ms=12,
+            color=colour,
+            mec="k",
+            mew=0.5,
+            zorder=5,
+        )
+    a2.annotate(
+        f"seismic at {at:.3g} MPa",
+        (at, length[-1]),
+        xytext=(-8, 0),
+        textcoords="offset points",
+        ha="right",
+        va="center",
+        fontsize=7,
+        color=colour,
+    )
 
 
 def _onset(report, fracture: int):

@@ -243,6 +243,42 @@ def test_slip_vs_depletion_joins_coincident_onsets_and_steps_the_length():
     assert_no_overlap(a1.texts, renderer)
 
 
+def test_slip_vs_depletion_marks_where_the_slip_turns_seismic():
+    """A path that ends at a loss of equilibrium (dp_seismic = -18 MPa, the
+    last sample): a star on the last point of both panels, inside the axes,
+    its value written beside it; no star for a fracture without one."""
+    from xfemslip.plot.depletion import figure_slip_vs_depletion
+    from xfemslip.studies.depletion import DepletionReport, FractureOnset
+
+    seismic = FractureOnset(0, -12e6, -13e6, at_singularity=True)
+    seismic.dp_seismic = -18e6
+    report = DepletionReport(
+        onsets=[seismic, FractureOnset(1, -16e6, -17e6)],
+        rows=[
+            (0, 0.0, 0.0, [(0.0, 0.0)] * 2),
+            (1, 0.5, -10e6, [(0.0, 0.0)] * 2),
+            (2, 0.8, -16e6, [(2e-3, 40.0), (0.0, 0.0)]),
+            (3, 0.9, -18e6, [(6e-3, 90.0), (1e-3, 10.0)]),
+        ],
+    )
+    fig = figure_slip_vs_depletion(report, "case")
+    renderer = drawn(fig)
+    a1, a2 = fig.axes
+    for ax, value in ((a1, 6.0), (a2, 90.0)):
+        stars = [ln for ln in ax.lines if ln.get_marker() == "*"]
+        assert len(stars) == 1
+        np.testing.assert_allclose(stars[0].get_xydata(), [[18.0, value]])
+        assert ax.get_xlim()[1] > 18.0  # room for the star
+    assert [t.get_text() for t in a2.texts] == ["seismic at 18 MPa"]
+    # the first slip of fracture 0 sits at a singular point, and says so
+    assert sorted(t.get_text() for t in a1.texts) == [
+        "fracture 0: 12.5 MPa (singular point)",
+        "fracture 1: 16.5 MPa",
+    ]
+    assert "seismic" in a1.get_title()
+    assert_no_overlap(a2.texts, renderer)
+
+
 def test_depletion_field_bars_fit_their_panels_and_centre_white_on_zero(depleted):
     """Colour bars as high as their equal-aspect panels; the change map
     white at zero (TwoSlopeNorm at 0) and said; the ranges clipped to the
