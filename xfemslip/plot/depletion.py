@@ -98,8 +98,8 @@ def figure_slip_vs_depletion(report, name: str | None = None) -> Figure:
         length = np.array([r[3][i][1] for r in rows])
         (line,) = a1.plot(x, slip, label=f"fracture {onset.fracture}", **style)
         top = int(np.argmax(slip))
-        at = (x[top], slip[top])
-        curves.append((line, line.get_label(), slip[top], at, f"{onset.fracture}"))
+        peak = (x[top], slip[top])
+        curves.append((line, line.get_label(), slip[top], peak, f"{onset.fracture}"))
         jump = sign * onset.dp_critical / 1e6 if np.isfinite(onset.dp_upper) else None
         a2.plot(
             *step_line(x, length, jump), color=style["color"], ls=style["linestyle"]
