@@ -44,6 +44,7 @@ import time
 from pathlib import Path
 
 import h5py
+import mdtable
 import numpy as np
 from xfem_process import timed_run
 
@@ -395,12 +396,26 @@ def pareto_plot(tips, ogs, path: Path, ogs_peer=None) -> None:
     plt.close(fig)
 
 
+def markdown(parts: list[str], runs: int, loads) -> str:
+    """docs/performance/accuracy_vs_time.md: the studies' tables, then how
+    they were measured."""
+    return (
+        "\n\n".join(parts)
+        + "\n"
+        + mdtable.note(
+            f"Times: medians of {runs} runs (in-process: build + solve; `xfemslip "
+            "run`: the whole process, warm caches, h5 output only)",
+            loads,
+        )
+    )
+
+
 def main() -> int:
     global OGS_PYTHON, OGS_SCRIPT
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--runs", type=int, default=3)
     ap.add_argument("--max-aoh", type=int, default=64)
-    ap.add_argument("--markdown", type=Path)
+    mdtable.add_option(ap, "docs/performance/accuracy_vs_time.md")
     ap.add_argument("--plot", type=Path)
     ap.add_argument("--skip", default="", help="comma list of tips,penalty,ogs")
     ap.add_argument("--ogs-python", type=Path, default=OGS_PYTHON)
@@ -415,13 +430,15 @@ def main() -> int:
             f"[{time.perf_counter() - start:7.1f} s] {msg}", file=sys.stderr, flush=True
         )
 
-    parts = []
+    parts, loads = [], [mdtable.load()]
 
     def emit(table):
         parts.append(table)
+        loads.append(mdtable.load())
         print(table + "\n", flush=True)
-        if args.markdown:
-            args.markdown.write_text("\n\n".join(parts) + "\n")
+        if args.markdown:  # after each study, so that a stopped run keeps them
+            args.markdown.parent.mkdir(parents=True, exist_ok=True)
+            args.markdown.write_text(markdown(parts, args.runs, loads))
 
     with tempfile.TemporaryDirectory(prefix="xfemslip-bench-") as tmp:
         work = Path(tmp)

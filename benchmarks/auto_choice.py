@@ -5,6 +5,8 @@ generated fracture networks, by mesh size, fracture count and tip.
     OPENBLAS_NUM_THREADS=1 PYTHONPATH=$PWD python benchmarks/auto_choice.py \
         --mesh 100 --counts 1,10,30,100 --tips ramp,branch [--steps 2] \
         [--runs 2] [--max-systems 8] [--json out.json] [--source dfn|build]
+    python benchmarks/auto_choice.py --merge a.json b.json ... \
+        --markdown docs/performance/auto_choice.md
 
 Case: the 20-realization sweep's network (cases/sweeps/dfn_realizations.toml,
 seed 1, two sets, lengths 0.12-0.4 m) with `count` generated fractures on
@@ -38,6 +40,7 @@ import sys
 import time
 from pathlib import Path
 
+import mdtable
 import scipy.sparse as sp
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -127,6 +130,55 @@ def replay(ns, systems, method: str) -> dict:
     }
 
 
+HEADER = [
+    "network",
+    "cells",
+    "tips",
+    "fractures",
+    "free dofs",
+    "enriched",
+    "band",
+    "systems",
+    "SuperLU",
+    "AMG",
+    "AMG / SuperLU",
+    "SuperLU factorizations",
+    "AMG Krylov its",
+]
+
+
+def markdown(rows: list[dict]) -> str:
+    """The table of docs/performance/auto_choice.md from the rows of one or
+    more runs (their --json files): CPU seconds of the whole sequence of
+    Newton systems, medians of the interleaved replays."""
+    cells = [
+        [
+            r["source"],
+            f"{r['mesh']}²",
+            r["tip"],
+            r["fractures"],
+            f"{r['n_free']:,}",
+            f"{r['enriched_share']:.1%}".replace("%", " %"),
+            f"{r['band_share']:.1%}".replace("%", " %"),
+            f"{r['systems']}{MARK[r['run_finished']]}",
+            f"{r['superlu']:.2f} s",
+            f"{r['amg']:.2f} s",
+            f"{r['ratio']:.2f}",
+            r["superlu_factorizations"],
+            f"{r['amg_krylov']}" + (", fell back" if r["amg_fallbacks"] else ""),
+        ]
+        for r in rows
+    ]
+    replays = sorted({len(r["runs"]["amg"]) for r in rows})
+    loads = [x for r in rows for x in r.get("loads", [])]
+    counts = f"{replays[0]}" + (f"-{replays[-1]}" if len(replays) > 1 else "")
+    how = (
+        "CPU time (process_time, one BLAS thread) of the recorded Newton systems "
+        f"(+: the run was stopped there), median of {counts} interleaved replays"
+    )
+    return mdtable.table(HEADER, cells) + mdtable.note(how, loads)
+
+
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--mesh", type=int, default=100)
@@ -137,6 +189,10 @@ def main(argv=None) -> int:
     ap.add_argument("--max-systems", type=int, default=8)
     ap.add_argument("--json", type=Path)
     ap.add_argument(
+        "--merge", nargs="+", type=Path, help="JSON files to merge (no runs)"
+    )
+    mdtable.add_option(ap, "docs/performance/auto_choice.md")
+    ap.add_argument(
         "--source",
         choices=("dfn", "build"),
         default="dfn",
@@ -144,6 +200,10 @@ def main(argv=None) -> int:
         "seed-6 network (its own stress path, 1 step)",
     )
     args = ap.parse_args(argv)
+    if args.merge:
+        rows = [r for f in args.merge for r in json.loads(f.read_text())]
+        mdtable.write(args.markdown, markdown(rows))
+        return 0
     logging.disable(logging.WARNING)
     rows = []
     print(
@@ -180,6 +240,7 @@ def main(argv=None) -> int:
                 superlu_factorizations=out["superlu"][0]["factorizations"],
                 amg_krylov=out["amg"][0]["krylov"],
                 amg_fallbacks=out["amg"][0]["amg_fallbacks"],
+                loads=[mdtable.load()],
             )
             rows.append(row)
             print(
@@ -194,6 +255,8 @@ def main(argv=None) -> int:
             del ns, systems
             if args.json:
                 args.json.write_text(json.dumps(rows, indent=1))
+    if args.markdown:
+        mdtable.write(args.markdown, markdown(rows))
     return 0
 
 

@@ -31,6 +31,8 @@ import tempfile
 import time
 from pathlib import Path
 
+import mdtable
+
 ROOT = Path(__file__).resolve().parents[1]
 CASE = ROOT / "cases" / "field_section.toml"
 
@@ -154,10 +156,7 @@ def main() -> None:
         f"{time.strftime('%Y-%m-%d')}, load average "
         f"{min(loads):.1f}-{max(loads):.1f}.\n"
     )
-    print(note)
-    if args.markdown:
-        args.markdown.parent.mkdir(parents=True, exist_ok=True)
-        args.markdown.write_text("\n".join(lines) + "\n" + note, encoding="utf-8")
+    mdtable.write(args.markdown, "\n".join(lines) + "\n" + note)
 
 
 if __name__ == "__main__":

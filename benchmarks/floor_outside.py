@@ -39,6 +39,8 @@ import tempfile
 import time
 from pathlib import Path
 
+import mdtable
+
 ROOT = Path(__file__).resolve().parents[1]
 THREAD_VARS = (
     "OPENBLAS_NUM_THREADS",
@@ -204,11 +206,7 @@ def main() -> None:
         f"{min(loads):.1f}-{max(loads):.1f}. default: {_versions(pythons['default'])}; "
         f"mkl: {_versions(pythons['mkl'])}.",
     ]
-    text = "\n".join(lines) + "\n"
-    print(text)
-    if opts.markdown is not None:
-        opts.markdown.parent.mkdir(parents=True, exist_ok=True)
-        opts.markdown.write_text(text)
+    mdtable.write(opts.markdown, "\n".join(lines) + "\n")
 
 
 if __name__ == "__main__":

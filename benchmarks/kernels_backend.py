@@ -3,7 +3,8 @@
 backends (`[solver] kernels`), interleaved, on cases of growing enriched-cell
 work: the measurement behind `kernels.AUTO_NUMPY_MAX_WORK` (the "auto" rule).
 
-    python benchmarks/kernels_backend.py [--runs 3] [--json out.json]
+    python benchmarks/kernels_backend.py [--runs 3] [--only NAME ...] [--json out.json]
+        [--markdown docs/performance/kernels_backend.md]
 
 Each configuration runs in a fresh process with a warm Numba cache and cached
 bytecode (as an installed package has), h5 output only.  Reported: the
@@ -22,6 +23,7 @@ import sys
 import tempfile
 from pathlib import Path
 
+import mdtable
 from xfem_process import timed_run
 
 from xfemslip.case import build
@@ -59,6 +61,46 @@ CONFIGS = {
 }
 
 
+LABELS = {
+    "reservoir 50": "reservoir 50 x 50",
+    "reservoir 100": "reservoir 100 x 100",
+    "reservoir 200": "reservoir 200 x 200",
+    "reservoir 400": "reservoir 400 x 400",
+    "network 80 (shipped)": "shipped 15-fracture network, 80 x 80",
+    "dfn 30 ramp, 50": "30 generated fractures, 50 x 50",
+    "dfn 30 ramp, 100": "30 generated fractures, 100 x 100",
+    "dfn 100 ramp, 200": "100 generated fractures, 200 x 200",
+    "dfn 300 ramp, 400": "300 generated fractures, 400 x 400",
+}
+
+
+def markdown(rows: list[dict], runs: int, loads) -> str:
+    """The table of docs/performance/kernels_backend.md: per case, its
+    enriched-cell work, median wall (CPU) per backend, numpy / numba CPU."""
+    cells = [
+        [
+            LABELS[r["case"]],
+            f"{r['work']:.1e}",
+            f"{r['numpy_wall']:.2f} ({r['numpy_cpu']:.2f})",
+            f"{r['numba_wall']:.2f} ({r['numba_cpu']:.2f})",
+            f"{r['numpy_cpu'] / r['numba_cpu']:.2f}",
+        ]
+        for r in rows
+    ]
+    header = [
+        "case",
+        "enriched-cell work",
+        "numpy: wall (CPU) [s]",
+        "numba: wall (CPU) [s]",
+        "numpy / numba, CPU",
+    ]
+    return mdtable.table(header, cells) + mdtable.note(
+        f"Whole-process `xfemslip run`, h5 output, warm caches, medians of {runs} "
+        "runs, the backends interleaved",
+        loads,
+    )
+
+
 def with_backend(case: dict, backend: str) -> str:
     """Case text with ``[solver] kernels = backend`` and, where the case
     names output formats, result.h5 only."""
@@ -84,7 +126,9 @@ def main() -> int:
     ap.add_argument("--runs", type=int, default=3)
     ap.add_argument("--only", nargs="*", help="configuration names (default: all)")
     ap.add_argument("--json", type=Path)
+    mdtable.add_option(ap, "docs/performance/kernels_backend.md")
     args = ap.parse_args()
+    loads = [mdtable.load()]
     folder = Path(tempfile.mkdtemp(prefix="xfemslip-kernels-"))
     env = dict(
         os.environ,
@@ -111,6 +155,7 @@ def main() -> int:
             row[f"{backend}_wall"] = statistics.median(t[0] for t in times[backend])
             row[f"{backend}_cpu"] = statistics.median(t[1] for t in times[backend])
         rows.append(row)
+        loads.append(mdtable.load())
         print(
             f"| {name} | {row['work']:.3g} | "
             f"{row['numpy_wall']:.2f} ({row['numpy_cpu']:.2f})"
@@ -120,6 +165,7 @@ def main() -> int:
         )
     if args.json:
         args.json.write_text(json.dumps(rows, indent=1))
+    mdtable.write(args.markdown, markdown(rows, args.runs, loads))
     return 0
 
 

@@ -11,6 +11,7 @@ converges in 10 load steps after 59; 200 fractures, the shipped DFN
 realizations' table).  All sizes in MB (1e6 B).
 
     python benchmarks/memory_estimate.py [--only NAME,...] [--timeout 900]
+        [--markdown docs/performance/memory_estimate.md]
 """
 
 from __future__ import annotations
@@ -20,6 +21,8 @@ import os
 import sys
 import tempfile
 from pathlib import Path
+
+import mdtable
 
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))  # tests.support
@@ -66,11 +69,56 @@ INPUTS = {
 }
 
 
+LABELS = {
+    "reservoir": "`reservoir_depletion`",
+    "liu-borja": "`liu_borja_plate`",
+    "network": "`fracture_network`",
+    "depleting": "`depleting_reservoir`",
+    "reservoir-400-steps": "reservoir, 400 load steps",
+    "network-100-steps": "network, 100 load steps",
+    "reservoir-200x200": "reservoir, 200 x 200",
+    "reservoir-300x300": "reservoir, 300 x 300",
+    "dfn-60-30x30": "60 fractures, 30 x 30",
+    "dfn-60-30x30-s14-10": "60 fractures, 30 x 30, seed 14, 10 steps",
+    "dfn-200-50x50": "200 fractures, 50 x 50",
+    "dfn-200-100x100": "200 fractures, 100 x 100",
+}
+
+
+def markdown(rows: list[tuple[str, object, list[float], float]], loads) -> str:
+    """The table of docs/performance/memory_estimate.md: the three estimates
+    and the measured peak of each case, in MB; a run that failed (exit code
+    not 0) is marked, its peak is that of the failed run."""
+    cells = [
+        [LABELS[name] + ("" if code == 0 else f" (exit {code})")]
+        + [f"{e:.0f}" for e in est]
+        + [f"{peak:.0f}"]
+        for name, code, est, peak in rows
+    ]
+    text = mdtable.table(
+        [
+            "case",
+            "from the case",
+            "before the enriched cells",
+            "from the model",
+            "measured peak",
+        ],
+        cells,
+    )
+    return text + mdtable.note(
+        "MB (1e6 B); each case one `xfemslip run` process, its peak resident "
+        "memory (ru_maxrss of that process alone)",
+        loads,
+    )
+
+
 def main() -> int:
     parser = argparse.ArgumentParser()
     parser.add_argument("--only", default=",".join(INPUTS))
     parser.add_argument("--timeout", type=float, default=900.0)
+    mdtable.add_option(parser, "docs/performance/memory_estimate.md")
     opt = parser.parse_args()
+    rows, loads = [], [mdtable.load()]
     os.environ.pop(memory.ENV_LIMIT, None)
     print(
         f"{'case':20s} {'exit':>5s} {'wall':>6s} {'case':>7s} {'enrich':>7s} "
@@ -91,6 +139,9 @@ def main() -> int:
                 f"{est[1] / peak:5.2f} {est[2] / peak:5.2f}",
                 flush=True,
             )
+            rows.append((name, code, est, peak))
+            loads.append(mdtable.load())
+    mdtable.write(opt.markdown, markdown(rows, loads))
     return 0
 
 

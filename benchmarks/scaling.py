@@ -5,7 +5,8 @@ elements = [n, n]) against the floors, whole processes, in the same run.
     MKL_NUM_THREADS=2 OPENBLAS_NUM_THREADS=1 NUMBA_NUM_THREADS=2 \\
     python benchmarks/scaling.py --sizes 50 100 200 400 --runs 3 --json a.json
     python benchmarks/scaling.py --sizes 700 1000 --runs 1 --json b.json
-    python benchmarks/scaling.py --merge a.json b.json --plot scaling.png
+    python benchmarks/scaling.py --merge a.json b.json --plot scaling.png \
+        --markdown docs/performance/scaling.md
 
 Per size, each in its own process (python -c ..., wall time from the parent
 from start to exit, CPU time and peak memory (ru_maxrss) of that child alone,
@@ -42,6 +43,8 @@ import tempfile
 import threading
 import time
 from pathlib import Path
+
+import mdtable
 
 ROOT = Path(__file__).resolve().parents[1]
 CASE = ROOT / "cases" / "reservoir_depletion.toml"
@@ -153,6 +156,7 @@ def measure(sizes, runs, superlu_max, timeout, log):
             for n in sizes:
                 for c in configs[n]:
                     row = child(n, c, work, timeout)
+                    row["load"] = mdtable.load()
                     samples[(n, c)].append(row)
                     log(f"run {k + 1} n={n} {c}: {row}")
     out = []
@@ -166,20 +170,40 @@ def measure(sizes, runs, superlu_max, timeout, log):
             if key in ok[0]:
                 entry[key] = statistics.median(r[key] for r in ok)
         entry["maxrss_mib"] = max(r["maxrss_mib"] for r in ok)
+        entry["loads"] = [r["load"] for r in ok]
+        entry["threads"] = thread_settings()
         out.append(entry)
     return out
 
 
+def thread_settings() -> str:
+    return ", ".join(
+        f"{k}={os.environ.get(k, 'unset')}"
+        for k in ("MKL_NUM_THREADS", "OPENBLAS_NUM_THREADS", "NUMBA_NUM_THREADS")
+    )
+
+
+HEADER = [
+    "n x n",
+    "dofs",
+    "default [s]",
+    "pardiso [s]",
+    "floor PARDISO [s]",
+    "floor SuperLU [s]",
+    "default / floor P",
+    "pardiso / floor P",
+    "default / floor S",
+    "CPU default / pardiso / floor P [s]",
+    "peak RSS default / pardiso / floor P [MiB]",
+]
+
+
 def table(results) -> str:
+    """The table of docs/performance/scaling.md, with its note (runs,
+    threads, machine, the load averages sampled after each child)."""
     by = {(r["n"], r["config"]): r for r in results}
     sizes = sorted({r["n"] for r in results})
-    lines = [
-        "| n x n | dofs | default [s] | pardiso [s] | floor PARDISO [s] | "
-        "floor SuperLU [s] | default / floor P | pardiso / floor P | "
-        "default / floor S | CPU default / pardiso / floor P [s] | "
-        "peak RSS default / pardiso / floor P [MiB] |",
-        "| --- " * 11 + "|",
-    ]
+    rows = []
 
     def g(n, c, key, fmt="{:.2f}"):
         r = by.get((n, c))
@@ -195,20 +219,33 @@ def table(results) -> str:
 
     for n in sizes:
         dofs = next(r["dofs"] for r in results if r["n"] == n and "dofs" in r)
-        lines.append(
-            f"| {n} | {dofs:,} | {g(n, 'default', 'wall')} | "
-            f"{g(n, 'pardiso', 'wall')} | {g(n, 'floor_pardiso', 'wall')} | "
-            f"{g(n, 'floor_superlu', 'wall')} | "
-            f"{ratio(n, 'default', 'floor_pardiso')} | "
-            f"{ratio(n, 'pardiso', 'floor_pardiso')} | "
-            f"{ratio(n, 'default', 'floor_superlu')} | "
-            f"{g(n, 'default', 'cpu', '{:.1f}')} / {g(n, 'pardiso', 'cpu', '{:.1f}')}"
-            f" / {g(n, 'floor_pardiso', 'cpu', '{:.1f}')} | "
-            f"{g(n, 'default', 'maxrss_mib', '{:.0f}')} / "
-            f"{g(n, 'pardiso', 'maxrss_mib', '{:.0f}')} / "
-            f"{g(n, 'floor_pardiso', 'maxrss_mib', '{:.0f}')} |"
+        rows.append(
+            [
+                n,
+                f"{dofs:,}",
+                g(n, "default", "wall"),
+                g(n, "pardiso", "wall"),
+                g(n, "floor_pardiso", "wall"),
+                g(n, "floor_superlu", "wall"),
+                ratio(n, "default", "floor_pardiso"),
+                ratio(n, "pardiso", "floor_pardiso"),
+                ratio(n, "default", "floor_superlu"),
+                f"{g(n, 'default', 'cpu', '{:.1f}')} / "
+                f"{g(n, 'pardiso', 'cpu', '{:.1f}')} / "
+                f"{g(n, 'floor_pardiso', 'cpu', '{:.1f}')}",
+                f"{g(n, 'default', 'maxrss_mib', '{:.0f}')} / "
+                f"{g(n, 'pardiso', 'maxrss_mib', '{:.0f}')} / "
+                f"{g(n, 'floor_pardiso', 'maxrss_mib', '{:.0f}')}",
+            ]
         )
-    return "\n".join(lines)
+    runs = sorted({r["runs"] for r in results if "runs" in r})
+    threads = sorted({r["threads"] for r in results if "threads" in r})
+    loads = [x for r in results for x in r.get("loads", [])]
+    how = (
+        f"Medians of {'/'.join(map(str, runs))} whole processes per configuration, "
+        f"alternated; peak RSS the largest of the runs; {'; '.join(threads)}"
+    )
+    return mdtable.table(HEADER, rows) + mdtable.note(how, loads)
 
 
 def plot(results, path):
@@ -255,6 +292,7 @@ def main() -> int:
     ap.add_argument("--json", help="write the results here")
     ap.add_argument("--merge", nargs="+", help="JSON files to merge (no runs)")
     ap.add_argument("--plot", help="write a log-log plot here")
+    mdtable.add_option(ap, "docs/performance/scaling.md")
     a = ap.parse_args()
     if a.merge:
         results = [r for f in a.merge for r in json.loads(Path(f).read_text())]
@@ -274,7 +312,7 @@ def main() -> int:
         print(f"load after: {os.getloadavg()}", flush=True)
     if a.json:
         Path(a.json).write_text(json.dumps(results, indent=1))
-    print(table(results))
+    mdtable.write(a.markdown, table(results))
     if a.plot:
         plot(results, a.plot)
     return 0

@@ -68,10 +68,10 @@ def case_text(
     patch=None,
     aligned=False,
 ):
-    """xfemslip.reference.peer.case_table on the mesh graded(h, fine, half, growth), with
-    one option changed.  aligned: the crack at 0 degrees (off the mesh lines by
-    (0.3 h, 0.37 h)) under the stress that gives it the same normal and shear
-    traction as the 45-degree crack: (-30, -30, 10) MPa."""
+    """xfemslip.reference.peer.case_table on the mesh graded(h, fine, half,
+    growth), with one option changed.  aligned: the crack at 0 degrees (off the
+    mesh lines by (0.3 h, 0.37 h)) under the stress that gives it the same
+    normal and shear traction as the 45-degree crack: (-30, -30, 10) MPa."""
     case = oc.case_table(
         h, half=half, fine=fine, growth=growth, radius=radius, tip=tip, kn=kn
     )

@@ -213,7 +213,10 @@ def load_steps(quick: bool) -> None:
                 np.max(np.abs(s[0].u - s[4].u)), np.max(np.abs(s[1].u - s[5].u))
             ) / np.max(np.abs(s[0].u))
             stick = all(np.all(r.contact.state == STICK) for r in s[1::2])
-            versus = f"residual slip {resid * 1e3:.3f} mm, unloaded all stick: {stick}, drift {drift:.1e}"
+            versus = (
+                f"residual slip {resid * 1e3:.3f} mm, unloaded all stick: {stick}, "
+                f"drift {drift:.1e}"
+            )
         else:
             versus = "-"
         row(
@@ -255,9 +258,9 @@ def sweep() -> None:
                 ):
                     wrong.append(angle)
             rows.append(
-                f"| angle sweep | f = {f:g}: 0..180 deg, 1-deg steps, reservoir 20x20 | {tangent} "
-                f"| {conv}/181 | {its} (max {itmax}) | {sw} | {cuts}/{frz} | - | slip window (3 deg margin) "
-                f"| misclassified: {wrong or 'none'} |"
+                f"| angle sweep | f = {f:g}: 0..180 deg, 1-deg steps, reservoir 20x20 "
+                f"| {tangent} | {conv}/181 | {its} (max {itmax}) | {sw} | {cuts}/{frz} "
+                f"| - | slip window (3 deg margin) | misclassified: {wrong or 'none'} |"
             )
             print(rows[-1], f"({time.perf_counter() - start:.0f} s)", flush=True)
 
@@ -278,20 +281,23 @@ def main() -> int:
         sweep()
     wall = time.perf_counter() - start
     header = [
-        "| group | case | tangent | converged | Newton iterations | switches | cuts/freezes | max abs(slip) [m] | reference | result vs reference |",
+        "| group | case | tangent | converged | Newton iterations | switches "
+        "| cuts/freezes | max abs(slip) [m] | reference | result vs reference |",
         "| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |",
     ]
     text = "\n".join(
         [
             BEGIN,
-            f"Command: `python benchmarks/stability.py{' --quick' if args.quick else ''}`, "
-            f"{wall / 60:.1f} min on {platform.machine()}, Python {platform.python_version()} "
+            "Command: `python benchmarks/stability.py"
+            f"{' --quick' if args.quick else ''}`, {wall / 60:.1f} min on "
+            f"{platform.machine()}, Python {platform.python_version()} "
             "(shared machine, so the times are not benchmarks).",
             "",
             *header,
             *rows,
             "",
-            "Combinations that do not converge, and why (the ConvergenceError message):",
+            "Combinations that do not converge, and why "
+            "(the ConvergenceError message):",
             "",
             *(failures or ["- none"]),
             END,

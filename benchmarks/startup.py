@@ -1,13 +1,13 @@
 #!/usr/bin/env python3
 """Whole-process wall time of `xfemslip run` on a shipped case: first run after
 install (empty Numba and bytecode caches: a case on the Numba kernels compiles
-them) and warm runs (caches filled).  Medians of several runs; results go to
-docs/performance.md (*Start-up*) by hand, with the machine they were
-measured on.
-`XFEMSLIP_KERNELS=numba python benchmarks/startup.py` forces the Numba kernels
-(a small case gets the NumPy ones: xfemslip.kernels.choose).
+them) and warm runs (caches filled).  Medians of several runs, one
+row per kernel backend (``--kernels auto numba``: "numba" forces the Numba
+kernels through XFEMSLIP_KERNELS; a small case gets the NumPy ones under
+"auto", xfemslip.kernels.choose).
 
     python benchmarks/startup.py [--case cases/reservoir_depletion.toml] [--runs 5]
+        [--kernels auto numba] [--markdown docs/performance/startup.md]
 
 A cold run gets a fresh, empty NUMBA_CACHE_DIR; warm runs share one that a
 first run has filled.  The same holds for Python's bytecode cache
@@ -26,17 +26,26 @@ import sys
 import tempfile
 from pathlib import Path
 
+import mdtable
 from xfem_process import timed_run as run_process
 
 CPU: list[float] = []  # CPU time (user + system) of every timed run, in order
 
 
-def timed_run(case: str, cache_dir: str, out: Path, tree: str | None = None) -> float:
+def timed_run(
+    case: str,
+    cache_dir: str,
+    out: Path,
+    tree: str | None = None,
+    kernels: str = "auto",
+) -> float:
     """Wall time of one `xfemslip run`; its CPU time is appended to CPU.
-    ``tree``: a source tree put first on PYTHONPATH (None: the environment's)."""
+    ``tree``: a source tree put first on PYTHONPATH (None: the environment's);
+    ``kernels``: XFEMSLIP_KERNELS ("auto": the case's own choice)."""
     env = dict(
         os.environ,
         **({"PYTHONPATH": tree} if tree else {}),
+        **({"XFEMSLIP_KERNELS": kernels} if kernels != "auto" else {}),
         NUMBA_CACHE_DIR=cache_dir,
         PYTHONPYCACHEPREFIX=str(Path(cache_dir) / "pycache"),
     )
@@ -46,45 +55,75 @@ def timed_run(case: str, cache_dir: str, out: Path, tree: str | None = None) -> 
     return wall
 
 
+def markdown(case: str, runs: int, rows: dict[str, dict], loads) -> str:
+    """The table of docs/performance/startup.md: per backend, the first run
+    after install and warm runs, medians with (min, max), and warm CPU."""
+
+    def cell(v: list[float]) -> str:
+        return f"{statistics.median(v):.2f} s ({min(v):.2f}, {max(v):.2f})"
+
+    names = {"auto": "auto (the default)", "numba": "numba (forced)"}
+    text = mdtable.table(
+        [
+            "kernels",
+            "first run (empty Numba and bytecode caches)",
+            "warm run",
+            "warm CPU",
+        ],
+        [
+            [
+                names.get(k, k),
+                cell(r["cold"]),
+                cell(r["warm"]),
+                f"{statistics.median(r['warm_cpu']):.2f} s",
+            ]
+            for k, r in rows.items()
+        ],
+    )
+    return text + mdtable.note(
+        f"Whole-process time of `xfemslip run {case}`, medians of {runs} runs "
+        "(min, max)",
+        loads,
+    )
+
+
+def measure(case: str, runs: int, kernels: str, tmp: str) -> dict:
+    out = Path(tmp) / "out"
+    del CPU[:]
+    cold = [
+        timed_run(case, str(Path(tmp) / f"cold{kernels}{i}"), out, kernels=kernels)
+        for i in range(runs)
+    ]
+    warm_cache = str(Path(tmp) / f"warm{kernels}")
+    timed_run(case, warm_cache, out, kernels=kernels)  # fill the cache
+    del CPU[:]
+    warm = [timed_run(case, warm_cache, out, kernels=kernels) for _ in range(runs)]
+    return {"cold": cold, "warm": warm, "warm_cpu": CPU[:]}
+
+
 def main() -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--case", default="cases/reservoir_depletion.toml")
     ap.add_argument("--runs", type=int, default=5)
+    ap.add_argument(
+        "--kernels", nargs="+", default=["auto"], choices=("auto", "numpy", "numba")
+    )
     ap.add_argument(
         "--trees",
         nargs="+",
         help="only warm runs, of each of these source trees (PYTHONPATH) in turn, "
         "interleaved run by run",
     )
+    mdtable.add_option(ap, "docs/performance/startup.md")
     args = ap.parse_args()
     if args.trees:
         return compare(args)
+    rows, loads = {}, [mdtable.load()]
     with tempfile.TemporaryDirectory() as tmp:
-        out = Path(tmp) / "out"
-        cold = [
-            timed_run(args.case, str(Path(tmp) / f"cold{i}"), out)
-            for i in range(args.runs)
-        ]
-        cold_cpu = CPU[:]
-        warm_cache = str(Path(tmp) / "warm")
-        timed_run(args.case, warm_cache, out)  # fill the cache
-        del CPU[:]
-        warm = [timed_run(args.case, warm_cache, out) for _ in range(args.runs)]
-        warm_cpu = CPU[:]
-    print(f"case {args.case}, {args.runs} runs each")
-    print(
-        f"first run (empty caches): median {statistics.median(cold):.2f} s "
-        f"(min {min(cold):.2f}, max {max(cold):.2f})"
-    )
-    print(
-        f"warm run (cached):       median {statistics.median(warm):.2f} s "
-        f"(min {min(warm):.2f}, max {max(warm):.2f})"
-    )
-    print(
-        f"CPU time (user + system): first run median "
-        f"{statistics.median(cold_cpu):.2f} s, warm run median "
-        f"{statistics.median(warm_cpu):.2f} s"
-    )
+        for kernels in args.kernels:
+            rows[kernels] = measure(args.case, args.runs, kernels, tmp)
+            loads.append(mdtable.load())
+    mdtable.write(args.markdown, markdown(args.case, args.runs, rows, loads))
     return 0
 
 

@@ -41,6 +41,8 @@ import tempfile
 import time
 from pathlib import Path
 
+import mdtable
+
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT / "benchmarks"))
 
@@ -182,11 +184,7 @@ def main() -> None:
         f"{platform.processor() or platform.machine()}, {os.cpu_count()} cores, "
         f"load average {min(loads):.1f}-{max(loads):.1f} during the runs.",
     ]
-    text = "\n".join(lines) + "\n"
-    print(text)
-    if opts.markdown is not None:
-        opts.markdown.parent.mkdir(parents=True, exist_ok=True)
-        opts.markdown.write_text(text)
+    mdtable.write(opts.markdown, "\n".join(lines) + "\n")
 
 
 if __name__ == "__main__":

@@ -3,7 +3,8 @@ and where the closed form and the XFEM probabilities agree or differ.
 
 Usage, from the project root::
 
-    python benchmarks/uncertainty.py screen --samples 10000
+    python benchmarks/uncertainty.py screen --samples 10000 \
+        [--markdown docs/performance/uncertainty_screen.md]
     python benchmarks/uncertainty.py xfem --samples 1000 --jobs 2
     python benchmarks/uncertainty.py xfem --samples 1000 --dask 2
     python benchmarks/uncertainty.py compare --samples 200 --jobs 2
@@ -31,6 +32,7 @@ import tempfile
 import time
 from pathlib import Path
 
+import mdtable
 import numpy as np
 
 from xfemslip.studies.reactivation import evaluate_screen, evaluate_xfem
@@ -133,8 +135,10 @@ def _best(fn, repeats=5) -> float:
     return min(times)
 
 
-def screen(samples: int) -> None:
-    """Compute time of the closed form for ``samples`` samples."""
+def screen(samples: int, markdown: Path | None = None) -> None:
+    """Compute time of the closed form for ``samples`` samples; the table
+    goes to ``markdown`` too (docs/performance/uncertainty_screen.md)."""
+    rows, loads = [], [mdtable.load()]
     with tempfile.TemporaryDirectory() as tmp:
         shipped = ROOT / "cases" / "sweeps" / "slip_probability.toml"
         base = (ROOT / "cases" / "depleting_reservoir.toml").as_posix()
@@ -162,11 +166,28 @@ def screen(samples: int) -> None:
                 )
             )
             whole = _best(lambda spec=spec: evaluate_screen(spec))
-            print(
-                f"{label}: {samples} samples: closed form {compute * 1e3:.1f} ms, "
-                f"with counting and sensitivity {whole * 1e3:.1f} ms; "
-                f"loading the file and drawing {load * 1e3:.0f} ms"
-            )
+            rows.append((label, samples, compute, whole, load))
+            loads.append(mdtable.load())
+    mdtable.write(markdown, screen_markdown(rows, loads))
+
+
+def screen_markdown(rows, loads) -> str:
+    """The screen's table: per study, the closed form alone, the whole
+    evaluation (with the counts per level, the Wilson intervals and the
+    Spearman correlations), and loading the file with drawing the samples."""
+    return mdtable.table(
+        [
+            "study",
+            "samples",
+            "closed form [ms]",
+            "whole evaluation [ms]",
+            "loading the file, drawing [ms]",
+        ],
+        [
+            [label, f"{n:,}", f"{c * 1e3:.1f}", f"{w * 1e3:.1f}", f"{ld * 1e3:.0f}"]
+            for label, n, c, w, ld in rows
+        ],
+    ) + mdtable.note("Best of 5 after a warm-up, in one process", loads)
 
 
 def xfem(samples: int, jobs: int, dask: int) -> None:
@@ -262,9 +283,10 @@ def main() -> None:
     ap.add_argument("--samples", type=int, default=None)
     ap.add_argument("--jobs", type=int, default=2)
     ap.add_argument("--dask", type=int, default=0, help="LocalCluster workers")
+    mdtable.add_option(ap, "docs/performance/uncertainty_screen.md (screen)")
     opts = ap.parse_args()
     if opts.what == "screen":
-        screen(opts.samples or 10_000)
+        screen(opts.samples or 10_000, opts.markdown)
     elif opts.what == "xfem":
         xfem(opts.samples or 1000, opts.jobs, opts.dask)
     else:

@@ -131,3 +131,13 @@ def assert_legend_covers_no_point(legend, axes, renderer) -> None:
         assert not under.any(), (
             f"the legend covers {int(under.sum())} data points of {ax.get_title()!r}"
         )
+
+
+def assert_legend_inside(legend, ax, renderer, most: int = 6) -> None:
+    """The legend lies within the box of ``ax``, has at most ``most``
+    entries, and covers no data point of ``ax``."""
+    box, frame = legend.get_window_extent(renderer), ax.bbox
+    assert frame.x0 - 0.5 <= box.x0 and box.x1 <= frame.x1 + 0.5, "legend beside"
+    assert frame.y0 - 0.5 <= box.y0 and box.y1 <= frame.y1 + 0.5, "legend above/below"
+    assert len(legend.get_texts()) <= most, [t.get_text() for t in legend.get_texts()]
+    assert_legend_covers_no_point(legend, [ax], renderer)

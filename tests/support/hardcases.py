@@ -134,6 +134,9 @@ def measure(argv, timeout, log) -> tuple[int | str, float, float, list[str]]:
     """(exit code or 'timeout', wall [s], peak RSS [MB], output lines) of a
     command killed after ``timeout`` s; stdout and stderr go to the file
     ``log``, the peak to ``log`` + '.peak'."""
+    # The peak comes from getrusage in a wrapper around the command, not
+    # from psutil (not a dependency): psutil reads a process's current
+    # resident memory while it runs, not its peak after it has exited.
     peak_file = f"{log}.peak"
     wrapped = [sys.executable, "-c", _PEAK_WRAPPER, peak_file, *argv]
     start = time.perf_counter()

@@ -178,6 +178,11 @@ def simplify(
     least min_segment * h from their neighbours in it.  The end points are
     always kept.
     """
+    # Not a library's simplification: the tolerance here varies along the
+    # line with the local cell size, and the shortest segment is a
+    # constraint; matplotlib's Path simplification works to one tolerance in
+    # display pixels for drawing, and shapely (which has Douglas-Peucker
+    # with one tolerance) is not a dependency.
     pts = np.asarray(points, float)
     h = np.asarray(cell_size, float)
     lengths = np.linalg.norm(np.diff(pts, axis=0), axis=1)

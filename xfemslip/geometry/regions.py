@@ -40,6 +40,11 @@ def in_polygon(xy: np.ndarray, polygon: np.ndarray) -> np.ndarray:
     chunks: the work follows the number of edges a horizontal line meets, not
     points x edges.
     """
+    # matplotlib.path.Path.contains_points (a dependency) gives the same
+    # answer off the edges (tests/unit/geometry/test_regions_polygon.py) but
+    # tests every point against every edge: 11 times slower for 100,000
+    # points in a polygon of 5,000 or 50,000 vertices (a digitised outline),
+    # faster only for a few edges, where either takes well under a second.
     xy = np.asarray(xy, float).reshape(-1, 2)
     P = np.asarray(polygon, float)
     Q = np.roll(P, -1, axis=0)

@@ -16,6 +16,7 @@ from xfemslip.conventions import SLIP
 from xfemslip.geometry.regions import edges
 from xfemslip.plot.style import (
     colourbar_label,
+    legend_of_many,
     line_styles,
     pressure_change_axis,
     robust_norm,
@@ -91,6 +92,7 @@ def figure_slip_vs_depletion(report, name: str | None = None) -> Figure:
     a1, a2 = fig.subplots(1, 2)
     styles = line_styles(len(report.onsets), dashes=True)
     seismic = False
+    curves = []  # (handle, label, largest slip, its point on a1, number)
     for i, onset in enumerate(report.onsets):
         style = {**styles[i], "ms": 3}
         slip = np.array([r[3][i][0] for r in rows]) * 1e3
@@ -98,7 +100,10 @@ def figure_slip_vs_depletion(report, name: str | None = None) -> Figure:
         if np.isfinite(onset.dp_seismic):
             seismic = True
             _mark_nucleation(a1, a2, sign * onset.dp_seismic / 1e6, slip, length, style)
-        a1.plot(x, slip, label=f"fracture {onset.fracture}", **style)
+        (line,) = a1.plot(x, slip, label=f"fracture {onset.fracture}", **style)
+        top = int(np.argmax(slip))
+        peak = (x[top], slip[top])
+        curves.append((line, line.get_label(), slip[top], peak, f"{onset.fracture}"))
         jump = sign * onset.dp_critical / 1e6 if np.isfinite(onset.dp_upper) else None
         a2.plot(
             *step_line(x, length, jump), color=style["color"], ls=style["linestyle"]
@@ -140,7 +145,10 @@ def figure_slip_vs_depletion(report, name: str | None = None) -> Figure:
     for ax in (a1, a2):
         ax.set_xlim(min(0.0, float(x.min())), right)
         ax.grid(alpha=0.3)
-    fig.legend(loc="outside lower center", ncol=min(len(report.onsets), 6), fontsize=8)
+    # in the length panel (the critical depletions are annotated along the
+    # top of the slip panel), over no point; beyond six entries the smaller
+    # fractures are numbered on their slip curves
+    legend_of_many(a2, curves, fontsize=7, label_ax=a1)
     if name:
         fig.suptitle(f"{name}: slip against depletion", fontsize=10)
     return fig

@@ -55,6 +55,7 @@ from xfemslip.plot.permeability import figure_permeability
 from xfemslip.plot.profile import figure_profile
 from xfemslip.plot.style import (
     colourbar_label,
+    legend_of_many,
     line_styles,
     place_labels,
     robust_norm,
@@ -354,6 +355,7 @@ def figure_slip(results: Sequence[ResultData]) -> Figure:
     ax = fig.subplots()
     many = len(results) if len(results) > 1 else max(len(results[0].fractures), 1)
     styles = line_styles(many)
+    curves = []  # (line, label, largest slip, its point, number) per curve
     for k, data in enumerate(results):
         for fr in data.fractures:
             # the title names the case: one result's fractures by number
@@ -371,6 +373,10 @@ def figure_slip(results: Sequence[ResultData]) -> Figure:
             (line,) = ax.plot(
                 s, mm, lw=1.4, color=colour, ls=style["linestyle"], label=label
             )
+            if mm.size:
+                top = int(np.argmax(mm))
+                number = f"{fr.index}" if len(results) == 1 else f"{k}:{fr.index}"
+                curves.append((line, label, mm[top], (s[top], mm[top]), number))
             ax.plot(s, 1e3 * np.abs(fr.slip), lw=0.7, ls=(0, (2, 2)), color=colour)
             in_slip = fr.state == SLIP
             ax.plot(s[in_slip], mm[in_slip], ".", ms=3, color=line.get_color())
@@ -381,11 +387,9 @@ def figure_slip(results: Sequence[ResultData]) -> Figure:
         f"{names}\nslip along the fracture (dots: points in slip)", fontsize=10
     )
     ax.grid(alpha=0.3)
-    entries = sum(len(data.fractures) for data in results)
-    if entries > 6:  # beside the axes, not over the curves
-        ax.legend(fontsize=7, loc="upper left", bbox_to_anchor=(1.01, 1.0))
-    else:
-        ax.legend(fontsize=8)
+    # inside the axes, over no curve; beyond six entries the smaller curves
+    # are numbered at their largest slip
+    legend_of_many(ax, curves, fontsize=7 if len(curves) > 3 else 8)
     return fig
 
 

@@ -16,7 +16,10 @@ not cover each other or the lines they name.
   decade (matplotlib labels only the powers of ten by default);
 - :func:`place_labels`: text labels at anchor points, those at one point
   joined into one ("0, 1, 2"), each moved to the first nearby place where it
-  covers no other label and no line to avoid.
+  covers no other label and no line to avoid;
+- :func:`legend_of_many`: a legend of at most :data:`MAX_LEGEND_ENTRIES`
+  inside the axes, over no data (the y range is raised to leave it a free
+  band), the curves beyond it numbered where they end.
 """
 
 from __future__ import annotations
@@ -37,6 +40,8 @@ MARKERS = ("o", "s", "^", "D", "v", "P", "X")
 # magnitude (1st-99th percentile), so a nearly uniform field looks uniform
 MIN_SPAN_FRACTION = 0.1
 PERCENTILES = (1.0, 99.0)
+# entries of a legend inside the axes; more curves are numbered on the axes
+MAX_LEGEND_ENTRIES = 6
 
 
 def line_styles(n: int, dashes: bool = False) -> list[dict]:
@@ -292,3 +297,86 @@ def place_labels(
         placed.append(best.get_window_extent(renderer))
         notes.append(best)
     return notes
+
+
+def _line_data(ax) -> np.ndarray:
+    """(N, 2) data coordinates of the vertices of the lines drawn in data
+    coordinates (axvline and axhline left out)."""
+    pts = [
+        np.column_stack(line.get_data()).astype(float)
+        for line in ax.get_lines()
+        if line.get_visible() and line.get_transform() is ax.transData
+    ]
+    pts = [p for p in pts if p.size]
+    return np.concatenate(pts) if pts else np.zeros((0, 2))
+
+
+def legend_inside(ax, handles, labels, *, loc: str = "upper left", **kwargs):
+    """A legend inside ``ax`` at ``loc`` (an upper corner) that covers no data
+    point: after the layout, the top of the y range is raised until the
+    highest point of every line lies below the legend's lower edge."""
+    legend = ax.legend(handles, labels, loc=loc, **kwargs)
+    fig = ax.figure
+    renderer = renderer_of(fig)
+    for _ in range(4):  # the layout moves a little with the tick labels
+        fig.draw_without_rendering()
+        box, frame = legend.get_window_extent(renderer), ax.bbox
+        data = _line_data(ax)
+        if data.size == 0:
+            break
+        px = ax.transData.transform(data)
+        under = (px[:, 0] >= box.x0 - 2.0) & (px[:, 0] <= box.x1 + 2.0)
+        under &= (px[:, 1] >= box.y0 - 2.0) & (px[:, 1] <= box.y1 + 2.0)
+        if not under.any():
+            break
+        # the data below the legend: their top at this share of the height
+        free = (box.y0 - frame.y0) / frame.height - 0.03
+        y0, y1 = ax.get_ylim()
+        top = float(np.nanmax(data[:, 1]))
+        if free <= 0.1 or not math.isfinite(top) or top <= y0:
+            break
+        ax.set_ylim(y0, max(y0 + (top - y0) / free, y1 * (1.0 + 1e-6)))
+    return legend
+
+
+def legend_of_many(
+    ax,
+    curves: Sequence[tuple[object, str, float, tuple[float, float], str]],
+    *,
+    fontsize: float = 8,
+    loc: str = "upper left",
+    label_ax=None,
+):
+    """A legend for many curves: at most :data:`MAX_LEGEND_ENTRIES` entries
+    inside ``ax`` over no data (:func:`legend_inside`).
+
+    ``curves``: (handle, label, size, end, number) per curve; ``size`` ranks
+    them (e.g. the largest slip), ``end`` is a point (data) of the curve on
+    ``label_ax`` (default ``ax``) where its ``number`` is written when the
+    curve has no legend entry.  With more curves than entries, the largest
+    MAX_LEGEND_ENTRIES - 1 keep theirs (in their order) and the last entry
+    says how many more are numbered on their curves (:func:`place_labels`,
+    in the axes, off each other and the legend)."""
+    from matplotlib.lines import Line2D
+
+    if len(curves) <= MAX_LEGEND_ENTRIES:
+        keep, rest = list(range(len(curves))), []
+    else:
+        ranked = sorted(range(len(curves)), key=lambda i: -curves[i][2])
+        keep = sorted(ranked[: MAX_LEGEND_ENTRIES - 1])
+        rest = sorted(ranked[MAX_LEGEND_ENTRIES - 1 :])
+    handles = [curves[i][0] for i in keep]
+    labels = [curves[i][1] for i in keep]
+    if rest:
+        handles.append(Line2D([], [], color="none"))
+        labels.append(f"{len(rest)} more: numbered on their curves")
+    legend = legend_inside(ax, handles, labels, loc=loc, fontsize=fontsize)
+    if rest:
+        target = label_ax if label_ax is not None else ax
+        place_labels(
+            target,
+            [(curves[i][3], curves[i][4]) for i in rest],
+            join_within=6.0,
+            fontsize=7,
+        )
+    return legend

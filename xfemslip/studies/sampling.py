@@ -128,6 +128,13 @@ class Distribution:
 
 def unit_samples(n: int, d: int, method: str, rng: np.random.Generator) -> np.ndarray:
     """(n, d) points in [0, 1): "lhs" (Latin hypercube) or "monte_carlo"."""
+    # The construction of scipy.stats.qmc.LatinHypercube (a uniform offset
+    # in each stratum, strata paired by independent permutations), but
+    # drawing from the generator in this order: a sweep file's seed promises
+    # the same samples (docs/sweep-format.md), and a study run again reads
+    # back the sample folders it wrote, so the stream must not change with
+    # scipy's.  tests/unit/studies/test_sampling.py checks both have one
+    # sample per stratum of every input.
     if method == "monte_carlo":
         return rng.random((n, d))
     if method != "lhs":
@@ -225,6 +232,11 @@ def wilson_interval(k, n, confidence: float = 0.95):
     when it is inverted for p, which stays inside [0, 1] and keeps its
     coverage near 0 and 1 (where the plain p +- z sqrt(p(1-p)/n) collapses).
     """
+    # scipy.stats.binomtest(k, n).proportion_ci(method="wilson") gives the
+    # same bounds (to 1e-15, tests/unit/studies/test_sampling.py) for one
+    # integer k at a time; here k is an array (every level of a study, and
+    # the non-integer k = p n of wilson_samples_needed), about 1e4 times
+    # faster than a loop of binomtest calls.
     k = np.asarray(k, float)
     z = float(special.ndtri(0.5 + confidence / 2.0))
     p = k / n

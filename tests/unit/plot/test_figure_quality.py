@@ -18,6 +18,7 @@ from matplotlib.colors import TwoSlopeNorm
 
 from tests.support.figure_checks import (
     assert_legend_covers_no_point,
+    assert_legend_inside,
     assert_limits_span,
     assert_no_overlap,
     assert_off_lines,
@@ -239,7 +240,13 @@ def test_slip_vs_depletion_joins_coincident_onsets_and_steps_the_length():
         assert_ticks_labelled(ax)
         assert_limits_span(ax, "x", [0.0, 20.0], slack=1.0)
         assert "drop" in ax.get_xlabel()
-    assert_legend_covers_no_point(fig.legends[0], fig.axes, renderer)
+    assert_legend_inside(a2.get_legend(), a2, renderer)
+    assert [t.get_text() for t in a2.get_legend().get_texts()] == [
+        "fracture 0",
+        "fracture 1",
+        "fracture 2",
+    ]
+    assert not fig.legends
     assert_no_overlap(a1.texts, renderer)
 
 
@@ -277,6 +284,90 @@ def test_slip_vs_depletion_marks_where_the_slip_turns_seismic():
     ]
     assert "seismic" in a1.get_title()
     assert_no_overlap(a2.texts, renderer)
+
+
+def _many_onsets(count: int):
+    """A depletion report of ``count`` fractures, fracture i slipping from
+    5 + i MPa with a largest slip of (i + 1) mm and a length of i + 1 m."""
+    from xfemslip.studies.depletion import DepletionReport, FractureOnset
+
+    onsets = [FractureOnset(i, -(5 + i) * 1e6, -(6 + i) * 1e6) for i in range(count)]
+    rows = [
+        (
+            k,
+            k / 10,
+            -2e6 * k,
+            [
+                ((i + 1) * 1e-3 if 2 * k > 5 + i else 0.0, float(i + 1))
+                for i in range(count)
+            ],
+        )
+        for k in range(11)
+    ]
+    return DepletionReport(onsets=onsets, rows=rows)
+
+
+@pytest.mark.parametrize("count", [3, 6, 7, 15])
+def test_slip_vs_depletion_legend_inside_with_six_entries_at_most(count):
+    """With many fractures the legend stays inside its panel, over no point,
+    with six entries: the five largest slips and "n more", whose fracture
+    numbers are written on the slip panel, apart from each other."""
+    from xfemslip.plot.depletion import figure_slip_vs_depletion
+
+    fig = figure_slip_vs_depletion(_many_onsets(count), "case")
+    renderer = drawn(fig)
+    a1, a2 = fig.axes
+    legend = a2.get_legend()
+    assert_legend_inside(legend, a2, renderer)
+    entries = [t.get_text() for t in legend.get_texts()]
+    if count <= 6:
+        assert entries == [f"fracture {i}" for i in range(count)]
+        return
+    largest = [f"fracture {i}" for i in range(count - 5, count)]
+    assert entries == [*largest, f"{count - 5} more: numbered on their curves"]
+    numbers = [t for t in a1.texts if ":" not in t.get_text()]
+    written = sorted(int(n) for t in numbers for n in t.get_text().split(", "))
+    assert written == list(range(count - 5))
+    assert_no_overlap(numbers, renderer)
+    assert_limits_span(a1, "y", [0.0, float(count)], slack=1.5)
+
+
+@pytest.mark.parametrize("count", [1, 4, 15])
+def test_slip_along_fractures_legend_inside_with_six_entries_at_most(count):
+    """figure_slip of a network of ``count`` fractures: the legend inside
+    the axes over no point, at most six entries, the others' numbers at
+    their largest slip."""
+    from types import SimpleNamespace
+
+    from xfemslip.plot.figures import figure_slip
+
+    s = np.linspace(0.0, 2.0, 41)
+    fractures = [
+        SimpleNamespace(
+            index=i,
+            s=s,
+            slid=(i + 1) * 1e-3 * np.sqrt(np.clip(1 - (s - 1) ** 2, 0, None)),
+            slip=(i + 1.1) * 1e-3 * np.sqrt(np.clip(1 - (s - 1) ** 2, 0, None)),
+            state=np.full(s.size, 2),
+        )
+        for i in range(count)
+    ]
+    data = SimpleNamespace(fractures=fractures, label="net", name="net")
+    fig = figure_slip([data])
+    renderer = drawn(fig)
+    (ax,) = fig.axes
+    assert_legend_inside(ax.get_legend(), ax, renderer)
+    entries = [t.get_text() for t in ax.get_legend().get_texts()]
+    if count == 1:
+        assert entries == ["net"]
+    elif count <= 6:
+        assert entries == [f"fracture {i}" for i in range(count)]
+    else:
+        assert entries[:5] == [f"fracture {i}" for i in range(count - 5, count)]
+        assert entries[5] == f"{count - 5} more: numbered on their curves"
+        written = sorted(int(n) for t in ax.texts for n in t.get_text().split(", "))
+        assert written == list(range(count - 5))
+        assert_no_overlap(ax.texts, renderer)
 
 
 def test_depletion_field_bars_fit_their_panels_and_centre_white_on_zero(depleted):

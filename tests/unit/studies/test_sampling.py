@@ -188,3 +188,44 @@ def test_wilson_samples_needed_is_the_fewest_that_reach_the_half_width():
             lo1, hi1 = wilson_interval(pi * (ni - 1), ni - 1, conf)
             assert (hi - lo) / 2 <= hw < (hi1 - lo1) / 2
         assert n[0] == n[-1] > 1  # P = 0 still needs samples to be sure of it
+
+
+@pytest.mark.parametrize("confidence", [0.5, 0.8, 0.9, 0.95, 0.99, 0.999])
+def test_wilson_interval_is_scipys(confidence):
+    """Against scipy.stats.binomtest(k, n).proportion_ci(method="wilson") for
+    every k of small n and a spread of k for large n (the array form is the
+    one the studies call)."""
+    for n in (1, 2, 3, 7, 20, 101, 1000, 20000):
+        k = np.unique(np.linspace(0, n, min(n + 1, 41)).round().astype(int))
+        lo, hi = wilson_interval(k, n, confidence)
+        for ki, l_i, h_i in zip(k, lo, hi, strict=True):
+            ref = stats.binomtest(int(ki), n).proportion_ci(
+                confidence_level=confidence, method="wilson"
+            )
+            assert l_i == pytest.approx(ref.low, abs=1e-14), (ki, n)
+            assert h_i == pytest.approx(ref.high, abs=1e-14), (ki, n)
+
+
+def test_latin_hypercube_is_stratified_like_scipys_qmc():
+    """The construction of scipy.stats.qmc.LatinHypercube, from another
+    stream: both put one sample in each of the n strata of every input, the
+    offsets inside the strata are uniform (Kolmogorov-Smirnov over many
+    draws), and the strata of two inputs are paired independently (the rank
+    correlation of the pairs is centred on 0 with the spread of random
+    pairings, 1 / sqrt(n - 1))."""
+    n, d, draws = 40, 3, 400
+    ours = [unit_samples(n, d, "lhs", np.random.default_rng(s)) for s in range(draws)]
+    ref = [stats.qmc.LatinHypercube(d, seed=s).random(n) for s in range(draws)]
+    for samples in (ours, ref):
+        for u in samples:
+            for j in range(d):
+                assert sorted(np.floor(u[:, j] * n).astype(int)) == list(range(n))
+        offsets = np.concatenate([(u * n % 1.0).ravel() for u in samples])
+        assert stats.kstest(offsets, "uniform").pvalue > 1e-3
+        rho = np.array([stats.spearmanr(u[:, 0], u[:, 1]).statistic for u in samples])
+        assert abs(rho.mean()) < 4 / math.sqrt((n - 1) * draws)
+        assert rho.std() == pytest.approx(1 / math.sqrt(n - 1), rel=0.15)
+    # the two offset samples come from one distribution
+    a = np.concatenate([(u * n % 1.0).ravel() for u in ours])
+    b = np.concatenate([(u * n % 1.0).ravel() for u in ref])
+    assert stats.ks_2samp(a, b).pvalue > 1e-3
