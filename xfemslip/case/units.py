@@ -206,6 +206,34 @@ def _local_size(grid, point) -> float:
     return max(sizes)
 
 
+def _near_fractures(P, fractures, grid) -> np.ndarray:
+    """Indices (ascending) of the closed polygon P's edges that may lie
+    within SNAP_CELLS local cell sizes of a fracture's line, and their
+    neighbours (snapping an edge moves both its ends): a vectorised sieve
+    of the per-edge test, twice as wide, so that a polygon of many
+    thousand edges is not tested edge by edge against every segment."""
+    Q = np.roll(P, -1, axis=0)
+    mid = 0.5 * (P + Q)
+    size = np.zeros(len(P))
+    for axis, v in ((grid.mesh.x, mid[:, 0]), (grid.mesh.y, mid[:, 1])):
+        k = np.clip(np.searchsorted(axis, v) - 1, 0, axis.size - 2)
+        size = np.maximum(size, axis[k + 1] - axis[k])
+    tol = 2.0 * SNAP_CELLS * size
+    near = np.zeros(len(P), bool)
+    for fr in fractures:
+        F = np.asarray(fr.points, float)
+        for a, b in zip(F[:-1], F[1:], strict=True):
+            L = float(np.hypot(*(b - a)))
+            t = (b - a) / L
+            n = np.array([-t[1], t[0]])
+            dp, dq = np.abs((P - a) @ n), np.abs((Q - a) @ n)
+            sp, sq = (P - a) @ t, (Q - a) @ t
+            along = (np.maximum(sp, sq) >= -tol) & (np.minimum(sp, sq) <= L + tol)
+            near |= (np.maximum(dp, dq) <= tol) & along
+    hit = np.nonzero(near)[0]
+    return np.unique(np.concatenate([hit - 1, hit, hit + 1]) % len(P))
+
+
 def _nearest_line(fractures, p, q, tol):
     """(fracture index, distance, a point on its line, its unit tangent) of
     the first fracture segment whose line passes within ``tol`` of both p and
@@ -261,7 +289,7 @@ def snap_to_fractures(region: RegionSpec, fractures, grid):
         names = [f"polygon edge {i}" for i in range(len(P))]
     k = len(P)
     moved = []
-    for i in range(k):
+    for i in _near_fractures(P, fractures, grid):
         j = (i + 1) % k
         tol = SNAP_CELLS * _local_size(grid, 0.5 * (P[i] + P[j]))
         hit = _nearest_line(fractures, P[i], P[j], tol)
