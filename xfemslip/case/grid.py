@@ -89,6 +89,12 @@ def check_element_count(nx: int, ny: int, key: str, problems: list) -> bool:
     return False
 
 
+# The narrowest cell of an explicit axis, as a share of the mesh's extent:
+# the geometry's tolerances scale with the cell sizes, and below this the
+# ratio of extent to tolerance leaves float64.
+MIN_CELL_SHARE = 1.0e-9
+
+
 def _read_axis(mesh: Table, name: str) -> np.ndarray | None:
     """``mesh.x`` or ``mesh.y``: >= 2 strictly increasing finite numbers."""
     found, value = mesh._get(
@@ -114,6 +120,19 @@ def _read_axis(mesh: Table, name: str) -> np.ndarray | None:
             f"{name}[{i}]",
             f"must be > {name}[{i - 1}] = {exact(coords[i - 1])} "
             f"(strictly increasing), got {exact(coords[i])}",
+        )
+        return None
+    span = float(coords[-1] - coords[0])
+    with np.errstate(over="ignore"):
+        thin = np.flatnonzero(np.diff(coords) < MIN_CELL_SHARE * span)
+    if thin.size:
+        i = int(thin[0]) + 1
+        mesh.error(
+            f"{name}[{i}]",
+            f"the cell from {name}[{i - 1}] = {exact(coords[i - 1])} to "
+            f"{exact(coords[i])} is narrower than {MIN_CELL_SHARE:g} of the "
+            f"mesh's extent ({span:g} m): the geometry's tolerances cannot "
+            "resolve it",
         )
         return None
     return coords

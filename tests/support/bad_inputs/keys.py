@@ -43,6 +43,8 @@ MUTATIONS = {
     "int-beyond-float": None,  # written as text: 10**400 as a TOML integer
 }
 NON_NUMBERS = ("string", "bool", "table", "array", "empty-array")
+# keys whose table form has a number form too (a friction law or a constant)
+NUMBER_OR_TABLE = ("friction",)
 NOT_FINITE = ("nan", "inf", "-inf", "int-beyond-float")
 
 
@@ -91,7 +93,12 @@ def mutate(doc: dict, path: tuple, mutation: str) -> tuple[str, tuple]:
     must = ()
     if number and (mutation in NON_NUMBERS or not_finite):
         must = (key_name(path),)
-    elif not number and new_kind == "number" and not isinstance(old, list):
+    elif (
+        not number
+        and new_kind == "number"
+        and not isinstance(old, list)
+        and path[-1] not in NUMBER_OR_TABLE
+    ):
         must = (key_name(path),)
     return text, must
 

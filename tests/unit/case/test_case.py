@@ -519,6 +519,23 @@ def test_x_without_y_and_non_increasing_x(tmp_path):
     )
 
 
+@pytest.mark.parametrize("width", [1e-300, 5e-10, 9.9e-10])
+def test_a_cell_too_thin_for_the_geometry_is_refused(tmp_path, width):
+    """A cell narrower than 1e-9 of the mesh's extent (1 m here) is named
+    (the geometry's tolerances follow the cell sizes: 1e-300 m overflowed
+    them); one of 1e-8 m is kept."""
+    fracture = {**BASE["fractures"][0], "points": [[0.25, 0.5], [0.75, 0.5]]}
+
+    def doc(x):
+        return base(domain=None, mesh={"x": x, "y": [0.0, 1.0]}, fractures=[fracture])
+
+    err = error_of(tmp_path, doc([0.0, width, 0.5, 1.0]))
+    assert "narrower than 1e-09 of the mesh's extent (1 m)" in messages(
+        err, "mesh.x[1]"
+    )
+    assert load_case(write(tmp_path, doc([0.0, 1e-8, 0.5, 1.0]))).mesh.x[1] == 1e-8
+
+
 def test_mesh_without_elements_or_x_y(tmp_path):
     err = error_of(tmp_path, base(mesh={}))
     assert "give elements = [nx, ny]" in messages(err, "mesh")
