@@ -429,7 +429,14 @@ class _Follower:
             if here.slope > 0.0:
                 # the path is linear until the slipping set changes: the
                 # step ends just past the next patch predicted to slip
-                ahead = self._first_slip(here.res, k, here.x_f)
+                # at least APPROACH_MIN_STEP of load_step, as in the
+                # approach: a patch predicted on its bound (a prediction of
+                # round-off size) must be pushed past it, or the steps stall
+                # there and round-off decides which patches slip
+                ahead = max(
+                    self._first_slip(here.res, k, here.x_f),
+                    APPROACH_MIN_STEP * opt.load_step,
+                )
                 ahead = min((1.0 + APPROACH_OVERSHOOT) * ahead, opt.load_step)
                 dc = min(dc, ahead / here.slope)
             try:
@@ -458,7 +465,7 @@ class _Follower:
             if end.lam > opt.max_load:  # reached on the rising path
                 self._finish_at_max_load(here.u, k)
                 return
-            if end.slope <= 0.0 or end.lam < here.lam:
+            if not self._stable_after(here, end):
                 self._locate(here, end, a, dc, k)
                 return
             here = end
@@ -560,6 +567,13 @@ class _Follower:
                 raise self._error(k, it + 1, eta, "the residual is not finite")
         raise self._error(k, s.max_it, eta, f"no convergence in {s.max_it} iterations")
 
+    @staticmethod
+    def _stable_after(before: _State, state: _State) -> bool:
+        """Whether ``state``, reached from ``before`` along the path, is
+        still below the limit point: the load still rises (a positive slope
+        and no lower load factor)."""
+        return state.slope > 0.0 and state.lam >= before.lam
+
     def _check_excursion(self, start, u, lam, res, dc, k, it, eta) -> None:
         """ConvergenceError when a converged state lies off the path: its
         load factor moved by more than load_step, or a weakening patch
@@ -617,7 +631,7 @@ class _Follower:
             mid = 0.5 * (lo + hi)
             self.result.bisections += 1
             state = self._bordered(start, a, mid, k)
-            if state.slope > 0.0 and state.lam >= lo_state.lam:
+            if self._stable_after(lo_state, state):
                 lo, lo_state = mid, state
             else:
                 hi, hi_state = mid, state
