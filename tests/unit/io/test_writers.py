@@ -301,7 +301,9 @@ def _high_level_dataset(group, name, value, units, nan=False):
 
 
 @pytest.mark.parametrize("content", ["steps", "mesh"])
-def test_result_h5_is_the_file_of_h5pys_high_level_calls(tmp_path, monkeypatch, content):
+def test_result_h5_is_the_file_of_h5pys_high_level_calls(
+    tmp_path, monkeypatch, content
+):
     """result.h5 is, to the byte, the file that h5py's create_dataset (with
     track_times=False and a Fletcher-32 checksum on arrays) and attrs write:
     the same chunks, filters and attributes.  ``steps``: two load steps with
