@@ -39,7 +39,9 @@ def jacobi_spectral_radius(A, steps: int = LANCZOS_STEPS) -> float:
     its diagonal) from ``steps`` Lanczos steps on D^-1/2 A D^-1/2: the
     largest eigenvalue of the tridiagonal matrix of the recurrence."""
     d = np.asarray(A.diagonal(), dtype=float)
-    s = 1.0 / np.sqrt(d)
+    # a row without a positive diagonal is left out, as pyamg's D^-1 does
+    s = np.zeros_like(d)
+    np.divide(1.0, np.sqrt(d, where=d > 0, out=np.zeros_like(d)), out=s, where=d > 0)
     n = A.shape[0]
     v = np.random.default_rng(SEED).random(n)
     v /= np.linalg.norm(v)
