@@ -290,6 +290,56 @@ def test_result_h5_is_deterministic(tmp_path):
     assert (tmp_path / "a.h5").read_bytes() == (tmp_path / "b.h5").read_bytes()
 
 
+def _high_level_dataset(group, name, value, units, nan=False):
+    """A data set as h5py's high-level calls write it: the reference of
+    the writer's own calls."""
+    dataset = group.create_dataset(
+        name, data=value, track_times=False, fletcher32=np.ndim(value) > 0
+    )
+    dataset.attrs["units"] = units
+    return dataset
+
+
+@pytest.mark.parametrize("content", ["steps", "mesh"])
+def test_result_h5_is_the_file_of_h5pys_high_level_calls(
+    tmp_path, monkeypatch, content
+):
+    """result.h5 is, to the byte, the file that h5py's create_dataset (with
+    track_times=False and a Fletcher-32 checksum on arrays) and attrs write:
+    the same chunks, filters and attributes.  ``steps``: two load steps with
+    their fracture fields and event sizes (float64, int8, NaN); ``mesh``: a
+    300 x 300 mesh alone, whose points span several chunks."""
+    from xfemslip.io import hdf5
+
+    if content == "steps":
+        points, cells = _mesh()
+        steps = [_step(1), _step(2)]
+        events = _events([[np.nan], [3.0e6]])
+    else:
+        xs, ys = np.meshgrid(np.linspace(0, 1, 301), np.linspace(0, 1, 301))
+        points = np.column_stack([xs.ravel(), ys.ravel()])
+        ij = np.arange(301 * 300).reshape(301, 300)[:300]
+        cells = np.stack([ij, ij + 1, ij + 302, ij + 301], axis=-1).reshape(-1, 4)
+        steps, events = [], None
+    common = dict(
+        points=points,
+        cells=cells.astype(np.int64),
+        steps=steps,
+        attrs=_attrs(2),
+        load_steps=2,
+        events=events,
+    )
+    write_result(tmp_path / "a.h5", **common)
+    monkeypatch.setattr(hdf5, "_dataset", _high_level_dataset)
+    write_result(tmp_path / "b.h5", **common)
+    with h5py.File(tmp_path / "b.h5") as h5:
+        chunks = h5["mesh/points"].chunks
+        assert h5["mesh/points"].fletcher32 and h5["mesh/cells"].attrs["units"] == "-"
+    if content == "mesh":
+        assert chunks[0] < points.shape[0]  # several chunks
+    assert (tmp_path / "a.h5").read_bytes() == (tmp_path / "b.h5").read_bytes()
+
+
 def test_result_h5_rejects_wrong_shapes(tmp_path):
     points, cells = _mesh()
     bad = _step(1)
