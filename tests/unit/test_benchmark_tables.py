@@ -279,6 +279,21 @@ def test_contact_patch_and_screen_tables(bench):
     assert rows_of(text)[1] == ["s", "10,000", "4.5", "40.0", "18"]
 
 
+def test_continuation_cost_table(bench):
+    cost = bench("continuation_cost")
+    rows = [
+        {"size": 12.5, "states": 21, "deplete": 31.04, "run": 10.0},
+        {"size": 3.125, "states": 34, "deplete": 120.0, "run": 40.0},
+    ]
+    text = cost.markdown(rows, [2.0, 2.5], 3)
+    assert rows_of(text)[1:] == [
+        ["12.5", "21", "31.0", "10.0", "3.1"],
+        ["3.125", "34", "120.0", "40.0", "3.0"],
+    ]
+    assert "Medians of 3 whole processes" in text
+    assert text.rstrip().endswith("load average 2.0-2.5.")
+
+
 # docs/performance/<file>: the benchmark that writes it, and a synthetic
 # result that gives the header its writer prints
 def _headers(bench) -> dict[str, list[str]]:
@@ -301,6 +316,9 @@ def _headers(bench) -> dict[str, list[str]]:
             0
         ],
         "accuracy_vs_time.md": rows_of(bench("accuracy_vs_time").md_tips([]))[0],
+        "continuation_cost.md": rows_of(bench("continuation_cost").markdown([], [], 1))[
+            0
+        ],
     }
 
 
