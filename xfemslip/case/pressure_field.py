@@ -26,7 +26,6 @@ from collections import Counter
 from pathlib import Path
 
 import numpy as np
-from scipy.spatial import Delaunay, QhullError
 
 from xfemslip.case.files import (
     MAX_CSV_BYTES,
@@ -286,6 +285,10 @@ def _from_csv(file: Path, columns: tuple[str, ...], outside):
         grid = np.empty((len(columns), uy.size, ux.size))
         grid[:, j, i] = values
         return "grid", GridField(ux, uy, grid, outside, str(file))
+    # scipy.spatial costs about 0.2 s to import: only a file of scattered
+    # points needs it, not every case read
+    from scipy.spatial import Delaunay, QhullError
+
     try:
         tri = Delaunay(xy)
     except QhullError:

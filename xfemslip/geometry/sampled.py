@@ -28,7 +28,6 @@ The readers of the files are in ``xfemslip.case.pressure_field``.
 from __future__ import annotations
 
 import numpy as np
-from scipy.spatial import cKDTree
 
 from xfemslip.errors import CaseError
 
@@ -153,6 +152,8 @@ class GridField(_Field):
         return out, cx & cy
 
     def _tree(self):
+        from scipy.spatial import cKDTree  # lazily, as below
+
         X, Y = np.meshgrid(self.x, self.y)
         return cKDTree(np.column_stack([X.ravel(), Y.ravel()]))
 
@@ -216,6 +217,11 @@ class TriangleField(_Field):
         return out, covered
 
     def _tree(self):
+        # scipy.spatial costs about 0.2 s to import; only a case with a
+        # pressure field from a file (and a point outside its data) builds
+        # a tree
+        from scipy.spatial import cKDTree
+
         if self.point_values is not None:
             return cKDTree(self.points)
         return cKDTree(self._centroids())
