@@ -225,7 +225,8 @@ def test_whole_runs_agree(tmp_path):
 
 def test_a_small_run_never_imports_numba(tmp_path):
     """The point of the NumPy backend: `xfemslip run` of a small case loads
-    no Numba at all (no import, no target set-up, no compilation)."""
+    no Numba at all (no import, no target set-up, no compilation); nor
+    scipy.spatial (0.2 s), which only a pressure field from a file needs."""
     case = tmp_path / "small.toml"
     case.write_text(_small_case("auto", steps=1, formats=["h5"]))
     code = (
@@ -237,13 +238,14 @@ def test_a_small_run_never_imports_numba(tmp_path):
         "    assert not e.code, e.code\n"
         "jit = ('numba', 'llvmlite')\n"
         "print(sorted(m for m in sys.modules if m.split('.')[0] in jit))\n"
+        "print('scipy.spatial' in sys.modules)\n"
     )
     env = {k: v for k, v in os.environ.items() if k != kernels.ENV_OVERRIDE}
     proc = subprocess.run(
         [sys.executable, "-c", code], capture_output=True, text=True, env=env, cwd=ROOT
     )
     assert proc.returncode == 0, proc.stderr[-2000:]
-    assert proc.stdout.strip().splitlines()[-1] == "[]"
+    assert proc.stdout.strip().splitlines()[-2:] == ["[]", "False"]
     import h5py
 
     with h5py.File(tmp_path / "out" / "result.h5") as f:
