@@ -45,7 +45,9 @@ or D_c (max_slip), D_c the smallest slip distance of the weakening patches.
 Two caps keep a step on the path.  Between changes of the set of slipping
 patches the problem is linear (for linear weakening at constant p_N), so a
 step ends just past the next sticking weakening patch that the tangent
-predicts to reach its bound (APPROACH_OVERSHOOT past it); and no step
+predicts to reach its bound (APPROACH_OVERSHOOT past it, and at least
+APPROACH_MIN_STEP of ``load_step`` past the start: a patch predicted on its
+bound must be pushed over it, or round-off decides); and no step
 moves the load factor by more than ``load_step`` (near first slip the
 control answers mostly through the elastic penalty, where a slip-sized step
 is a large load step).  The size grows by GROW after a step converged in at
