@@ -196,40 +196,43 @@ RESERVOIR_NO_CENTRE = (
 # --------------------------------------------------------------------------- #
 
 
-def _local_size(grid, point) -> float:
-    """The larger side of the mesh cell holding ``point`` [m] (the nearest
-    cell for a point outside the mesh)."""
-    sizes = []
-    for axis, v in ((grid.mesh.x, point[0]), (grid.mesh.y, point[1])):
-        k = int(np.clip(np.searchsorted(axis, v) - 1, 0, axis.size - 2))
-        sizes.append(float(axis[k + 1] - axis[k]))
-    return max(sizes)
+def _local_sizes(grid, points) -> np.ndarray:
+    """(k,) the larger side of the mesh cell holding each of ``points``
+    (k, 2) [m] (the nearest cell for a point outside the mesh)."""
+    points = np.atleast_2d(points)
+    size = np.zeros(len(points))
+    for axis, v in ((grid.mesh.x, points[:, 0]), (grid.mesh.y, points[:, 1])):
+        k = np.clip(np.searchsorted(axis, v) - 1, 0, axis.size - 2)
+        size = np.maximum(size, axis[k + 1] - axis[k])
+    return size
+
+
+def _segments(fractures):
+    """(fracture index, start a, unit tangent t, normal n, length L) of every
+    straight segment of the fractures, in order."""
+    for fr in fractures:
+        F = np.asarray(fr.points, float)
+        for a, b in zip(F[:-1], F[1:], strict=True):
+            L = float(np.hypot(*(b - a)))
+            t = (b - a) / L
+            yield fr.index, a, t, np.array([-t[1], t[0]]), L
 
 
 def _near_fractures(P, fractures, grid) -> np.ndarray:
     """Indices (ascending) of the closed polygon P's edges that may lie
     within SNAP_CELLS local cell sizes of a fracture's line, and their
     neighbours (snapping an edge moves both its ends): a vectorised sieve
-    of the per-edge test, twice as wide, so that a polygon of many
-    thousand edges is not tested edge by edge against every segment."""
+    of the per-edge test (_nearest_line), twice as wide, so that a polygon
+    of many thousand edges is not tested edge by edge against every
+    segment."""
     Q = np.roll(P, -1, axis=0)
-    mid = 0.5 * (P + Q)
-    size = np.zeros(len(P))
-    for axis, v in ((grid.mesh.x, mid[:, 0]), (grid.mesh.y, mid[:, 1])):
-        k = np.clip(np.searchsorted(axis, v) - 1, 0, axis.size - 2)
-        size = np.maximum(size, axis[k + 1] - axis[k])
-    tol = 2.0 * SNAP_CELLS * size
+    tol = 2.0 * SNAP_CELLS * _local_sizes(grid, 0.5 * (P + Q))
     near = np.zeros(len(P), bool)
-    for fr in fractures:
-        F = np.asarray(fr.points, float)
-        for a, b in zip(F[:-1], F[1:], strict=True):
-            L = float(np.hypot(*(b - a)))
-            t = (b - a) / L
-            n = np.array([-t[1], t[0]])
-            dp, dq = np.abs((P - a) @ n), np.abs((Q - a) @ n)
-            sp, sq = (P - a) @ t, (Q - a) @ t
-            along = (np.maximum(sp, sq) >= -tol) & (np.minimum(sp, sq) <= L + tol)
-            near |= (np.maximum(dp, dq) <= tol) & along
+    for _, a, t, n, L in _segments(fractures):
+        dp, dq = np.abs((P - a) @ n), np.abs((Q - a) @ n)
+        sp, sq = (P - a) @ t, (Q - a) @ t
+        along = (np.maximum(sp, sq) >= -tol) & (np.minimum(sp, sq) <= L + tol)
+        near |= (np.maximum(dp, dq) <= tol) & along
     hit = np.nonzero(near)[0]
     return np.unique(np.concatenate([hit - 1, hit, hit + 1]) % len(P))
 
@@ -238,19 +241,14 @@ def _nearest_line(fractures, p, q, tol):
     """(fracture index, distance, a point on its line, its unit tangent) of
     the first fracture segment whose line passes within ``tol`` of both p and
     q with p-q lying along it, or None."""
-    for fr in fractures:
-        P = np.asarray(fr.points, float)
-        for a, b in zip(P[:-1], P[1:], strict=True):
-            L = float(np.hypot(*(b - a)))
-            t = (b - a) / L
-            n = np.array([-t[1], t[0]])
-            dp, dq = float((p - a) @ n), float((q - a) @ n)
-            if max(abs(dp), abs(dq)) > tol or (dp == 0.0 and dq == 0.0):
-                continue
-            sp, sq = sorted((float((p - a) @ t), float((q - a) @ t)))
-            if sq < -tol or sp > L + tol:  # beside the segment, not along it
-                continue
-            return fr.index, max(abs(dp), abs(dq)), a, t
+    for index, a, t, n, L in _segments(fractures):
+        dp, dq = float((p - a) @ n), float((q - a) @ n)
+        if max(abs(dp), abs(dq)) > tol or (dp == 0.0 and dq == 0.0):
+            continue
+        sp, sq = sorted((float((p - a) @ t), float((q - a) @ t)))
+        if sq < -tol or sp > L + tol:  # beside the segment, not along it
+            continue
+        return index, max(abs(dp), abs(dq)), a, t
     return None
 
 
@@ -291,7 +289,7 @@ def snap_to_fractures(region: RegionSpec, fractures, grid):
     moved = []
     for i in _near_fractures(P, fractures, grid):
         j = (i + 1) % k
-        tol = SNAP_CELLS * _local_size(grid, 0.5 * (P[i] + P[j]))
+        tol = SNAP_CELLS * float(_local_sizes(grid, 0.5 * (P[i] + P[j]))[0])
         hit = _nearest_line(fractures, P[i], P[j], tol)
         if hit is not None:
             index, distance, a, t = hit

@@ -529,14 +529,15 @@ class _Follower:
         u, lam = u0.copy(), start.lam
         res = c.evaluate(u, s.mode, c.pt_committed, c.gt_committed)
         r, eta = s.residual(u, lam, res)
+        u0f = u0[free]
         seen: list[bytes] = []  # the successive stick/slip sets of the iterates
         for it in range(s.max_it + 1):
-            du = u[free] - u0[free]
-            g = dc - float(a @ du)
+            uf = u[free]
+            g = dc - float(a @ (uf - u0f))
             if (
                 it > 0
                 and eta <= s.tol
-                and abs(g) <= _constraint_tolerance(a, u[free], u0[free], dc)
+                and abs(g) <= _constraint_tolerance(a, uf, u0f, dc)
             ):
                 self._check_excursion(start, u, lam, res, dc, k, it, eta)
                 x_f = s.solve_tangent(res, self._load_derivative(res), k, it, eta)
