@@ -23,7 +23,12 @@ them; PARDISO's own machinery is in pardiso.py.
   factorization alone needs 121 at 200 x 200; a second back-solve after the
   band solve saves at most one iteration and cost 11.0 against 8.9 s).  If
   GMRES has not converged in REUSE_MAX_ITERATIONS iterations the matrix is
-  refactored and kept.
+  refactored and kept.  Where the band would hold more than
+  LU_BAND_MAX_FRACTION of the dofs (a network reaching most of the mesh),
+  a system whose tangent changed in few contact patches (a change of rank
+  at most 2 per patch) is solved by GMRES preconditioned with the kept
+  factorization alone, within that rank bound (KEPT_GMRES_MAX); a larger
+  change is refactored.
 - ``"amg"``: GMRES preconditioned with the same Schwarz sweep: one
   smoothed-aggregation AMG V-cycle (pyamg, rigid-body modes as near-nullspace)
   on the standard dofs in place of the back-solve, then the exact band solve,
@@ -128,8 +133,21 @@ KRYLOV_RTOL = 1.0e-10
 REUSE_MAX_ITERATIONS = 20
 LU_BAND_LAYERS = 12
 # A band holding more than this fraction of the dofs costs about as much as a
-# refactorization: refactor instead (small meshes).
+# refactorization: GMRES with the kept factorization alone instead (below).
 LU_BAND_MAX_FRACTION = 0.25
+# Without a band (a network whose fractures reach most of the mesh), a changed
+# contact tangent is a change of rank at most 2 per changed contact patch, so
+# GMRES preconditioned by the kept factorization converges in at most that
+# rank + 1 iterations in exact arithmetic; KEPT_GMRES_EXTRA more are allowed
+# for round-off.  It is tried when that bound is at most KEPT_GMRES_MAX
+# iterations, and the matrix refactored (and kept) otherwise or when GMRES has
+# not converged there (it can stall: the factors are an unpivoted LU's).  A
+# fixed bound, not a measured cost, so that a rerun takes the same path: on
+# 100 branch-tipped fractures on 200 x 200 cells (147k dofs) a factorization
+# costs about 35 back-solves, so 17 iterations are about half of one; most
+# Newton iterations there change 0-8 patches (benchmarks/network_floor.py).
+KEPT_GMRES_MAX = 17
+KEPT_GMRES_EXTRA = 4
 # GMRES restart length and total iteration cap of the AMG path.
 AMG_RESTART = 60
 AMG_MAX_ITERATIONS = 150
@@ -156,10 +174,17 @@ STALL_CHECK = 20
 # coupling raised the fill of the 100 x 100 reservoir matrix from 3.6M to 6.2M
 # entries and the factorization from 0.15 to 0.37 s (relative residual
 # 2e-11 either way).  A solve whose residual is poor is redone with COLAMD and
-# full partial pivoting (LU_SAFE).
+# full partial pivoting (LU_SAFE).  No relaxed supernodes (relax 1, SuperLU's
+# default groups up to 20 columns at the leaves of the elimination tree): the
+# same fill, and the factorization of the stuck matrix of 100 branch-tipped
+# fractures on 200 x 200 cells (147k dofs, 42M entries in L + U) in 2.8-3.1 s
+# against 6.7-8.4 s; 1.22-1.30 against 1.55-1.74 s on the shipped network at
+# 200 x 200, and the same (1.3 s, 7.8-9.0 s) on the reservoir case at 200 x 200
+# and 400 x 400 (one BLAS thread, measured in one process each).
 LU_FAST = {
     "permc_spec": "MMD_AT_PLUS_A",
     "diag_pivot_thresh": 0.0,
+    "relax": 1,
     "options": {"SymmetricMode": True},
 }
 LU_SAFE = {"permc_spec": "COLAMD", "diag_pivot_thresh": 1.0}
@@ -601,6 +626,10 @@ class LinearSolver:
         self._pardiso = None
         self._pardiso_key = None
         self._lu = None  # (SuperLU object, checked solve, K_c it factors)
+        # the contact blocks of the system being solved and of the factored
+        # one (solve_contact), for _kept_gmres
+        self._blocks_now = None
+        self._lu_blocks = None
         # shared.SharedSchurSystems within shared.sharing(); False: not usable
         self._shared: shared.SharedSchurSystems | bool | None = None
         self._amg = None  # V-cycle on the standard dofs
@@ -660,7 +689,11 @@ class LinearSolver:
         Kc = None
         if blocks is not None and np.size(blocks):
             Kc = coo_block(self.contact_dofs, blocks, self.K.shape[0], self.kernels)
-        return self.solve(Kc, r)
+        self._blocks_now = blocks
+        try:
+            return self.solve(Kc, r)
+        finally:
+            self._blocks_now = None
 
     def _solve_shared(self, blocks, r):
         """The solve on the Schur factors kept between runs of the same
@@ -888,7 +921,52 @@ class LinearSolver:
         self.stats["factorizations"] += 1
         self.stats["factor_time"] += time.perf_counter() - t
         self._lu = (lu, solve, Kc)
+        blocks = self._blocks_now
+        self._lu_blocks = None if blocks is None else np.array(blocks, copy=True)
         return solve
+
+    def _change_rank(self) -> int | None:
+        """An upper bound of the rank of the change of the contact tangent
+        since the factored system: 2 per contact patch whose block changed
+        (None when the blocks are not known)."""
+        now, ref = self._blocks_now, self._lu_blocks
+        if now is None or ref is None or np.shape(now) != ref.shape:
+            return None
+        now = np.asarray(now)
+        if now.size == 0:
+            return 0
+        return 2 * int(np.count_nonzero(np.any(now != ref, axis=(1, 2))))
+
+    def _kept_gmres(self, A, r):
+        """GMRES on A x = r preconditioned by the kept factorization alone,
+        or None when the change since it is unknown or too large
+        (KEPT_GMRES_MAX) or GMRES has not converged within its bound."""
+        from scipy.sparse.linalg import LinearOperator
+
+        rank = self._change_rank()
+        if rank is None or rank + 1 + KEPT_GMRES_EXTRA > KEPT_GMRES_MAX:
+            return None
+        cap = rank + 1 + KEPT_GMRES_EXTRA
+        x0, res0 = self._previous.guess(A, r)
+        if x0 is not None and res0 <= KRYLOV_RTOL * np.linalg.norm(r):
+            self.stats["guesses_exact"] += 1
+            return x0
+        lu = self._lu[0]
+        M = LinearOperator(A.shape, matvec=lu.solve, dtype=float)
+        x, ok, its, rel = _gmres(A, r, M, cap, cap, False, x0)
+        self.stats["krylov_iterations"] += its
+        logger.debug(
+            "linear solve: GMRES with the kept factorization, %d iterations "
+            "(change of rank <= %s; %s, residual ratio %.1e)",
+            its,
+            rank,
+            "converged" if ok else "refactoring",
+            rel,
+        )
+        if not ok:
+            return None
+        self._previous.add(x)
+        return x
 
     def _solve_superlu(self, Kc, r):
         A = (self.K + Kc).tocsc()
@@ -908,8 +986,10 @@ class LinearSolver:
                     REUSE_MAX_ITERATIONS,
                     REUSE_MAX_ITERATIONS,
                 )
-                if x is not None:
-                    return x
+            else:
+                x = self._kept_gmres(A.tocsr(), r)
+            if x is not None:
+                return x
         return self._factor(A, Kc)(r)
 
     # ------------------------------------------------------------------ #
