@@ -399,6 +399,7 @@ def build_enriched_cells(
 
     # pass 2: each enrichment group on every cell it reaches
     nq_cell = np.diff(qp_off)
+    nt_cell = np.diff(tri_off)
     slot_off = np.zeros(nc + 1, np.int64)
     np.cumsum(nq_cell * n_slots, out=slot_off[1:])
     F = np.zeros(slot_off[-1])
@@ -416,8 +417,8 @@ def build_enriched_cells(
         k0 = k_used[mine][0]
         fi, tip = int(cand.fracture[k0]), int(cand.tip[k0])
         cells = np.unique(e_used[mine])  # rows of the cells the group reaches
-        ti = ranges(tri_off[cells], np.diff(tri_off)[cells])
-        qi = ranges(qp_off[cells], np.diff(qp_off)[cells])
+        ti = ranges(tri_off[cells], nt_cell[cells])
+        qi = ranges(qp_off[cells], nq_cell[cells])
         st = fractures[fi].side(centroids[ti])
         Fq, gq = group_values(
             fractures,
@@ -442,15 +443,15 @@ def build_enriched_cells(
         func = cand.func[slot_cand[es, ss]]
         js = np.where(func == HEAVISIDE, 0, func - 1)
         pos = np.searchsorted(cells, es)
-        g_qp = np.concatenate([[0], np.cumsum(np.diff(qp_off)[cells])])
-        g_tri = np.concatenate([[0], np.cumsum(np.diff(tri_off)[cells])])
+        g_qp = np.concatenate([[0], np.cumsum(nq_cell[cells])])
+        g_tri = np.concatenate([[0], np.cumsum(nt_cell[cells])])
         nq_s = nq_cell[es]
         rows_v = ranges(slot_off[es] + ss * nq_s, nq_s)
         rows_g = ranges(g_qp[pos], nq_s)
         jj = np.repeat(js, nq_s)
         F[rows_v] = Fq[rows_g, jj]
         gF[rows_v] = gq[rows_g, jj]
-        nt_s = np.diff(tri_off)[es]
+        nt_s = nt_cell[es]
         rows_t = ranges(tri_off[es], nt_s)
         rows_gt = ranges(g_tri[pos], nt_s)
         Fv[rows_t, :, np.repeat(ss, nt_s)] = Fvert[rows_gt, :, np.repeat(js, nt_s)]
