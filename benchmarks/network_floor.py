@@ -5,6 +5,7 @@ PARDISO floor, whole processes, alternated in the same run.
     MKL_NUM_THREADS=2 OPENBLAS_NUM_THREADS=1 NUMBA_NUM_THREADS=2 \\
     python benchmarks/network_floor.py [--runs 3] [--configs floor,pardiso,default]
         [--count 100] [--n 200] [--seed 1] [--json FILE]
+        [--markdown docs/performance/network_floor.md]
 
 The network: ``[network.generate]`` with ``count`` fractures, uniform
 orientations, power-law lengths (exponent 2.5) on [0.06, 0.25] m, friction
@@ -43,6 +44,8 @@ import tempfile
 import threading
 import time
 from pathlib import Path
+
+import mdtable
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -160,6 +163,57 @@ def child(config: str, work: Path, args) -> dict:
     return row
 
 
+HEADER = [
+    "configuration",
+    "wall, median (min, max) [s]",
+    "/ floor",
+    "CPU [s]",
+    "peak RSS [MiB]",
+    "Newton iterations",
+]
+THREADS = ("MKL_NUM_THREADS", "OPENBLAS_NUM_THREADS", "NUMBA_NUM_THREADS")
+LABELS = {
+    "floor": "floor: one PARDISO SPD solve, no fractures",
+    "pardiso": "`xfemslip run`, mkl extra",
+    "default": "`xfemslip run`, default install",
+}
+
+
+def markdown(rows, configs, args) -> str:
+    """The table of the measured rows (each a child's dict): per
+    configuration the median wall time, its ratio to the floor's median, the
+    median CPU time, the largest peak RSS and the Newton iterations per
+    load step."""
+    floor = statistics.median(r["wall"] for r in rows if r["config"] == "floor")
+    out = []
+    for config in configs:
+        mine = [r for r in rows if r["config"] == config]
+        walls = [r["wall"] for r in mine]
+        med = statistics.median(walls)
+        newton = mine[0].get("newton")
+        out.append(
+            [
+                LABELS.get(config, config),
+                f"{med:.2f} ({min(walls):.2f}, {max(walls):.2f})",
+                f"{med / floor:.1f}",
+                f"{statistics.median(r['cpu'] for r in mine):.1f}",
+                f"{max(r['rss_mib'] for r in mine):,.0f}",
+                "-" if not newton else " + ".join(str(k) for k in newton),
+            ]
+        )
+    dofs = {r["config"]: r.get("dofs") for r in rows}
+    env = rows[0].get("env") or {k: os.environ.get(k, "-") for k in THREADS}
+    how = (
+        f"{args.count} generated fractures (seed {args.seed}, branch tips) on "
+        f"{args.n} x {args.n} cells, {dofs.get('pardiso') or dofs.get('default')} "
+        f"dofs (the floor's mesh {dofs.get('floor')}); medians of {args.runs} "
+        "whole processes per configuration, alternated; "
+        + ", ".join(f"{k}={env.get(k, '-')}" for k in THREADS)
+    )
+    loads = [r["load"] for r in rows]
+    return mdtable.table(HEADER, out) + mdtable.note(how, loads)
+
+
 def main() -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--runs", type=int, default=3)
@@ -170,8 +224,19 @@ def main() -> int:
     ap.add_argument("--timeout", type=float, default=3600.0)
     ap.add_argument("--no-warmup", action="store_true")
     ap.add_argument("--json")
+    ap.add_argument(
+        "--from-json",
+        metavar="FILE",
+        help="write the table of a run saved with --json (nothing is measured)",
+    )
+    mdtable.add_option(ap, "docs/performance/network_floor.md")
     args = ap.parse_args()
     configs = args.configs.split(",")
+    if args.from_json:
+        rows = json.loads(Path(args.from_json).read_text())
+        args.runs = max(r["run"] for r in rows) + 1
+        mdtable.write(args.markdown, markdown(rows, configs, args))
+        return 0
     compileall.compile_dir(str(ROOT / "xfemslip"), quiet=1)
     rows = []
     with tempfile.TemporaryDirectory() as tmp:
@@ -184,26 +249,12 @@ def main() -> int:
             for config in configs:
                 row = child(config, work, args)
                 row["run"] = run
+                row["env"] = {k: os.environ.get(k, "-") for k in THREADS}
                 rows.append(row)
                 print(json.dumps(row), flush=True)
     if args.json:
         Path(args.json).write_text(json.dumps(rows, indent=1))
-    floor = statistics.median(r["wall"] for r in rows if r["config"] == "floor")
-    print(
-        "\n| configuration | wall, median (min, max) [s] | CPU [s] | / floor | "
-        "peak RSS [MiB] | load |"
-    )
-    print("| --- | --- | --- | --- | --- | --- |")
-    for config in configs:
-        mine = [r for r in rows if r["config"] == config]
-        walls = [r["wall"] for r in mine]
-        med = statistics.median(walls)
-        print(
-            f"| {config} | {med:.2f} ({min(walls):.2f}, {max(walls):.2f}) | "
-            f"{statistics.median(r['cpu'] for r in mine):.1f} | "
-            f"{med / floor:.1f} | {max(r['rss_mib'] for r in mine):.0f} | "
-            f"{min(r['load'] for r in mine):.1f}-{max(r['load'] for r in mine):.1f} |"
-        )
+    mdtable.write(args.markdown, markdown(rows, configs, args))
     return 0
 
 

@@ -294,6 +294,66 @@ def test_continuation_cost_table(bench):
     assert text.rstrip().endswith("load average 2.0-2.5.")
 
 
+def test_network_floor_table(bench):
+    nf = bench("network_floor")
+    rows = [
+        {
+            "config": "floor",
+            "wall": 3.0,
+            "cpu": 2.0,
+            "rss_mib": 250.0,
+            "load": 1.0,
+            "dofs": 80600,
+            "run": 0,
+        },
+        {
+            "config": "floor",
+            "wall": 2.0,
+            "cpu": 2.0,
+            "rss_mib": 260.0,
+            "load": 1.2,
+            "dofs": 80600,
+            "run": 1,
+        },
+        {
+            "config": "pardiso",
+            "wall": 25.0,
+            "cpu": 20.0,
+            "rss_mib": 1800.0,
+            "load": 1.1,
+            "dofs": 147524,
+            "newton": [11, 6],
+            "run": 0,
+        },
+        {
+            "config": "pardiso",
+            "wall": 15.0,
+            "cpu": 10.0,
+            "rss_mib": 1700.0,
+            "load": 1.3,
+            "dofs": 147524,
+            "newton": [11, 6],
+            "run": 1,
+        },
+    ]
+    args = type("A", (), {"count": 100, "seed": 1, "n": 200, "runs": 2})()
+    text = nf.markdown(rows, ["floor", "pardiso"], args)
+    assert rows_of(text)[0] == nf.HEADER
+    assert rows_of(text)[1:] == [
+        [nf.LABELS["floor"], "2.50 (2.00, 3.00)", "1.0", "2.0", "260", "-"],
+        [
+            nf.LABELS["pardiso"],
+            "20.00 (15.00, 25.00)",
+            "8.0",
+            "15.0",
+            "1,800",
+            "11 + 6",
+        ],
+    ]
+    assert "147524 dofs" in text and "medians of 2 whole processes" in text
+    assert text.rstrip().endswith("load average 1.0-1.3.")
+
+
 # docs/performance/<file>: the benchmark that writes it, and a synthetic
 # result that gives the header its writer prints
 def _headers(bench) -> dict[str, list[str]]:
@@ -319,6 +379,7 @@ def _headers(bench) -> dict[str, list[str]]:
         "continuation_cost.md": rows_of(bench("continuation_cost").markdown([], [], 1))[
             0
         ],
+        "network_floor.md": bench("network_floor").HEADER,
     }
 
 
