@@ -132,10 +132,12 @@ def colourbar_label(label: str, scale: FieldScale) -> str:
 
 def label_log_axis(axis) -> None:
     """Tick labels on a log ``axis`` (``ax.xaxis``) however short its range:
-    spanning a decade or more, the powers of ten as usual; less, the
-    minor ticks at 1..9 x 10^k labelled in plain numbers as well."""
+    spanning two decades or more, the powers of ten as usual; less, ticks at
+    1, 2 and 5 x 10^k in plain numbers (matplotlib labels the minor ticks of
+    a range of one to two decades in scientific notation, which run into
+    each other), and below a factor 2.5 every 1..9 x 10^k."""
     lo, hi = sorted(axis.get_view_interval())
-    if lo <= 0.0 or hi / lo >= 10.0:
+    if lo <= 0.0 or hi / lo >= 100.0:
         return
     axis.set_major_locator(LogLocator(base=10.0, subs=(1.0, 2.0, 5.0)))
     axis.set_minor_locator(LogLocator(base=10.0, subs=[float(k) for k in range(1, 10)]))

@@ -139,6 +139,35 @@ def test_short_log_axes_have_labelled_ticks():
     assert "0.05" in tick_labels(fig.axes[0].xaxis)
 
 
+def test_log_axes_of_one_to_two_decades_have_ticks_apart():
+    """verify.png of the full set: wall times of 0.12 to 1.1 s span just over
+    a decade, where matplotlib names the minor ticks in scientific notation
+    ("3 x 10^-1" against "4 x 10^-1"); the tick labels of both panels lie
+    apart, in plain numbers."""
+    from xfemslip.verify.problems import Report, Row
+    from xfemslip.verify.report import figure_verify
+
+    rows = [
+        Row(name, n, slip_error=e * k, kii_error=2 * e * k, wall_s=t * k)
+        for k, name in enumerate(("inclined-30", "inclined-60", "cohesion-30"), 1)
+        for n, e, t in (
+            (5, 0.016, 0.12),
+            (10, 0.008, 0.2),
+            (20, 0.004, 0.35),
+            (40, 0.0015, 0.37),
+        )
+    ]
+    fig = figure_verify(Report(rows, [], [], None))
+    renderer = drawn(fig)
+    for ax in fig.axes:
+        assert_ticks_labelled(ax)
+        for axis in (ax.xaxis, ax.yaxis):
+            texts = [t for t in axis.get_ticklabels(which="both") if t.get_text()]
+            texts = [t for t in texts if t.get_visible()]
+            assert_no_overlap(texts, renderer, "tick labels")
+            assert not any("times" in t.get_text() for t in texts)
+
+
 # --------------------------------------------------------------------------- #
 # Labels of fractures at one point or angle
 # --------------------------------------------------------------------------- #
