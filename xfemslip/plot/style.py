@@ -12,8 +12,9 @@ not cover each other or the lines they name.
   percentile (a tip singularity does not set it), at least
   :data:`MIN_SPAN_FRACTION` of the field's size wide (noise is not magnified
   into colour), centred on zero when the field changes sign;
-- :func:`label_log_axis`: tick labels on a log axis that spans less than a
-  decade (matplotlib labels only the powers of ten by default);
+- :func:`label_log_axis`: plain tick labels on a log axis that spans less
+  than two decades (matplotlib labels only the powers of ten below one
+  decade, and crowds scientific-notation minor labels from one to two);
 - :func:`place_labels`: text labels at anchor points, those at one point
   joined into one ("0, 1, 2"), each moved to the first nearby place where it
   covers no other label and no line to avoid;
