@@ -88,6 +88,38 @@ def test_patch_tangents_reads_each_blocks_2x2():
     assert lowrank.patch_tangents(bad, coef, dofs) is None
 
 
+def test_tangents_are_read_again_where_the_blocks_changed():
+    """The systems' tangents after a first read: the changed patches read
+    again, the others kept; the same as reading every block, and a changed
+    block not of the patch form refused."""
+    from types import SimpleNamespace
+
+    rng = np.random.default_rng(5)
+    m, J = 9, 4
+    coef = rng.standard_normal((m, J))
+    dofs = rng.integers(0, 100, size=(m, 2 * J))
+
+    def blocks_of(D):
+        return np.einsum("mk,ml,mab->mkalb", coef, coef, D).reshape(m, 2 * J, 2 * J)
+
+    D = rng.standard_normal((m, 2, 2))
+    systems = SimpleNamespace(_update=None, coef=coef, dofs=dofs)
+    first = lowrank.LowRankSystems._tangents(systems, blocks_of(D))
+    np.testing.assert_allclose(first, D, rtol=1e-14, atol=0)
+    systems._update = (blocks_of(D), first)
+    D2 = D.copy()
+    D2[[2, 7]] = rng.standard_normal((2, 2, 2))
+    got = lowrank.LowRankSystems._tangents(systems, blocks_of(D2))
+    np.testing.assert_array_equal(
+        got[[0, 1, 3, 4, 5, 6, 8]], first[[0, 1, 3, 4, 5, 6, 8]]
+    )
+    np.testing.assert_allclose(got, lowrank.patch_tangents(blocks_of(D2), coef, dofs))
+    np.testing.assert_allclose(got, D2, rtol=1e-13, atol=0)
+    bad = blocks_of(D2)
+    bad[7, 0, 3] += 1e-6 * np.abs(bad[7]).max()
+    assert lowrank.LowRankSystems._tangents(systems, bad) is None
+
+
 def test_stick_tangent_is_the_kernels():
     """D0 = w (k_N n n^T + k_T t t^T) is the block of a stuck patch as the
     contact kernel gives it (read back with patch_tangents)."""
