@@ -991,7 +991,7 @@ class LinearSolver:
             if x is not None:
                 return x
             # the old factors go before the new ones are made: two at once
-            # were 0.5 GB more at the peak of a 100-fracture network
+            # were 0.4 GB more at the peak of a 100-fracture network
             del lu, solve, Kc_ref
             self._lu = self._lu_blocks = None
         return self._factor(A, Kc)(r)
