@@ -404,6 +404,7 @@ def build_enriched_cells(
     np.cumsum(nq_cell * n_slots, out=slot_off[1:])
     F = np.zeros(slot_off[-1])
     gF = np.zeros((slot_off[-1], 2))
+    gF_pairs = gF.view(np.complex128)[:, 0]  # gF's rows, written through
     Fv = np.zeros((tris.shape[0], 3, S))
     group = cand.fracture[k_used] * (1 << 32) + (cand.tip[k_used] + (1 << 31))
     # the slots of each group as one slice of a stable sort (in the order a
@@ -450,7 +451,10 @@ def build_enriched_cells(
         rows_g = ranges(g_qp[pos], nq_s)
         jj = np.repeat(js, nq_s)
         F[rows_v] = Fq[rows_g, jj]
-        gF[rows_v] = gq[rows_g, jj]
+        # the (x, y) pairs moved as one complex number each: a fancy index
+        # over the rows of an (n, 2) array moved 13M pairs of a 100-fracture
+        # network in 1.0 s, this in about a third of it
+        gF_pairs[rows_v] = np.ascontiguousarray(gq).view(np.complex128)[rows_g, jj, 0]
         nt_s = nt_cell[es]
         rows_t = ranges(tri_off[es], nt_s)
         rows_gt = ranges(g_tri[pos], nt_s)
