@@ -120,11 +120,11 @@ AUTO_AMG_MAX_ASPECT = 4.0
 # at most this share of the free dofs.  Measured on generated networks of
 # 1-100 fractures, 80k-375k dofs (benchmarks/auto_choice.py, docs/
 # performance.md "Automatic linear solver choice"): the band LU of every Newton system
-# grows with the band, and AMG's CPU time on the same Newton systems, 0.54 to
-# 0.82 of SuperLU's with bands of 12-64 %, was 0.92-0.93 with 67 % and 79 %;
-# the one run with a larger band that fell back to SuperLU (a singular band
-# matrix, 72 %) took 1.08.  Above 0.65 the gain is under 10 %, within one
-# run's noise on the shared machine, and a fall-back costs more than that.
+# grows with the band, and AMG's CPU time on the same Newton systems from
+# 80k dofs up was 0.58-1.0 of SuperLU's with bands of 12-64 % (two
+# exceptions: 1.15 at 51 %, 1.61 at 6.5 % where SuperLU kept one
+# factorization), and 1.01-1.53 with bands of 67-86 % (two of them fell back
+# to SuperLU).  Above 0.65 AMG no longer gains.
 AUTO_AMG_MAX_BAND = 0.65
 # Relative residual ||A x - b|| / ||b|| at which the Krylov solves stop.
 KRYLOV_RTOL = 1.0e-10
