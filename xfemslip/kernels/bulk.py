@@ -199,17 +199,13 @@ def enriched_cell_matrices(
             for k in range(3):
                 for j in range(m):
                     DB[k, j] = D[k, 0] * B[0, j] + D[k, 1] * B[1, j] + D[k, 2] * B[2, j]
-            # the upper triangle only (D symmetric: K is), mirrored below
             for i in range(m):
                 b0, b1, b2 = B[0, i] * w, B[1, i] * w, B[2, i] * w
-                for j in range(i, m):
+                for j in range(m):
                     K[e, i, j] += b0 * DB[0, j] + b1 * DB[1, j] + b2 * DB[2, j]
                 Bbar[e, 0, i] += b0
                 Bbar[e, 1, i] += b1
                 Bbar[e, 2, i] += b2
             area += w
-        for i in range(m):
-            for j in range(i):
-                K[e, i, j] = K[e, j, i]
         Bbar[e] /= area
     return K, Bbar
