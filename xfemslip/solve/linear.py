@@ -935,7 +935,7 @@ class LinearSolver:
         now = np.asarray(now)
         if now.size == 0:
             return 0
-        return 2 * int(np.count_nonzero(np.any(now != ref, axis=(1, 2))))
+        return 2 * int(lowrank.changed_patches(now, ref).size)
 
     def _kept_gmres(self, A, r):
         """GMRES on A x = r preconditioned by the kept factorization alone,

@@ -97,6 +97,12 @@ def jump_matrix(dofs, coef, n) -> sp.csr_matrix:
     )
 
 
+def changed_patches(blocks, ref) -> np.ndarray:
+    """The patches (indices) whose contact blocks (m, k, k) differ from
+    those of ``ref`` in some entry."""
+    return np.nonzero(np.any(blocks != ref, axis=(1, 2)))[0]
+
+
 def patch_tangents(blocks, coef, dofs):
     """D (m, 2, 2) with blocks[i] = c_i c_i^T (x) D_i, or None when some block
     is not of that form (to FORM_RTOL).  D_i is read at the coefficient of
@@ -198,7 +204,7 @@ class LowRankSystems:
         last = self._update
         if last is None or last[0].shape != blocks.shape:
             return patch_tangents(blocks, self.coef, self.dofs)
-        changed = np.nonzero(np.any(blocks != last[0], axis=(1, 2)))[0]
+        changed = changed_patches(blocks, last[0])
         D = last[1].copy()
         if changed.size:
             part = patch_tangents(

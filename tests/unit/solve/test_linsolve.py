@@ -11,6 +11,7 @@ import pytest
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
+from tests.support.newton_systems import recorded_systems
 from xfemslip.case import build, loads_case
 from xfemslip.errors import CaseError
 from xfemslip.fem.assembly import coo_block
@@ -247,24 +248,12 @@ def test_kept_factorization_takes_small_contact_changes(monkeypatch):
     Newton systems of a 3-step run, in order, agree with spsolve to 1e-8,
     with fewer factorizations than changed tangents."""
     monkeypatch.setattr(linsolve, "LU_BAND_MAX_FRACTION", 0.0)
-    model = build_model(loads_case(_text(30, 3), CASE))
-    newton = NewtonSolver(
-        model.problem, 1e-10, 30, "consistent", "superlu", predictor=False
-    )
-    seq = []
-    solve = newton._solve
-
-    def record(res, r, k, it, eta):
-        seq.append((res.blocks.copy(), r.copy()))
-        return solve(res, r, k, it, eta)
-
-    newton._solve = record
-    newton.run(3)
+    newton, seq = recorded_systems(_text(30, 3), CASE, 3)
     ls = LinearSolver(
         newton.K_ff,
         "superlu",
         newton.free,
-        model.mesh.nodes,
+        newton.p.node_xy,
         newton.c_dofs,
         kernels=newton.p.contact.kernels,
     )

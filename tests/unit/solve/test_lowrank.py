@@ -13,12 +13,12 @@ import pytest
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
+from tests.support.newton_systems import recorded_systems
 from xfemslip.case import loads_case
 from xfemslip.fem.assembly import coo_block
 from xfemslip.simulation import build_model, newton_solver
 from xfemslip.solve import linear, lowrank, pardiso
 from xfemslip.solve.linear import LU_BACKWARD_ERROR, LinearSolver, backward_error
-from xfemslip.solve.newton import NewtonSolver
 
 ROOT = Path(__file__).resolve().parents[3]
 CASE = ROOT / "cases" / "reservoir_depletion.toml"
@@ -30,25 +30,6 @@ def _reservoir(n=20, steps=3, friction=0.1):
     text = CASE.read_text().replace("elements = [50, 50]", f"elements = [{n}, {n}]")
     text = text.replace("steps = 1", f"steps = {steps}")
     return text.replace("friction = 0.1", f"friction = {friction}")
-
-
-def _systems(text, path, steps):
-    """The Newton systems (blocks, r) of a run, in order, solved by SuperLU,
-    and its solver."""
-    model = build_model(loads_case(text, path))
-    solver = NewtonSolver(
-        model.problem, 1e-10, 30, "consistent", "superlu", predictor=False
-    )
-    systems = []
-    solve = solver._solve
-
-    def record(res, r, k, it, eta):
-        systems.append((res.blocks.copy(), r.copy()))
-        return solve(res, r, k, it, eta)
-
-    solver._solve = record
-    solver.run(steps)
-    return solver, systems
 
 
 def _stick(newton):
@@ -123,7 +104,7 @@ def test_tangents_are_read_again_where_the_blocks_changed():
 def test_stick_tangent_is_the_kernels():
     """D0 = w (k_N n n^T + k_T t t^T) is the block of a stuck patch as the
     contact kernel gives it (read back with patch_tangents)."""
-    newton, seq = _systems(_reservoir(friction=10.0, steps=1), CASE, 1)
+    newton, seq = recorded_systems(_reservoir(friction=10.0, steps=1), CASE, 1)
     c = newton.p.contact
     D = lowrank.patch_tangents(seq[0][0], c.coef, newton.c_dofs)
     np.testing.assert_allclose(D, _stick(newton), rtol=1e-13, atol=0)
@@ -134,7 +115,7 @@ def test_schur_block_is_the_jump_compliance(monkeypatch):
     """G = M R^-1 M^T from PARDISO's Schur complement of the augmented
     matrix equals the product computed with SuperLU's solves of the stuck
     matrix R = K_ff + M^T M."""
-    newton, _ = _systems(_reservoir(n=12, steps=1), CASE, 1)
+    newton, _ = recorded_systems(_reservoir(n=12, steps=1), CASE, 1)
     c = newton.p.contact
     stats = dict.fromkeys(("factorizations", "pardiso_analyses"), 0)
     stats["factor_time"] = 0.0
@@ -162,7 +143,7 @@ def test_newton_systems_match_superlu(friction, slips, monkeypatch):
     backward error bound against the assembled matrix and spsolve's answer
     to 1e-8; one factorization for the run, a dense LU per new tangent."""
     monkeypatch.setattr(pardiso, "SCHUR_MAX_DOFS", 0)
-    newton, seq = _systems(_reservoir(friction=friction), CASE, 3)
+    newton, seq = recorded_systems(_reservoir(friction=friction), CASE, 3)
     ls = _lowrank_solver(newton)
     changes, last = 0, None
     for blocks, r in seq:
@@ -190,7 +171,7 @@ def test_open_patches_are_a_rank_two_change(monkeypatch):
     """Patches with no contact stiffness (open: zero blocks) next to stuck
     and slipping ones: the same answer as spsolve, rank 2 per open patch."""
     monkeypatch.setattr(pardiso, "SCHUR_MAX_DOFS", 0)
-    newton, seq = _systems(_reservoir(friction=0.1, steps=1), CASE, 1)
+    newton, seq = recorded_systems(_reservoir(friction=0.1, steps=1), CASE, 1)
     blocks, r = seq[-1]
     blocks = blocks.copy()
     blocks[::3] = 0.0
@@ -209,7 +190,7 @@ def test_blocks_of_another_form_go_to_the_general_path(monkeypatch, caplog):
     """A block that is not c c^T (x) D: one warning, that system and the
     later ones on PARDISO's general path, the same answer."""
     monkeypatch.setattr(pardiso, "SCHUR_MAX_DOFS", 0)
-    newton, seq = _systems(_reservoir(n=16, steps=1), CASE, 1)
+    newton, seq = recorded_systems(_reservoir(n=16, steps=1), CASE, 1)
     blocks, r = seq[0]
     blocks = blocks.copy()
     blocks[0] += np.diag(np.arange(blocks.shape[1], dtype=float)) * abs(blocks).max()
