@@ -93,27 +93,27 @@ def rectangle_stiffness(hx, hy, D):
 
 
 @njit(cache=NUMBA_CACHE)
-def _enriched_B(x, y, x0, x1, y0, y1, slot_node, slot_fnode, F, gradF, N, dN, out_B):
-    """Fill out_B (3, 8 + 2S) at one point; returns nothing (writes out_B)."""
-    q4_shape(x, y, x0, x1, y0, y1, N, dN)
-    out_B[:, :] = 0.0
-    for a in range(4):
-        out_B[0, 2 * a] = dN[a, 0]
-        out_B[1, 2 * a + 1] = dN[a, 1]
-        out_B[2, 2 * a] = dN[a, 1]
-        out_B[2, 2 * a + 1] = dN[a, 0]
-    for s in range(slot_node.shape[0]):
-        a = slot_node[s]
-        if a < 0:
-            continue
-        shift = F[s] - slot_fnode[s]
-        gx = dN[a, 0] * shift + N[a] * gradF[s, 0]
-        gy = dN[a, 1] * shift + N[a] * gradF[s, 1]
-        c = 8 + 2 * s
-        out_B[0, c] = gx
-        out_B[1, c + 1] = gy
-        out_B[2, c] = gy
-        out_B[2, c + 1] = gx
+def _gram_to_stiffness(G, nf, D, K):
+    """K (2 nf, 2 nf) of functions whose strain columns are (g_x, 0, g_y) and
+    (0, g_y, g_x), from the weighted Gram matrix G of [g_x | g_y] (2 nf, 2 nf):
+    each 2 x 2 block is a combination of XX, XY, YX, YY with D's entries
+    (a third of the products of sum_qp B^T D B w)."""
+    for i in range(nf):
+        for j in range(nf):
+            XX = G[i, j]
+            XY = G[i, nf + j]
+            YX = G[nf + i, j]
+            YY = G[nf + i, nf + j]
+            K[2 * i, 2 * j] = D[0, 0] * XX + D[0, 2] * XY + D[2, 0] * YX + D[2, 2] * YY
+            K[2 * i, 2 * j + 1] = (
+                D[0, 1] * XY + D[0, 2] * XX + D[2, 1] * YY + D[2, 2] * YX
+            )
+            K[2 * i + 1, 2 * j] = (
+                D[1, 0] * YX + D[1, 2] * YY + D[2, 0] * XX + D[2, 2] * XY
+            )
+            K[2 * i + 1, 2 * j + 1] = (
+                D[1, 1] * YY + D[1, 2] * YX + D[2, 1] * XY + D[2, 2] * XX
+            )
 
 
 @njit(cache=NUMBA_CACHE)
@@ -157,55 +157,52 @@ def enriched_cell_matrices(
     Bbar = np.zeros((nc, 3, nd))
     N = np.empty(4)
     dN = np.empty((4, 2))
-    B = np.zeros((3, nd))
-    DB = np.zeros((3, nd))
-    F = np.zeros(S)
-    gradF = np.zeros((S, 2))
     for e in range(nc):
         x0, x1, y0, y1 = bounds[e, 0], bounds[e, 1], bounds[e, 2], bounds[e, 3]
-        area = 0.0
         q0 = qp_offsets[e]
         nq = qp_offsets[e + 1] - q0
-        # columns in use: slots are filled from 0, so only up to the last
-        # occupied one (networks pad most cells far below S)
-        m = 8
+        # functions in use: the four nodes' and the slots up to the last
+        # occupied one (slots are filled from 0; networks pad most cells far
+        # below S)
         n_used = 0
         for s in range(S):
             if slot_node[e, s] >= 0:
-                m = 10 + 2 * s
                 n_used = s + 1
-        for q in range(q0, q0 + nq):
+        nf = 4 + n_used
+        # G_x | G_y: the gradient of every scalar function at every point
+        P = np.empty((nq, 2 * nf))
+        Pw = np.empty((nq, 2 * nf))
+        area = 0.0
+        for k in range(nq):
+            q = q0 + k
+            q4_shape(qp_xy[q, 0], qp_xy[q, 1], x0, x1, y0, y1, N, dN)
+            for a in range(4):
+                P[k, a] = dN[a, 0]
+                P[k, nf + a] = dN[a, 1]
             for s in range(n_used):
-                v = slot_offsets[e] + s * nq + (q - q0)
-                F[s] = slot_F[v]
-                gradF[s, 0] = slot_gradF[v, 0]
-                gradF[s, 1] = slot_gradF[v, 1]
-            _enriched_B(
-                qp_xy[q, 0],
-                qp_xy[q, 1],
-                x0,
-                x1,
-                y0,
-                y1,
-                slot_node[e],
-                slot_fnode[e],
-                F,
-                gradF,
-                N,
-                dN,
-                B,
-            )
+                a = slot_node[e, s]
+                if a < 0:
+                    P[k, 4 + s] = 0.0
+                    P[k, nf + 4 + s] = 0.0
+                    continue
+                v = slot_offsets[e] + s * nq + k
+                shift = slot_F[v] - slot_fnode[e, s]
+                P[k, 4 + s] = dN[a, 0] * shift + N[a] * slot_gradF[v, 0]
+                P[k, nf + 4 + s] = dN[a, 1] * shift + N[a] * slot_gradF[v, 1]
             w = qp_w[q]
-            for k in range(3):
-                for j in range(m):
-                    DB[k, j] = D[k, 0] * B[0, j] + D[k, 1] * B[1, j] + D[k, 2] * B[2, j]
-            for i in range(m):
-                b0, b1, b2 = B[0, i] * w, B[1, i] * w, B[2, i] * w
-                for j in range(m):
-                    K[e, i, j] += b0 * DB[0, j] + b1 * DB[1, j] + b2 * DB[2, j]
-                Bbar[e, 0, i] += b0
-                Bbar[e, 1, i] += b1
-                Bbar[e, 2, i] += b2
+            for i in range(2 * nf):
+                Pw[k, i] = w * P[k, i]
             area += w
-        Bbar[e] /= area
+        G = np.dot(P.T, Pw)
+        _gram_to_stiffness(G, nf, D, K[e])
+        for i in range(nf):
+            sx = 0.0
+            sy = 0.0
+            for k in range(nq):
+                sx += Pw[k, i]
+                sy += Pw[k, nf + i]
+            Bbar[e, 0, 2 * i] = sx / area
+            Bbar[e, 1, 2 * i + 1] = sy / area
+            Bbar[e, 2, 2 * i] = sy / area
+            Bbar[e, 2, 2 * i + 1] = sx / area
     return K, Bbar
