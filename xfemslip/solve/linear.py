@@ -969,15 +969,18 @@ class LinearSolver:
         return x
 
     def _solve_superlu(self, Kc, r):
-        A = (self.K + Kc).tocsc()
+        # CSR for the products of the Krylov solves; SuperLU's CSC made only
+        # for a factorization (a conversion per Newton system was 0.1 s of
+        # each at 147k dofs)
+        if self._lu is not None and _same(Kc, self._lu[2]):
+            return self._lu[1](r)
+        A = sp.csr_matrix(self.K + Kc)
         if self._lu is not None:
             lu, solve, Kc_ref = self._lu
-            if _same(Kc, Kc_ref):
-                return solve(r)
             band = self._band(LU_BAND_LAYERS, Kc)
             if 0 < band.size <= LU_BAND_MAX_FRACTION * A.shape[0]:
                 x = self._schwarz_gmres(
-                    A.tocsr(),
+                    A,
                     Kc,
                     r,
                     lu.solve,
@@ -987,14 +990,14 @@ class LinearSolver:
                     REUSE_MAX_ITERATIONS,
                 )
             else:
-                x = self._kept_gmres(A.tocsr(), r)
+                x = self._kept_gmres(A, r)
             if x is not None:
                 return x
             # the old factors go before the new ones are made: two at once
             # were 0.4 GB more at the peak of a 100-fracture network
             del lu, solve, Kc_ref
             self._lu = self._lu_blocks = None
-        return self._factor(A, Kc)(r)
+        return self._factor(A.tocsc(), Kc)(r)
 
     # ------------------------------------------------------------------ #
     def _setup_amg(self):
