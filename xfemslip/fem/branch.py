@@ -47,15 +47,26 @@ def branch_functions(tip, pts, side=None, tol=0.0):
     scale = 1.0 / np.sqrt(tip.cell_size)
     sr = np.sqrt(r)
     s2, c2 = np.sin(th / 2.0), np.cos(th / 2.0)
-    s1, c1 = np.sin(th), np.cos(th)
-    s32, c32 = np.sin(1.5 * th), np.cos(1.5 * th)
-    F = np.stack([sr * s2, sr * c2, sr * s2 * s1, sr * c2 * s1], axis=1) * scale
+    # sin, cos of theta and 3 theta / 2 from those of theta / 2
+    s1 = 2.0 * s2 * c2
+    c1 = (c2 - s2) * (c2 + s2)
+    s32 = s1 * c2 + c1 * s2
+    c32 = c1 * c2 - s1 * s2
+    F = np.empty((r.size, 4))
+    F[:, 0] = sr * s2
+    F[:, 1] = sr * c2
+    F[:, 2] = F[:, 0] * s1
+    F[:, 3] = F[:, 1] * s1
+    F *= scale
     with np.errstate(divide="ignore", invalid="ignore"):
-        k = np.where(r > 0.0, 0.5 / sr, 0.0)
-    # derivatives in the local frame (x_l, y_l)
-    gx = np.stack([-s2, c2, -s32 * s1, -c32 * s1], axis=1) * k[:, None]
-    gy = np.stack([c2, s2, s2 + s32 * c1, c2 + c32 * c1], axis=1) * k[:, None]
+        k = np.where(r > 0.0, 0.5 * scale / sr, 0.0)
+    # derivatives in the local frame (x_l, y_l), turned to (x, y)
+    gx = np.stack([-s2, c2, -s32 * s1, -c32 * s1], axis=1)
+    gy = np.stack([c2, s2, s2 + s32 * c1, c2 + c32 * c1], axis=1)
+    gx *= k[:, None]
+    gy *= k[:, None]
     d = tip.direction
-    nd = np.array([-d[1], d[0]])
-    grad = (gx[..., None] * d + gy[..., None] * nd) * scale
+    grad = np.empty((r.size, 4, 2))
+    grad[:, :, 0] = gx * d[0] - gy * d[1]
+    grad[:, :, 1] = gx * d[1] + gy * d[0]
     return F, grad
