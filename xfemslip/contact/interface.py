@@ -534,11 +534,19 @@ def _jump_operators(mesh, fractures, ip, ec, cand, dofmap):
     eps = JUMP_PROBE * mesh.h_min
     tol = GEOMETRY_TOL * mesh.h_min
     group = np.where(live, cand.fracture[Kc] * 100003 + cand.tip[Kc] + 50000, -1)
-    for g in np.unique(group[live]):
+    # the live slots of each group as one slice of a stable sort, in the
+    # order np.nonzero(group == g) gives (a mask per group over all the
+    # slots was 0.4 s of 300 groups on a 100-fracture network)
+    flat = np.flatnonzero(live)
+    by_group = np.argsort(group.ravel()[flat], kind="stable")
+    flat = flat[by_group]
+    groups, starts = np.unique(group.ravel()[flat], return_index=True)
+    ends = np.append(starts[1:], flat.size)
+    for g, lo, hi in zip(groups.tolist(), starts.tolist(), ends.tolist(), strict=True):
         fi, tip = divmod(int(g), 100003)
         tip -= 50000
         fr = fractures[fi]
-        rows, cols = np.nonzero(group == g)
+        rows, cols = np.divmod(flat[lo:hi], K.shape[1])
         pts = ip.xy[rows]
         off = eps * ip.normal[rows]
         vals = []
