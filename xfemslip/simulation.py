@@ -60,6 +60,7 @@ from xfemslip.post.fields import (
 from xfemslip.post.hydraulics import add_permeability
 from xfemslip.post.result import Result, run_id
 from xfemslip.solve.newton import NewtonSolver, Problem
+from xfemslip.solve.shared import active as sharing_active
 from xfemslip.solve.shared import digest
 
 logger = logging.getLogger(__name__)
@@ -483,6 +484,10 @@ def solve_and_write(
     )
     with folder as stage:
         model = build_model(spec)
+        if not sharing_active():  # kept for the next case within sharing
+            # assembled and loaded: the solve and the output read the
+            # enrichment's sub-triangles, not its values at the points
+            model = dataclasses.replace(model, ec=model.ec.without_point_values())
         solver = newton_solver(model)
         value = failure = None
         try:

@@ -39,6 +39,7 @@ order as ``n_std + 2*k + c``.
 
 from __future__ import annotations
 
+import dataclasses
 import logging
 from dataclasses import dataclass
 from typing import Any
@@ -85,10 +86,34 @@ class EnrichedCells:
     tri_offsets: np.ndarray  # (nc+1,) int64 sub-triangles of each cell
     tris: np.ndarray  # (nt, 3, 2) [m]
     tri_F: np.ndarray  # (nt, 3, S) F at the triangle's vertices, from its own side
+    # slot_F and slot_gradF dropped (without_point_values)
+    values_released: bool = False
+
+    def without_point_values(self) -> EnrichedCells:
+        """These cells without the enrichment values at their quadrature
+        points (slot_F, slot_gradF: 640 MB on a 100-fracture network at 200
+        x 200 cells, three fifths of its model), for a model assembled and
+        loaded, which is only solved and written from here on (the
+        sub-triangles and their vertex values stay for the output);
+        qp_values and part raise on the copy."""
+        return dataclasses.replace(
+            self,
+            slot_F=np.zeros(0),
+            slot_gradF=np.zeros((0, 2)),
+            values_released=True,
+        )
+
+    def _check_values(self) -> None:
+        if self.values_released:
+            raise RuntimeError(
+                "the enrichment values at the quadrature points were released "
+                "after the model was assembled"
+            )
 
     def qp_values(self, q) -> tuple[np.ndarray, np.ndarray]:
         """F (n, S) and grad F (n, S, 2) [1/m] at the points q (n,) int,
         each slot in its column (0 in empty slots)."""
+        self._check_values()
         q = np.asarray(q, dtype=np.int64)
         S = self.slot_cand.shape[1]
         e = np.searchsorted(self.qp_offsets, q, side="right") - 1
@@ -110,6 +135,7 @@ class EnrichedCells:
         cells, or a slice of them: then views, no copy), as the cell kernels
         take them: (qp_offsets, points (index array or slice), slot_offsets,
         slot_F, slot_gradF), offsets from 0."""
+        self._check_values()
         if isinstance(rows, slice):
             lo, hi, _ = rows.indices(self.cells.size)
             q0, v0 = self.qp_offsets[lo], self.slot_offsets[lo]

@@ -96,3 +96,24 @@ def test_every_slot_matches_a_cell_by_cell_evaluation():
         for c in np.nonzero((mesh.cells == node).any(axis=1))[0]
     }
     assert pairs == expected and checked == len(expected)
+
+
+def test_without_point_values_keeps_the_rest_and_refuses_their_use():
+    """The copy a solved-only model keeps: no values at the points (their
+    arrays emptied), every other array the same objects, and the two
+    readers of the values raise instead of reading empty arrays."""
+    import pytest
+
+    mesh, fractures = _network()
+    ec = build_enriched_cells(mesh, fractures, find_candidates(mesh, fractures))
+    assert ec.slot_F.size > 0 and not ec.values_released
+    bare = ec.without_point_values()
+    assert bare.values_released and bare.slot_F.size == bare.slot_gradF.size == 0
+    for name in ("cells", "slot_cand", "qp_xy", "qp_w", "tris", "tri_F"):
+        assert getattr(bare, name) is getattr(ec, name)
+    with pytest.raises(RuntimeError, match="released"):
+        bare.qp_values(np.arange(3))
+    with pytest.raises(RuntimeError, match="released"):
+        bare.part(slice(0, 2))
+    F, _ = ec.qp_values(np.arange(3))  # the original keeps them
+    assert F.shape == (3, ec.slot_cand.shape[1])

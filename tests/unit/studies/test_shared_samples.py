@@ -133,3 +133,27 @@ def test_samples_write_no_vtu(spec):
     for _, text, case, _ in sample_cases(spec):
         assert case.output.formats == ("h5",) or list(case.output.formats) == ["h5"]
         assert loads_case(text, Path("x.toml")).output.formats == case.output.formats
+
+
+def test_a_run_drops_the_point_values_a_study_keeps(tmp_path):
+    """solve_and_write outside sharing drops the enrichment values at the
+    points once the model is assembled (the run's answer is that of the
+    model that keeps them); within sharing the model keeps them for the
+    next sample."""
+    from xfemslip.simulation import build_model, newton_solver, solve_and_write
+
+    case = loads_case(BASE, tmp_path / "base.toml")
+
+    def drive(solver, model):
+        return solver.run(model.spec.loading.steps)
+
+    plain = solve_and_write(case, None, False, drive)
+    assert plain.model.ec.values_released
+    model = build_model(case)
+    kept = newton_solver(model).run(case.loading.steps)
+    assert not model.ec.values_released
+    np.testing.assert_array_equal(plain.results[-1].u, kept[-1].u)
+    with shared.sharing():
+        inside = solve_and_write(case, None, False, drive)
+    assert not inside.model.ec.values_released
+    shared.forget()
