@@ -23,12 +23,16 @@ them; PARDISO's own machinery is in pardiso.py.
   factorization alone needs 121 at 200 x 200; a second back-solve after the
   band solve saves at most one iteration and cost 11.0 against 8.9 s).  If
   GMRES has not converged in REUSE_MAX_ITERATIONS iterations the matrix is
-  refactored and kept.  Where the band would hold more than
-  LU_BAND_MAX_FRACTION of the dofs (a network reaching most of the mesh),
-  a system whose tangent changed in few contact patches (a change of rank
-  at most 2 per patch) is solved by GMRES preconditioned with the kept
-  factorization alone, within that rank bound (KEPT_GMRES_MAX); a larger
-  change is refactored.
+  refactored and kept.  A crowded network (the contact blocks of PARDISO's
+  low-rank path, up to lowrank.AUGMENTED_MAX_ROWS patch jumps) is solved on
+  ONE factorization for the run: the stuck matrix bordered by the patch
+  jumps, factored with the jumps last (lowrank.AugmentedLU), every Newton
+  system two back-solves and a dense LU of its change.  Otherwise, where
+  the band would hold more than LU_BAND_MAX_FRACTION of the dofs (a
+  network reaching most of the mesh), a system whose tangent changed in
+  few contact patches (a change of rank at most 2 per patch) is solved by
+  GMRES preconditioned with the kept factorization alone, within that rank
+  bound (KEPT_GMRES_MAX); a larger change is refactored.
 - ``"amg"``: GMRES preconditioned with the same Schwarz sweep: one
   smoothed-aggregation AMG V-cycle (pyamg, rigid-body modes as near-nullspace)
   on the standard dofs in place of the back-solve, then the exact band solve,
@@ -62,12 +66,15 @@ them; PARDISO's own machinery is in pardiso.py.
   otherwise.  All three inputs are known before the first solve
   (system_facts); the choice is logged at debug level.
 
-Why SuperLU refactors instead of a low-rank (Woodbury) update or a Schur
-complement on the contact dofs: through SuperLU both cost one back-solve per
-contact dof, and on the reservoir case at 200 x 200 (82k dofs, 518 contact
-dofs) one back-solve is 1/40 of a factorization, so the update would cost
-about 13 factorizations.  PARDISO forms the Schur complement inside its one
-factorization (pardiso.py), which is what makes that path cheap.
+Why SuperLU refactors a single fracture's matrix instead of a low-rank
+(Woodbury) update or a Schur complement on the contact dofs: through
+SuperLU's solves both cost one back-solve per contact dof, and on the
+reservoir case at 200 x 200 (82k dofs, 518 contact dofs) one back-solve is
+1/40 of a factorization, so the update would cost about 13
+factorizations.  PARDISO forms the Schur complement inside its one
+factorization (pardiso.py); for networks, AugmentedLU makes SuperLU do the
+same by ordering the patch jumps last and reading the trailing block of
+its factors.
 
 The friction tangent is not symmetric while slipping, hence GMRES (not CG)
 whenever a contact tangent is present.  Iterative solves stop at a relative
@@ -211,6 +218,10 @@ LU_BACKWARD_ERROR = 1.0e-10
 MATRIX_BYTES = 48.0
 LU_BYTES = 5.0  # per stiffness non-zero and per log2(n_dofs), one factor [B]
 LU_FACTORS = 2  # factorizations held at once
+# lowrank.AugmentedLU holds one factorization of the stuck matrix bordered
+# by the patch jumps: 56.0M entries in L + U against 42.5M for the stuck
+# matrix alone on 100 branch-tipped fractures at 200 x 200 cells
+AUGMENTED_FILL = 1.35
 # MKL PARDISO's factorization, per stiffness non-zero and per log2(n_dofs):
 # whole runs of the reservoir case peaked at 1043 / 2987 / 5892 MB at 324k /
 # 986k / 2.0M dofs (benchmarks/scaling.py), 5.2-5.6 B after the other terms [B]
@@ -378,7 +389,10 @@ def solver_bytes(
     dofs with its LU (16 B per entry, up to pardiso.SCHUR_MAX_DOFS of them)
     or, with more contact dofs, that of the patches' jumps and its inverse
     part (lowrank.LowRankSystems: 2 rows per patch, 16 B per entry, up to
-    lowrank.MAX_ROWS rows); with "amg", its hierarchy and set-up (AMG_BYTES
+    lowrank.MAX_ROWS rows) -- with "superlu" on such networks, the one
+    augmented factorization of lowrank.AugmentedLU (AUGMENTED_FILL times a
+    factorization), whose jump clique, S and G take 28 B per entry; with
+    "amg", its hierarchy and set-up (AMG_BYTES
     per non-zero), the GMRES basis (AMG_RESTART + 1 vectors) and the kept
     solutions that start each solve (guess.KEEP vectors).  A run whose AMG
     solve fails over to SuperLU may need more."""
@@ -394,7 +408,16 @@ def solver_bytes(
             out += 16.0 * (2.0 * patches) ** 2
     else:
         log_n = math.log2(max(n_dofs, 2))
-        out = nnz * (MATRIX_BYTES + LU_FACTORS * LU_BYTES * log_n)
+        factors = float(LU_FACTORS)
+        augmented = (
+            contact_dofs > pardiso.SCHUR_MAX_DOFS
+            and 0.0 < 2.0 * patches <= lowrank.AUGMENTED_MAX_ROWS
+        )
+        if augmented:  # lowrank.AugmentedLU: one factorization, more fill
+            factors = AUGMENTED_FILL
+        out = nnz * (MATRIX_BYTES + factors * LU_BYTES * log_n)
+        if augmented:  # the jump clique (12 B per entry), S and G (16 B)
+            out += 28.0 * (2.0 * patches) ** 2
     return out
 
 
@@ -617,6 +640,7 @@ class LinearSolver:
             "schur_factorizations": 0,
             "pardiso_fallbacks": 0,
             "pardiso_lowrank": 0,
+            "lowrank_superlu": 0,
             "lowrank_updates": 0,
             "lowrank_rank": 0,
             "shared_reuses": 0,
@@ -626,6 +650,9 @@ class LinearSolver:
         self._pardiso = None
         self._pardiso_key = None
         self._lu = None  # (SuperLU object, checked solve, K_c it factors)
+        # lowrank.AugmentedLU for a crowded network on SuperLU, made on the
+        # first contact solve; False: not used in this run
+        self._augmented: lowrank.AugmentedLU | bool | None = None
         # the contact blocks of the system being solved and of the factored
         # one (solve_contact), for _kept_gmres
         self._blocks_now = None
@@ -686,6 +713,13 @@ class LinearSolver:
                 self.stats["solves"] += 1
                 self.stats["solve_time"] += time.perf_counter() - start
                 return x
+        if self.method == "superlu" and self._augmented is not False:
+            start = time.perf_counter()
+            x = self._solve_augmented(blocks, r)
+            if x is not None:
+                self.stats["solves"] += 1
+                self.stats["solve_time"] += time.perf_counter() - start
+                return x
         Kc = None
         if blocks is not None and np.size(blocks):
             Kc = coo_block(self.contact_dofs, blocks, self.K.shape[0], self.kernels)
@@ -694,6 +728,45 @@ class LinearSolver:
             return self.solve(Kc, r)
         finally:
             self._blocks_now = None
+
+    def _solve_augmented(self, blocks, r):
+        """The solve on one SuperLU factorization of the stuck matrix
+        augmented by the patch jumps (lowrank.AugmentedLU), for networks
+        whose contact blocks would go to PARDISO's low-rank path; None when
+        it does not apply or has failed (logged once; this and the later
+        systems of the run go to the kept factorization of the whole
+        matrix)."""
+        if self._augmented is None:
+            dofs = np.asarray(self.contact_dofs, dtype=np.int64)
+            if dofs.ndim != 2:
+                dofs = dofs.reshape(len(dofs), -1)
+            rows = 2 * dofs.shape[0]
+            if not (self._lowrank_applies(dofs) and rows <= lowrank.AUGMENTED_MAX_ROWS):
+                self._augmented = False
+                return None
+            self._augmented = lowrank.AugmentedLU(
+                self.K,
+                dofs,
+                self.contact_coef,
+                self.contact_stick,
+                LU_BACKWARD_ERROR,
+                self.stats,
+                LU_FAST,
+            )
+        assert isinstance(self._augmented, lowrank.AugmentedLU)
+        t = time.perf_counter()
+        try:
+            return self._augmented.solve(self._augmented.values(blocks), False, r)
+        except RuntimeError as exc:
+            logger.warning(
+                "%s after %.2f s; SuperLU on the whole matrix solves this and "
+                "the later systems of the run",
+                exc,
+                time.perf_counter() - t,
+            )
+            self._augmented.release()
+            self._augmented = False
+            return None
 
     def _solve_shared(self, blocks, r):
         """The solve on the Schur factors kept between runs of the same

@@ -245,3 +245,175 @@ def test_without_coefficients_the_paths_are_as_before(monkeypatch):
     ls = LinearSolver(sp.identity(4, format="csr"), "superlu")
     assert not ls._lowrank_applies(np.array([[0, 1, 2, 3]]))
     assert linear.lowrank is lowrank
+
+
+# ------------------------------------------------- the same on SuperLU alone
+
+
+def _augmented_solver(newton):
+    c = newton.p.contact
+    return LinearSolver(
+        newton.K_ff,
+        "superlu",
+        newton.free,
+        None,
+        newton.c_dofs,
+        contact_coef=c.coef,
+        contact_stick=_stick(newton),
+    )
+
+
+@pytest.mark.parametrize(
+    ("friction", "slips"), [(0.1, True), (10.0, False)], ids=["sliding", "stuck"]
+)
+def test_superlu_augmented_systems_match_spsolve(friction, slips, monkeypatch):
+    """Without PARDISO: every Newton system of a 3-step run (the reservoir
+    case, its contact dofs sent past the Schur limit) on ONE SuperLU
+    factorization of the augmented matrix: the backward error bound and
+    spsolve's answer to 1e-8, a dense LU per new tangent."""
+    monkeypatch.setattr(pardiso, "SCHUR_MAX_DOFS", 0)
+    newton, seq = recorded_systems(_reservoir(friction=friction), CASE, 3)
+    ls = _augmented_solver(newton)
+    changes, last = 0, None
+    for blocks, r in seq:
+        A = (
+            newton.K_ff + coo_block(newton.c_dofs, blocks, newton.free.size, "numpy")
+        ).tocsc()
+        changes += last is None or not np.array_equal(blocks, last)
+        last = blocks
+        x = ls.solve_contact(blocks, r)
+        assert backward_error(A, x, r) <= LU_BACKWARD_ERROR
+        x_ref = spla.spsolve(A, r)
+        assert np.linalg.norm(x - x_ref) <= 1e-8 * np.linalg.norm(x_ref)
+    st = ls.stats
+    assert isinstance(ls._augmented, lowrank.AugmentedLU)
+    assert st["lowrank_superlu"] == len(seq) == st["solves"]
+    assert st["factorizations"] == 1 and st["lowrank_updates"] == changes
+    assert (st["lowrank_rank"] > 0) == slips
+
+
+@pytest.mark.parametrize("reordered", [False, True], ids=["its-order", "moved-last"])
+def test_superlu_schur_block_is_the_jump_compliance(reordered, monkeypatch):
+    """G = M R^-1 M^T read off the trailing block of the augmented factors
+    equals the product from SuperLU's solves of the stuck matrix R =
+    K_ff + M^T M, whether the minimum-degree ordering left the jump rows
+    last by itself or they were moved there (its eigenvalues in [0, 1])."""
+    from scipy.sparse.linalg import splu as real_splu
+
+    newton, _ = recorded_systems(_reservoir(n=12, steps=1), CASE, 1)
+    c = newton.p.contact
+    stats = dict.fromkeys(("factorizations",), 0)
+    stats["factor_time"] = 0.0
+    calls = []
+
+    def splu(A, **kw):  # the first ordering with the jump rows not last
+        lu = real_splu(A, **kw)
+        calls.append(kw["permc_spec"])
+        if reordered and len(calls) == 1:
+
+            class Shuffled:
+                perm_r = perm_c = np.arange(A.shape[0])[::-1].copy()
+
+            return Shuffled()
+        return lu
+
+    monkeypatch.setattr(spla, "splu", splu)
+    systems = lowrank.AugmentedLU(
+        newton.K_ff,
+        newton.c_dofs,
+        c.coef,
+        _stick(newton),
+        LU_BACKWARD_ERROR,
+        stats,
+        linear.LU_FAST,
+    )
+    systems._factor()
+    n = newton.K_ff.shape[0]
+    if reordered:
+        assert calls == ["MMD_AT_PLUS_A", "NATURAL"] and systems._order is not None
+        m2 = systems.M.shape[0]
+        assert np.array_equal(systems._order[-m2:] - n, np.arange(m2))
+    M = systems.M.toarray()
+    R = (newton.K_ff + sp.csr_matrix(M.T @ M)).tocsc()
+    ref = M @ real_splu(R).solve(M.T)
+    np.testing.assert_allclose(systems.G, ref, rtol=0, atol=1e-10 * abs(ref).max())
+    lam = np.linalg.eigvalsh(0.5 * (ref + ref.T))
+    assert lam.min() > -1e-12 and lam.max() < 1.0 + 1e-12
+    assert systems._B is None  # released once factored
+
+
+def test_superlu_open_patches_are_a_rank_two_change(monkeypatch):
+    """Open patches (zero blocks) next to stuck and slipping ones on the
+    augmented SuperLU path: spsolve's answer, rank 2 per open patch."""
+    monkeypatch.setattr(pardiso, "SCHUR_MAX_DOFS", 0)
+    newton, seq = recorded_systems(_reservoir(friction=0.1, steps=1), CASE, 1)
+    blocks, r = seq[-1]
+    blocks = blocks.copy()
+    blocks[::3] = 0.0
+    ls = _augmented_solver(newton)
+    x = ls.solve_contact(blocks, r)
+    A = (
+        newton.K_ff + coo_block(newton.c_dofs, blocks, newton.free.size, "numpy")
+    ).tocsc()
+    x_ref = spla.spsolve(A, r)
+    assert np.linalg.norm(x - x_ref) <= 1e-8 * np.linalg.norm(x_ref)
+    assert ls.stats["lowrank_rank"] >= 2 * len(blocks[::3])
+    assert ls.stats["lowrank_superlu"] == 1
+
+
+def test_superlu_blocks_of_another_form_go_to_the_kept_factorization(
+    monkeypatch, caplog
+):
+    """A block that is not c c^T (x) D on the augmented path: one warning,
+    that system and the later ones on SuperLU's factorization of the whole
+    matrix, the same answers."""
+    monkeypatch.setattr(pardiso, "SCHUR_MAX_DOFS", 0)
+    newton, seq = recorded_systems(_reservoir(n=16, steps=1), CASE, 1)
+    blocks, r = seq[0]
+    blocks = blocks.copy()
+    blocks[0] += np.diag(np.arange(blocks.shape[1], dtype=float)) * abs(blocks).max()
+    ls = _augmented_solver(newton)
+    with caplog.at_level(logging.WARNING, logger="xfemslip.solve.linear"):
+        for _ in range(2):
+            x = ls.solve_contact(blocks, r)
+            A = (
+                newton.K_ff
+                + coo_block(newton.c_dofs, blocks, newton.free.size, "numpy")
+            ).tocsc()
+            x_ref = spla.spsolve(A, r)
+            assert np.linalg.norm(x - x_ref) <= 1e-8 * np.linalg.norm(x_ref)
+    assert caplog.text.count("not of the patch form") == 1
+    assert ls._augmented is False and ls._lu is not None
+    assert ls.stats["lowrank_superlu"] == 0 and ls.stats["solves"] == 2
+
+
+def test_network_run_on_superlu_matches_the_kept_factorization_path(monkeypatch):
+    """The shipped 15-fracture network (crossings, T's, branch tips, 4 load
+    steps) on SuperLU through the augmented factorization and through the
+    factorizations of the whole matrix: the same Newton iterations and the
+    same slip to 1e-7 of its maximum; one factorization for the run."""
+    monkeypatch.setattr(pardiso, "SCHUR_MAX_DOFS", 0)
+    text = NETWORK.read_text().replace("elements = [80, 80]", "elements = [40, 40]")
+    text = text.replace("[solver]", '[solver]\nlinear_solver = "superlu"', 1)
+    assert "elements = [40, 40]" in text and 'linear_solver = "superlu"' in text
+    out = {}
+    for path in ("augmented", "whole"):
+        if path == "whole":
+            monkeypatch.setattr(lowrank, "AUGMENTED_MAX_ROWS", 0)
+        model = build_model(loads_case(text, NETWORK))
+        solver = newton_solver(model)
+        steps = solver.run(model.spec.loading.steps)
+        st = solver.linear.stats
+        assert (st["lowrank_superlu"] > 0) == (path == "augmented")
+        if path == "augmented":  # the clique left the jump rows last by itself
+            assert solver.linear._augmented._order is None
+        out[path] = (
+            [s.iterations for s in steps],
+            np.concatenate([s.contact.point_gt for s in steps]),
+            st["factorizations"],
+        )
+    assert out["augmented"][0] == out["whole"][0]
+    ref = np.abs(out["whole"][1]).max()
+    assert ref > 0.0
+    assert np.abs(out["augmented"][1] - out["whole"][1]).max() <= 1e-7 * ref
+    assert out["augmented"][2] == 1 < out["whole"][2]
