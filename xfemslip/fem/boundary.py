@@ -221,17 +221,18 @@ def _edge_points(mesh, segments, fractures):
     piece of edge (P, 2), which decides the side of the fracture, and the
     weight times the length (P,) [m]."""
     lines = [ln for fr in fractures for ln in fr.kink_lines()]
+    points = np.array([pt for pt, _ in lines], float).reshape(-1, 2)
+    normals = np.array([nm for _, nm in lines], float).reshape(-1, 2)
     seg, xs, mids, coefs = [], [], [], []
     for i, (_, _, p, q, _) in enumerate(segments):
         xp, xq = mesh.nodes[p], mesh.nodes[q]
-        cuts = [0.0, 1.0]
-        for point, normal in lines:
-            den = (xq - xp) @ normal
-            if den != 0.0:
-                s = ((point - xp) @ normal) / den
-                if 0.0 < s < 1.0:
-                    cuts.append(s)
-        cuts = np.sort(cuts)
+        # where the edge crosses each kink line, all lines at once
+        den = normals[:, 0] * (xq - xp)[0] + normals[:, 1] * (xq - xp)[1]
+        off = points - xp
+        num = off[:, 0] * normals[:, 0] + off[:, 1] * normals[:, 1]
+        with np.errstate(divide="ignore", invalid="ignore"):
+            s = np.where(den != 0.0, num / den, -1.0)
+        cuts = np.sort(np.concatenate([[0.0, 1.0], s[(s > 0.0) & (s < 1.0)]]))
         a0, a1 = cuts[:-1, None], cuts[1:, None]
         s = 0.5 * (a0 + a1) + 0.5 * (a1 - a0) * LINE_POINTS[None, :]  # (m, 4)
         xs.append(xp + s.reshape(-1, 1) * (xq - xp))
