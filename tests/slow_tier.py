@@ -116,6 +116,7 @@ SLOW_TESTS = frozenset(
         "tests/unit/solve/test_linsolve.py::test_whole_run_agrees_between_linear_solvers",
         "tests/unit/solve/test_linsolve_auto.py::test_auto_picks_per_case_end_to_end",
         "tests/unit/solve/test_lowrank.py::test_network_run_matches_the_general_path",
+        "tests/unit/solve/test_lowrank.py::test_network_run_on_superlu_matches_the_kept_factorization_path",
         "tests/unit/solve/test_pardiso.py::test_newton_systems_match_superlu[sliding-pattern]",
         "tests/unit/solve/test_pardiso.py::test_newton_systems_match_superlu[sliding-schur]",
         "tests/unit/studies/test_depletion_onset.py::test_a_horizon_crossing_a_fracture_is_no_singularity",
