@@ -46,6 +46,7 @@ checked against the whole matrix by its backward error, as everywhere.
 
 from __future__ import annotations
 
+import logging
 import time
 
 import numpy as np
@@ -54,6 +55,8 @@ import scipy.sparse as sp
 
 from xfemslip.solve.backward import refined
 from xfemslip.solve.pardiso import MTYPE_SPD, Handle, PardisoError
+
+logger = logging.getLogger(__name__)
 
 # Largest number of patch jump rows (2 per patch) of the Schur block: it takes
 # 8 (2m)^2 bytes (288 MB at 6000) and a dense LU of up to that size per new
@@ -390,7 +393,16 @@ class AugmentedLU(LowRankSystems):
         self._S = S
         self.G = 2.0 * np.eye(S.shape[0]) - S
         self.stats["factorizations"] += 1
-        self.stats["factor_time"] += time.perf_counter() - t
+        elapsed = time.perf_counter() - t
+        self.stats["factor_time"] += elapsed
+        logger.debug(
+            "SuperLU: the stuck matrix bordered by %d patch jumps factored in "
+            "%.2f s (%.1fM entries in L + U, jump rows %s)",
+            m2,
+            elapsed,
+            lu.nnz / 1e6,
+            "ordered last" if order is None else "moved last",
+        )
 
     def _solve(self, r):
         _, _, rows, pu, pv, lu = self._update
