@@ -318,7 +318,8 @@ class AugmentedLU(LowRankSystems):
     factored whole, with the jump rows eliminated last: their block is
     stored as a dense clique (explicit zeros beside the 2 I), so the
     minimum-degree ordering of A^T + A leaves them to the end (checked on
-    the permutation; otherwise the factorization is refused).  The trailing
+    the permutation; where it does not, on small meshes, that ordering with
+    the jump rows moved last is factored as it stands).  The trailing
     block of the factors is then the Schur complement S = 2 I - G, read off
     as L22 U22.  With E = P_U P_V^T (LowRankSystems), a Newton system
     A x = r, A = R + M^T E M, is two solves with B:
