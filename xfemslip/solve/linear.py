@@ -695,31 +695,23 @@ class LinearSolver:
     def solve_contact(self, blocks, r):
         """x with (K_ff + sum of the contact blocks) x = r; blocks (m, k, k)
         on the rows and columns contact_dofs (m, k), or None."""
-        if self.method == "pardiso":
-            start = time.perf_counter()
-            if self._pardiso is None:
-                self._make_pardiso_contact()
-            x = self._solve_pardiso(blocks, self._symmetric(blocks), r)
-            if x is None and self.method == "pardiso":  # low-rank failed
-                x = self._solve_pardiso(blocks, self._symmetric(blocks), r)
-            if x is not None:
-                self.stats["solves"] += 1
-                self.stats["solve_time"] += time.perf_counter() - start
-                return x
-        if self.method == "superlu" and shared.active():
-            start = time.perf_counter()
-            x = self._solve_shared(blocks, r)
-            if x is not None:
-                self.stats["solves"] += 1
-                self.stats["solve_time"] += time.perf_counter() - start
-                return x
-        if self.method == "superlu" and self._augmented is not False:
-            start = time.perf_counter()
-            x = self._solve_augmented(blocks, r)
-            if x is not None:
-                self.stats["solves"] += 1
-                self.stats["solve_time"] += time.perf_counter() - start
-                return x
+        # the paths that keep a factorization of their own, in turn; each
+        # returns None when it does not apply or has failed
+        for applies, path in (
+            (lambda: self.method == "pardiso", self._solve_pardiso_contact),
+            (lambda: self.method == "superlu" and shared.active(), self._solve_shared),
+            (
+                lambda: self.method == "superlu" and self._augmented is not False,
+                self._solve_augmented,
+            ),
+        ):
+            if applies():
+                start = time.perf_counter()
+                x = path(blocks, r)
+                if x is not None:
+                    self.stats["solves"] += 1
+                    self.stats["solve_time"] += time.perf_counter() - start
+                    return x
         Kc = None
         if blocks is not None and np.size(blocks):
             Kc = coo_block(self.contact_dofs, blocks, self.K.shape[0], self.kernels)
@@ -728,6 +720,17 @@ class LinearSolver:
             return self.solve(Kc, r)
         finally:
             self._blocks_now = None
+
+    def _solve_pardiso_contact(self, blocks, r):
+        """The PARDISO solve of the contact blocks, made on the first call;
+        after a failure of the low-rank path, once more on the general one
+        (None when PARDISO has failed altogether)."""
+        if self._pardiso is None:
+            self._make_pardiso_contact()
+        x = self._solve_pardiso(blocks, self._symmetric(blocks), r)
+        if x is None and self.method == "pardiso":  # low-rank failed
+            x = self._solve_pardiso(blocks, self._symmetric(blocks), r)
+        return x
 
     def _solve_augmented(self, blocks, r):
         """The solve on one SuperLU factorization of the stuck matrix

@@ -368,9 +368,13 @@ class AugmentedLU(LowRankSystems):
 
         t = time.perf_counter()
         n, m2 = self.n, self.M.shape[0]
+
+        def jumps_last(lu) -> bool:
+            return min(lu.perm_r[n:].min(initial=n), lu.perm_c[n:].min(initial=n)) >= n
+
         lu = splu(self._B, **self._settings)
         order = None
-        if min(lu.perm_r[n:].min(initial=n), lu.perm_c[n:].min(initial=n)) < n:
+        if not jumps_last(lu):
             # small meshes: the clique is not the last of the minimum
             # degrees; the same ordering with the jump rows moved to the end,
             # factored as it stands
@@ -380,7 +384,7 @@ class AugmentedLU(LowRankSystems):
             B = self._B[order][:, order].tocsc()
             lu = splu(B, **dict(self._settings, permc_spec="NATURAL"))
             del B
-            if min(lu.perm_r[n:].min(initial=n), lu.perm_c[n:].min(initial=n)) < n:
+            if not jumps_last(lu):
                 raise RuntimeError("SuperLU pivoted a patch jump row forward")
         rows, cols = lu.perm_r[n:] - n, lu.perm_c[n:] - n
         self._B = None  # factored: not needed again (12M entries at 147k dofs)

@@ -13,12 +13,12 @@ import pytest
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
-from tests.support.newton_systems import recorded_systems
+from tests.support.newton_systems import recorded_systems, solve_like_spsolve
 from xfemslip.case import loads_case
 from xfemslip.fem.assembly import coo_block
 from xfemslip.simulation import build_model, newton_solver
 from xfemslip.solve import linear, lowrank, pardiso
-from xfemslip.solve.linear import LU_BACKWARD_ERROR, LinearSolver, backward_error
+from xfemslip.solve.linear import LU_BACKWARD_ERROR, LinearSolver
 
 ROOT = Path(__file__).resolve().parents[3]
 CASE = ROOT / "cases" / "reservoir_depletion.toml"
@@ -145,17 +145,7 @@ def test_newton_systems_match_superlu(friction, slips, monkeypatch):
     monkeypatch.setattr(pardiso, "SCHUR_MAX_DOFS", 0)
     newton, seq = recorded_systems(_reservoir(friction=friction), CASE, 3)
     ls = _lowrank_solver(newton)
-    changes, last = 0, None
-    for blocks, r in seq:
-        A = (
-            newton.K_ff + coo_block(newton.c_dofs, blocks, newton.free.size, "numpy")
-        ).tocsc()
-        changes += last is None or not np.array_equal(blocks, last)
-        last = blocks
-        x = ls.solve_contact(blocks, r)
-        assert backward_error(A, x, r) <= LU_BACKWARD_ERROR
-        x_ref = spla.spsolve(A, r)
-        assert np.linalg.norm(x - x_ref) <= 1e-8 * np.linalg.norm(x_ref)
+    changes, _ = solve_like_spsolve(newton, seq, ls)
     st = ls.stats
     assert isinstance(ls._pardiso, lowrank.LowRankSystems)
     assert st["pardiso_lowrank"] == len(seq) and st["pardiso_fallbacks"] == 0
@@ -274,17 +264,7 @@ def test_superlu_augmented_systems_match_spsolve(friction, slips, monkeypatch):
     monkeypatch.setattr(pardiso, "SCHUR_MAX_DOFS", 0)
     newton, seq = recorded_systems(_reservoir(friction=friction), CASE, 3)
     ls = _augmented_solver(newton)
-    changes, last = 0, None
-    for blocks, r in seq:
-        A = (
-            newton.K_ff + coo_block(newton.c_dofs, blocks, newton.free.size, "numpy")
-        ).tocsc()
-        changes += last is None or not np.array_equal(blocks, last)
-        last = blocks
-        x = ls.solve_contact(blocks, r)
-        assert backward_error(A, x, r) <= LU_BACKWARD_ERROR
-        x_ref = spla.spsolve(A, r)
-        assert np.linalg.norm(x - x_ref) <= 1e-8 * np.linalg.norm(x_ref)
+    changes, _ = solve_like_spsolve(newton, seq, ls)
     st = ls.stats
     assert isinstance(ls._augmented, lowrank.AugmentedLU)
     assert st["lowrank_superlu"] == len(seq) == st["solves"]
