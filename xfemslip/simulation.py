@@ -491,7 +491,8 @@ def solve_and_write(
         solver = newton_solver(model)
         value = failure = None
         try:
-            value = drive(solver, model)
+            with solver.linear.blas_threads():
+                value = drive(solver, model)
         except ConvergenceError as exc:
             failure = exc
         interrupt.checkpoint()  # a signal swallowed while solving ends it here

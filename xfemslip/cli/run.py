@@ -105,6 +105,7 @@ def info() -> None:
         (name, _dist_version(name))
         for name in (
             *("numpy", "scipy", "numba", "h5py", "meshio", "click", "tomli-w"),
+            "threadpoolctl",
             # optional: AMG, figures, Dask sweeps, MKL PARDISO (the mkl extra),
             # VTK (the tests read the ParaView files with it)
             *("pyamg", "matplotlib", "dask", "distributed", "pypardiso", "vtk"),

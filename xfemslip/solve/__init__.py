@@ -11,9 +11,10 @@ Modules:
   with the Schur complement on the contact dofs, or a fixed pattern;
 - ``lowrank``: the PARDISO path of networks: the stuck matrix factored once,
   each Newton system a low-rank change of it;
-- ``backward``: the backward error every solve is checked against.
+- ``backward``: the backward error every solve is checked against;
+- ``threads``: OpenBLAS on one thread while PARDISO solves.
 
 The subpackage imports nothing itself: import the module you need (``from
 xfemslip.solve.newton import ...``)."""
 
-__all__ = ["backward", "linear", "lowrank", "newton", "pardiso"]
+__all__ = ["backward", "linear", "lowrank", "newton", "pardiso", "threads"]

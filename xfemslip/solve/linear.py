@@ -84,6 +84,7 @@ with the direct solve.
 
 from __future__ import annotations
 
+import contextlib
 import importlib.util
 import logging
 import math
@@ -690,6 +691,16 @@ class LinearSolver:
             )
         else:
             logger.debug("linear solver: %s (%d free dofs)", self.method, n)
+
+    def blas_threads(self) -> contextlib.AbstractContextManager:
+        """The context the Newton solve runs in: OpenBLAS on one thread
+        when PARDISO solves (its MKL threads and OpenBLAS's would wait for
+        each other's cores: xfemslip.solve.threads), else nothing."""
+        if self.method != "pardiso":
+            return contextlib.nullcontext()
+        from xfemslip.solve.threads import one_openblas_thread
+
+        return one_openblas_thread()
 
     # ------------------------------------------------------------------ #
     def solve_contact(self, blocks, r):
