@@ -126,78 +126,38 @@ def grid_stiffness(mesh, cells, K_u, which) -> sp.csr_matrix:
     return sp.csr_matrix((values, indices, indptr), shape=(2 * N, 2 * N), copy=False)
 
 
-def add_to_grid(mesh, K_grid, rows, cols, vals, n) -> sp.csr_matrix:
-    """K_grid (grid_stiffness) plus the entries (rows, cols, vals) as (n, n)
-    CSR, n >= 2 n_nodes, keeping K_grid's pattern (its zeros too; scipy's
-    sum drops them).  K_grid's data are added to in place.
+def add_to_grid(K_grid, entries, to_dof, n, backend) -> sp.csr_matrix:
+    """K_grid (grid_stiffness) plus the entries [rows, cols, vals] (the list
+    is emptied: the caller keeps no reference) renumbered by to_dof (an entry
+    with a -1 left out), as (n, n) CSR, n >= 2 n_nodes, keeping K_grid's
+    pattern (its zeros too; scipy's sum drops them).  K_grid's data are
+    added to in place.
 
     An entry between two standard dofs lies in the grid's pattern (both
     nodes belong to one cell) and is added where it is; the others (a row or
     column of an enriched dof, numbered after the standard ones) are summed
-    into CSR and inserted after the grid's entries of their row, which keeps
-    every row's columns increasing."""
-    nx = mesh.nx
-    n_std = K_grid.shape[0]
-    rows = np.asarray(rows)
-    cols = np.asarray(cols)
-    if rows.dtype.kind != "i" or cols.dtype.kind != "i":
-        rows, cols = rows.astype(np.int64), cols.astype(np.int64)
-    vals = np.asarray(vals, dtype=np.float64)
-    std = (rows < n_std) & (cols < n_std)
-    if vals.size == 0 and n == n_std:
+    and appended to their rows after the grid's entries, which keeps every
+    row's columns increasing (kernel csr_add_entries of ``backend``)."""
+    rows, cols, vals = entries
+    entries.clear()
+    if vals.size == 0 and n == K_grid.shape[0]:
         return K_grid
-    data = K_grid.data
-    if std.any():
-        r, c = rows[std], cols[std]
-        i, j = r // 2, c // 2
-        dy = j // (nx + 1) - i // (nx + 1)
-        dx = j % (nx + 1) - i % (nx + 1)
-        if np.abs(dx).max() > 1 or np.abs(dy).max() > 1:
-            raise ValueError("an entry between standard dofs outside one cell")
-        k = (dy + 1) * 3 + (dx + 1)
-        # the neighbours of node i inside the grid before neighbour k: the
-        # entry's place in the row grid_stiffness wrote
-        inside = _neighbours_inside(i % (nx + 1), i // (nx + 1), nx, mesh.ny)
-        before = np.cumsum(inside, axis=1) - inside
-        pos = K_grid.indptr[r] + 2 * before[np.arange(r.size), k] + c % 2
-        if pos.size > data.size // 16:  # many entries (networks): one pass
-            data += np.bincount(pos, weights=vals[std], minlength=data.size)
-        else:
-            np.add.at(data, pos, vals[std])
-    tail = sp.coo_matrix((vals[~std], (rows[~std], cols[~std])), shape=(n, n))
-    del rows, cols, vals, std  # the caller's entries: freed here if it holds none
-    tail = tail.tocsr()
-    tail.sum_duplicates()
-    indptr = np.zeros(n + 1, dtype=np.int64)
-    indptr[: n_std + 1] = K_grid.indptr
-    indptr[n_std + 1 :] = K_grid.indptr[-1]
-    # the tail's entries of row r go after the grid's, at indptr[r + 1]: the
-    # grid's arrays are copied run by run between those points, one run per
-    # distinct point (the enriched rows all go after the last grid entry);
-    # np.insert took twice as long: it indexes every entry
-    ends = np.cumsum(np.diff(tail.indptr))
-    row_points = indptr[1:]
-    last = np.nonzero(np.r_[row_points[1:] != row_points[:-1], True])[0]
-    counts = np.diff(np.r_[0, ends[last]])
-    points = row_points[last]
-    keep = counts > 0
-    counts, points = counts[keep], points[keep]
-    index_type = K_grid.indices.dtype
-    out_indptr = (indptr + tail.indptr).astype(index_type)
-    out_data = np.empty(out_indptr[-1])
-    out_indices = np.empty(out_indptr[-1], dtype=index_type)
-    src = dst = t = 0
-    for point, count in zip(points.tolist(), counts.tolist(), strict=True):
-        run = point - src
-        out_data[dst : dst + run] = data[src:point]
-        out_indices[dst : dst + run] = K_grid.indices[src:point]
-        dst += run
-        out_data[dst : dst + count] = tail.data[t : t + count]
-        out_indices[dst : dst + count] = tail.indices[t : t + count]
-        dst, src, t = dst + count, point, t + count
-    out_data[dst:] = data[src:]
-    out_indices[dst:] = K_grid.indices[src:]
-    return sp.csr_matrix((out_data, out_indices, out_indptr), shape=(n, n), copy=False)
+    indptr, indices, data, bad = kernels.backend(backend).csr_add_entries(
+        K_grid.indptr,
+        K_grid.indices,
+        K_grid.data,
+        rows,
+        cols,
+        np.ascontiguousarray(vals, dtype=np.float64),
+        np.ascontiguousarray(to_dof, dtype=np.int64),
+        n,
+    )
+    if bad >= 0:
+        raise ValueError(
+            f"an entry between standard dofs outside one cell: "
+            f"({to_dof[rows[bad]]}, {to_dof[cols[bad]]})"
+        )
+    return sp.csr_matrix((data, indices, indptr), shape=(n, n), copy=False)
 
 
 def _rect_stiffness_shared(hx, hy, D, material, backend):
@@ -362,27 +322,6 @@ def _enriched_entries(mesh, ec, D, material, qp_material, backend):
     return diag, Bbar, [rows, cols, vals]
 
 
-def _kept_entries(
-    entries, to_dof, step=1 << 20
-) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """The entries [rows, cols, vals] (emptied: the caller keeps no
-    reference) renumbered by to_dof, those with a -1 left out, in place and
-    in order, as (rows, cols, vals) views."""
-    rows, cols, vals = entries
-    entries.clear()
-    w = 0
-    for a in range(0, vals.size, step):
-        b = min(a + step, vals.size)
-        r, c = to_dof[rows[a:b]], to_dof[cols[a:b]]
-        keep = (r >= 0) & (c >= 0)
-        k = int(np.count_nonzero(keep))
-        rows[w : w + k] = r[keep]
-        cols[w : w + k] = c[keep]
-        vals[w : w + k] = vals[a:b][keep]
-        w += k
-    return rows[:w], cols[:w], vals[:w]
-
-
 def assemble_bulk(
     mesh,
     D,
@@ -452,7 +391,7 @@ def assemble_bulk(
             ).ravel(),
         ]
     )
-    K = add_to_grid(mesh, K_grid, *_kept_entries(entries, to_dof), n)
+    K = add_to_grid(K_grid, entries, to_dof, n, backend)
     logger.info(
         "bulk: %d cells (%d enriched), %d dofs (%d enriched)",
         mesh.n_cells,

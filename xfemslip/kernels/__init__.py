@@ -33,6 +33,7 @@ KERNELS = (
     "cell_subtriangles",
     "contact_response",
     "coulomb_return_map",
+    "csr_add_entries",
     "enriched_cell_matrices",
     "rectangle_stiffness",
 )

@@ -3,7 +3,7 @@ NumPy backend (vectorized.py) also has.  Importing it imports Numba."""
 
 from xfemslip.kernels.bulk import enriched_cell_matrices, rectangle_stiffness
 from xfemslip.kernels.contact import contact_response, coulomb_return_map
-from xfemslip.kernels.scatter import block_triplets
+from xfemslip.kernels.scatter import block_triplets, csr_add_entries
 from xfemslip.kernels.subcells import cell_subtriangles
 
 __all__ = [
@@ -11,6 +11,7 @@ __all__ = [
     "cell_subtriangles",
     "contact_response",
     "coulomb_return_map",
+    "csr_add_entries",
     "enriched_cell_matrices",
     "rectangle_stiffness",
 ]

@@ -20,6 +20,7 @@ Formulas and argument conventions: see the Numba kernel of the same name.
 from __future__ import annotations
 
 import numpy as np
+import scipy.sparse as sp
 
 from xfemslip.conventions import OPEN, SLIP, STICK, TANGENT_SECANT
 from xfemslip.kernels._config import SECANT_MIN_INCREMENT
@@ -362,6 +363,65 @@ def block_triplets(dofs, blocks):
     rows = np.broadcast_to(dofs[:, :, None], (dofs.shape[0], k, k))[pair]
     cols = np.broadcast_to(dofs[:, None, :], (dofs.shape[0], k, k))[pair]
     return rows.astype(np.int64), cols.astype(np.int64), blocks[pair]
+
+
+def csr_add_entries(indptr, indices, data, rows, cols, vals, to_dof, n):
+    """scatter.csr_add_entries: the (n, n) CSR sum of the matrix (indptr,
+    indices, data) on the first rows and the entries renumbered by to_dof,
+    as (indptr, indices, data, bad) (the same matrix, each sum to round-off:
+    SciPy sums the appended duplicates in an order of its own)."""
+    n_std = indptr.size - 1
+    r, c = to_dof[rows], to_dof[cols]
+    keep = (r >= 0) & (c >= 0)
+    r, c, vals = r[keep], c[keep], vals[keep]
+    std = (r < n_std) & (c < n_std)
+    # each entry on the first rows found among its row's columns (at most
+    # a few tens: one pass per place in the row)
+    rs, cs = r[std], c[std]
+    start = indptr[rs].astype(np.int64)
+    length = indptr[rs + 1] - start
+    pos = np.full(rs.size, -1, np.int64)
+    last = max(indices.size - 1, 0)
+    for k in range(int(length.max(initial=0))):
+        hit = (k < length) & (indices[np.minimum(start + k, last)] == cs)
+        pos[hit] = start[hit] + k
+    if np.any(pos < 0):  # the first entry outside the pattern, as given
+        given = np.nonzero(keep)[0][std]
+        return indptr, indices, data, int(given[np.argmax(pos < 0)])
+    if pos.size > data.size // 16:  # many entries: one pass
+        data += np.bincount(pos, weights=vals[std], minlength=data.size)
+    else:
+        np.add.at(data, pos, vals[std])
+    tail = sp.coo_matrix((vals[~std], (r[~std], c[~std])), shape=(n, n)).tocsr()
+    tail.sum_duplicates()
+    del r, c, vals, std, rs, cs, start, length, pos
+    grid_ptr = np.full(n + 1, indptr[-1], dtype=np.int64)
+    grid_ptr[: n_std + 1] = indptr
+    # the tail's entries of row r go after the matrix's, at grid_ptr[r + 1]:
+    # the matrix's arrays are copied run by run between those points, one
+    # run per distinct point (the rows past n_std all at the end); np.insert
+    # took twice as long: it indexes every entry
+    ends = np.cumsum(np.diff(tail.indptr))
+    row_points = grid_ptr[1:]
+    distinct = np.nonzero(np.r_[row_points[1:] != row_points[:-1], True])[0]
+    counts = np.diff(np.r_[0, ends[distinct]])
+    points = row_points[distinct]
+    counts, points = counts[counts > 0], points[counts > 0]
+    out_ptr = (grid_ptr + tail.indptr).astype(indptr.dtype)
+    out_val = np.empty(int(out_ptr[-1]))
+    out_idx = np.empty(int(out_ptr[-1]), dtype=indices.dtype)
+    src = dst = t = 0
+    for point, count in zip(points.tolist(), counts.tolist(), strict=True):
+        run = point - src
+        out_val[dst : dst + run] = data[src:point]
+        out_idx[dst : dst + run] = indices[src:point]
+        dst += run
+        out_val[dst : dst + count] = tail.data[t : t + count]
+        out_idx[dst : dst + count] = tail.indices[t : t + count]
+        dst, src, t = dst + count, point, t + count
+    out_val[dst:] = data[src:]
+    out_idx[dst:] = indices[src:]
+    return out_ptr, out_idx, out_val, -1
 
 
 # ----------------------------------------------------------- sub-cells

@@ -45,31 +45,43 @@ def test_grid_matches_the_coo_sum(nx, ny, kinds):
     assert np.array_equal(counts, np.outer(ey, ex))
 
 
-def test_entries_added_keep_the_pattern_and_sort_the_rows():
-    """Standard entries land in place, enriched rows and columns (numbered
-    after the standard dofs) are appended to their rows; zeros of the grid
-    stay stored."""
-    rng = np.random.default_rng(7)
+def _grid_and_entries(rng, n_extra=12, picked=5):
+    """A grid matrix of a graded 6 x 5 mesh (one zero entry stored) and the
+    entries of `picked` enriched cells: their standard dofs and 4 dofs each
+    among n_extra numbered after the standard ones, repeated."""
     mesh = _mesh(6, 5, rng)
     cells = np.arange(mesh.n_cells)
     K_u = rng.standard_normal((1, 8, 8))
     K_u[0, 0, 3] = K_u[0, 3, 0] = 0.0
     which = np.zeros(cells.size, np.int64)
     n_std = 2 * mesh.n_nodes
-    n = n_std + 12
-    # enriched cells: their standard dofs and 4 extra dofs each, repeated
-    picked = rng.choice(mesh.n_cells, 5, replace=False)
-    extra = n_std + rng.integers(0, 12, (5, 4))
-    dofs = np.concatenate([std_cell_dofs(mesh.cells[picked]), extra], axis=1)
-    blocks = rng.standard_normal((5, 12, 12))
+    chosen = rng.choice(mesh.n_cells, picked, replace=False)
+    extra = n_std + rng.integers(0, n_extra, (picked, 4))
+    dofs = np.concatenate([std_cell_dofs(mesh.cells[chosen]), extra], axis=1)
+    blocks = rng.standard_normal((picked, 12, 12))
     rows = np.repeat(dofs, 12, axis=1).ravel()
     cols = np.tile(dofs, (1, 12)).ravel()
     grid = grid_stiffness(mesh, cells, K_u, which)
-    stored = grid.nnz
-    K = add_to_grid(mesh, grid, rows, cols, blocks.ravel(), n)
     ref = _coo_sum(std_cell_dofs(mesh.cells), K_u[which], n_std)
+    return mesh, grid, ref, rows, cols, blocks.ravel()
+
+
+@pytest.mark.parametrize("backend", ["numpy", "numba"])
+@pytest.mark.parametrize("seed", [7, 8, 9])
+def test_entries_added_keep_the_pattern_and_sort_the_rows(backend, seed):
+    """Standard entries land in place, enriched rows and columns (numbered
+    after the standard dofs) are appended to their rows; zeros of the grid
+    stay stored."""
+    rng = np.random.default_rng(seed)
+    mesh, grid, ref, rows, cols, vals = _grid_and_entries(rng)
+    n_std = 2 * mesh.n_nodes
+    n = n_std + 12
+    stored = grid.nnz
+    entries = [rows.astype(np.int32), cols.astype(np.int32), vals]
+    K = add_to_grid(grid, entries, np.arange(n), n, backend)
+    assert entries == []  # emptied: the caller holds no copy
     ref.resize((n, n))
-    ref = ref + sp.coo_matrix((blocks.ravel(), (rows, cols)), shape=(n, n)).tocsr()
+    ref = ref + sp.coo_matrix((vals, (rows, cols)), shape=(n, n)).tocsr()
     assert K.shape == (n, n) and K.has_canonical_format
     assert abs(K - ref).max() <= 1e-13 * abs(ref).max()
     new_pairs = np.unique(
@@ -77,9 +89,60 @@ def test_entries_added_keep_the_pattern_and_sort_the_rows():
         + cols[(rows >= n_std) | (cols >= n_std)]
     )
     assert K.nnz == stored + new_pairs.size
+    assert K.indices.dtype == grid.indices.dtype
 
 
-def test_bulk_of_a_network_is_the_coo_sum_of_its_cell_matrices(monkeypatch):
+@pytest.mark.parametrize("backend", ["numpy", "numba"])
+def test_entries_renumbered_and_the_dropped_left_out(backend):
+    """to_dof renumbers the candidate numbers after the standard dofs and
+    drops some (-1): the sum is that of the kept entries, renumbered."""
+    rng = np.random.default_rng(3)
+    mesh, grid, ref, rows, cols, vals = _grid_and_entries(rng)
+    n_std = 2 * mesh.n_nodes
+    # candidate numbers n_std .. n_std + 11: every third dropped, the rest
+    # numbered in reverse
+    kept = np.array([k for k in range(12) if k % 3 != 1])
+    to_dof = np.concatenate([np.arange(n_std), -np.ones(12, np.int64)])
+    to_dof[n_std + kept] = n_std + np.arange(kept.size)[::-1]
+    n = n_std + kept.size
+    K = add_to_grid(grid, [rows, cols, vals], to_dof, n, backend)
+    r, c = to_dof[rows], to_dof[cols]
+    ok = (r >= 0) & (c >= 0)
+    assert 0 < np.count_nonzero(ok) < ok.size
+    ref.resize((n, n))
+    ref = ref + sp.coo_matrix((vals[ok], (r[ok], c[ok])), shape=(n, n)).tocsr()
+    assert K.has_canonical_format
+    assert abs(K - ref).max() <= 1e-13 * abs(ref).max()
+
+
+@pytest.mark.parametrize("backend", ["numpy", "numba"])
+def test_a_standard_entry_outside_the_grid_is_refused(backend):
+    rng = np.random.default_rng(5)
+    mesh, grid, _, rows, cols, vals = _grid_and_entries(rng)
+    n = 2 * mesh.n_nodes + 12
+    rows = np.append(rows, 0)  # node 0 and the last node share no cell
+    cols = np.append(cols, 2 * mesh.n_nodes - 1)
+    vals = np.append(vals, 1.0)
+    with pytest.raises(ValueError, match="outside one cell"):
+        add_to_grid(grid, [rows, cols, vals], np.arange(n), n, backend)
+
+
+def test_both_backends_sum_to_the_same_matrix():
+    """The Numba kernel and its NumPy twin: the same pattern, each sum to
+    round-off (SciPy sums the appended duplicates in an order of its own)."""
+    out = {}
+    for backend in ("numpy", "numba"):
+        rng = np.random.default_rng(11)
+        _, grid, _, rows, cols, vals = _grid_and_entries(rng, 40, 20)
+        n = grid.shape[0] + 40
+        out[backend] = add_to_grid(grid, [rows, cols, vals], np.arange(n), n, backend)
+    a, b = out["numpy"], out["numba"]
+    assert np.array_equal(a.indptr, b.indptr) and np.array_equal(a.indices, b.indices)
+    assert np.abs(a.data - b.data).max() <= 1e-14 * np.abs(a.data).max()
+
+
+@pytest.mark.parametrize("backend", ["numpy", "numba"])
+def test_bulk_of_a_network_is_the_coo_sum_of_its_cell_matrices(backend, monkeypatch):
     """assemble_bulk on a crossing network (enriched cells taken in chunks of
     7, their entries gathered before the sliver rule in candidate numbering
     and renumbered) equals the COO sum of the intact cells' and the enriched
@@ -106,7 +169,7 @@ def test_bulk_of_a_network_is_the_coo_sum_of_its_cell_matrices(monkeypatch):
     out = {}
     for chunk in (7, 10**6):
         monkeypatch.setattr(assembly, "ENRICHED_CHUNK", chunk)
-        out[chunk] = assembly.assemble_bulk(mesh, D, cand, ec, ip, backend="numpy")
+        out[chunk] = assembly.assemble_bulk(mesh, D, cand, ec, ip, backend=backend)
     bulk = out[7]
     assert bulk.dofmap.n_enriched_functions < cand.node.size  # some dropped
     assert (abs(bulk.K - out[10**6].K)).max() == 0.0
