@@ -50,6 +50,7 @@ from xfemslip import kernels
 from xfemslip.fem.branch import branch_functions
 from xfemslip.fem.quadrature import DUFFY_POINTS, TRI_BARY, duffy_rule, triangle_rule
 from xfemslip.geometry.fracture import GEOMETRY_TOL
+from xfemslip.kernels.vectorized import ranges
 
 logger = logging.getLogger(__name__)
 
@@ -430,8 +431,8 @@ def build_enriched_cells(
     np.cumsum(nq_cell * n_slots, out=slot_off[1:])
     F = np.zeros(slot_off[-1])
     gF = np.zeros((slot_off[-1], 2))
-    gF_pairs = gF.view(np.complex128)[:, 0]  # gF's rows, written through
     Fv = np.zeros((tris.shape[0], 3, S))
+    scatter = kernels.backend(backend).scatter_slot_values
     group = cand.fracture[k_used] * (1 << 32) + (cand.tip[k_used] + (1 << 31))
     # the slots of each group as one slice of a stable sort (in the order a
     # mask `group == g` gives) rather than a mask over all slots per group:
@@ -465,27 +466,28 @@ def build_enriched_cells(
             tol,
             np.repeat(centroids[ti], 3, axis=0),
         )[0].reshape(ti.size, 3, -1)
-        # every slot of the group: its cell's rows in the group's arrays
+        # every slot of the group, with its cell's first rows in the group's
+        # arrays
         es, ss = e_used[mine], s_used[mine]
         func = cand.func[slot_cand[es, ss]]
-        js = np.where(func == HEAVISIDE, 0, func - 1)
-        pos = np.searchsorted(cells, es)
-        g_qp = np.concatenate([[0], np.cumsum(nq_cell[cells])])
-        g_tri = np.concatenate([[0], np.cumsum(nt_cell[cells])])
-        nq_s = nq_cell[es]
-        rows_v = ranges(slot_off[es] + ss * nq_s, nq_s)
-        rows_g = ranges(g_qp[pos], nq_s)
-        # one flat index into the group's (points, functions) arrays
-        flat = rows_g * Fq.shape[1] + np.repeat(js, nq_s)
-        F[rows_v] = Fq.ravel()[flat]
-        # the (x, y) pairs moved as one complex number each: a fancy index
-        # over the rows of an (n, 2) array moved the 27M pairs of a
-        # 100-fracture network in 1.0 s, this in about a third of it
-        gF_pairs[rows_v] = np.ascontiguousarray(gq).view(np.complex128).ravel()[flat]
-        nt_s = nt_cell[es]
-        rows_t = ranges(tri_off[es], nt_s)
-        rows_gt = ranges(g_tri[pos], nt_s)
-        Fv[rows_t, :, np.repeat(ss, nt_s)] = Fvert[rows_gt, :, np.repeat(js, nt_s)]
+        scatter(
+            F,
+            gF,
+            Fv,
+            np.ascontiguousarray(Fq),
+            np.ascontiguousarray(gq),
+            np.ascontiguousarray(Fvert),
+            es,
+            ss,
+            np.where(func == HEAVISIDE, 0, func - 1),
+            np.searchsorted(cells, es),
+            slot_off,
+            nq_cell,
+            np.concatenate([[0], np.cumsum(nq_cell[cells])]),
+            tri_off,
+            nt_cell,
+            np.concatenate([[0], np.cumsum(nt_cell[cells])]),
+        )
 
     return EnrichedCells(
         cells=cand_cells,
@@ -502,17 +504,6 @@ def build_enriched_cells(
         tris=tris,
         tri_F=Fv,
     )
-
-
-def ranges(starts, counts):
-    """Concatenation of arange(s, s + n) for each (s, n), int64."""
-    starts = np.asarray(starts, np.int64)
-    counts = np.asarray(counts, np.int64)
-    total = int(counts.sum())
-    if total == 0:
-        return np.zeros(0, np.int64)
-    first = np.cumsum(counts) - counts
-    return np.repeat(starts - first, counts) + np.arange(total, dtype=np.int64)
 
 
 def carries_jump(mesh, cand: Candidates, ip) -> np.ndarray:

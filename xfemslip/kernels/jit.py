@@ -3,7 +3,11 @@ NumPy backend (vectorized.py) also has.  Importing it imports Numba."""
 
 from xfemslip.kernels.bulk import enriched_cell_matrices, rectangle_stiffness
 from xfemslip.kernels.contact import contact_response, coulomb_return_map
-from xfemslip.kernels.scatter import block_triplets, csr_add_entries
+from xfemslip.kernels.scatter import (
+    block_triplets,
+    csr_add_entries,
+    scatter_slot_values,
+)
 from xfemslip.kernels.subcells import cell_subtriangles
 
 __all__ = [
@@ -14,4 +18,5 @@ __all__ = [
     "csr_add_entries",
     "enriched_cell_matrices",
     "rectangle_stiffness",
+    "scatter_slot_values",
 ]

@@ -150,3 +150,52 @@ def csr_add_entries(indptr, indices, data, rows, cols, vals, to_dof, n):
             out_val[w] = tail_val[q]
             w += 1
     return out_ptr.astype(indptr.dtype), out_idx, out_val, -1
+
+
+@njit(cache=NUMBA_CACHE)
+def scatter_slot_values(
+    F,
+    gF,
+    Fv,
+    Fq,
+    gq,
+    Fvert,
+    slot_cell,
+    slot,
+    func,
+    group_cell,
+    slot_off,
+    qp_count,
+    group_qp,
+    tri_off,
+    tri_count,
+    group_tri,
+):
+    """The values of one enrichment group, evaluated on the points of the
+    cells it reaches, copied to each of its slots (enrichment.EnrichedCells):
+    for slot ``slot[i]`` of cell ``slot_cell[i]`` (row ``group_cell[i]`` of
+    the group's cells) taking the group's function ``func[i]``,
+
+        F[slot_off[e] + s nq_e + q] = Fq[group_qp[g] + q, j]   (q < nq_e)
+        gF[...] likewise from gq (., ., 2),
+        Fv[tri_off[e] + t, :, s] = Fvert[group_tri[g] + t, :, j]   (t < nt_e)
+
+    with e, s, g, j those of slot i, nq_e = qp_count[e], nt_e = tri_count[e].
+    F, gF and Fv are written in place."""
+    for i in range(slot_cell.size):
+        e = slot_cell[i]
+        s = slot[i]
+        g = group_cell[i]
+        j = func[i]
+        nq = qp_count[e]
+        dst = slot_off[e] + s * nq
+        src = group_qp[g]
+        for q in range(nq):
+            F[dst + q] = Fq[src + q, j]
+            gF[dst + q, 0] = gq[src + q, j, 0]
+            gF[dst + q, 1] = gq[src + q, j, 1]
+        dst = tri_off[e]
+        src = group_tri[g]
+        for t in range(tri_count[e]):
+            for v in range(3):
+                Fv[dst + t, v, s] = Fvert[src + t, v, j]

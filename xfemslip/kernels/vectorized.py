@@ -424,6 +424,54 @@ def csr_add_entries(indptr, indices, data, rows, cols, vals, to_dof, n):
     return out_ptr, out_idx, out_val, -1
 
 
+def scatter_slot_values(
+    F,
+    gF,
+    Fv,
+    Fq,
+    gq,
+    Fvert,
+    slot_cell,
+    slot,
+    func,
+    group_cell,
+    slot_off,
+    qp_count,
+    group_qp,
+    tri_off,
+    tri_count,
+    group_tri,
+):
+    """scatter.scatter_slot_values: one enrichment group's values copied to
+    its slots (F, gF, Fv written in place, the same values)."""
+    nq_s = qp_count[slot_cell]
+    rows_v = ranges(slot_off[slot_cell] + slot * nq_s, nq_s)
+    rows_g = ranges(group_qp[group_cell], nq_s)
+    # one flat index into the group's (points, functions) arrays
+    flat = rows_g * Fq.shape[1] + np.repeat(func, nq_s)
+    F[rows_v] = Fq.ravel()[flat]
+    # the (x, y) pairs moved as one complex number each: a fancy index over
+    # the rows of an (n, 2) array moved the 27M pairs of a 100-fracture
+    # network in 1.0 s, this in about a third of it
+    gF_pairs = gF.view(np.complex128)[:, 0]
+    gF_pairs[rows_v] = np.ascontiguousarray(gq).view(np.complex128).ravel()[flat]
+    nt_s = tri_count[slot_cell]
+    rows_t = ranges(tri_off[slot_cell], nt_s)
+    rows_gt = ranges(group_tri[group_cell], nt_s)
+    Fv[rows_t, :, np.repeat(slot, nt_s)] = Fvert[rows_gt, :, np.repeat(func, nt_s)]
+
+
+def ranges(starts, counts):
+    """Concatenation of arange(s, s + n) for each (s, n), int64."""
+    starts = np.asarray(starts, np.int64)
+    counts = np.asarray(counts, np.int64)
+    total = int(counts.sum())
+    if total == 0:
+        return np.zeros(0, np.int64)
+    first = np.cumsum(counts) - counts
+    return np.repeat(starts - first, counts) + np.arange(total, dtype=np.int64)
+
+
 # ----------------------------------------------------------- sub-cells
 def split_polygon(poly: np.ndarray, point: np.ndarray, normal: np.ndarray, tol: float):
     """Split a convex polygon (k, 2) by a line; returns a list of 1 or 2 polygons.
