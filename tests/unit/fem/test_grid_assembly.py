@@ -7,6 +7,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 import scipy.sparse as sp
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from xfemslip.fem.assembly import add_to_grid, grid_stiffness, std_cell_dofs
 from xfemslip.fem.mesh import build_mesh
@@ -188,3 +190,52 @@ def test_bulk_of_a_network_is_the_coo_sum_of_its_cell_matrices(backend, monkeypa
     cols = np.broadcast_to(dofs[:, None, :], K_e.shape)[ok]
     ref = ref + sp.coo_matrix((K_e[ok], (rows, cols)), shape=(n, n)).tocsr()
     assert abs(bulk.K - ref).max() <= 1e-13 * abs(ref).max()
+
+
+@settings(max_examples=40, deadline=None)
+@given(
+    nx=st.integers(1, 5),
+    ny=st.integers(1, 5),
+    extra=st.integers(0, 6),
+    picked=st.integers(0, 6),
+    drop=st.floats(0.0, 0.6),
+    seed=st.integers(0, 2**31 - 1),
+)
+def test_generated_entries_sum_like_coo_on_both_backends(
+    nx, ny, extra, picked, drop, seed
+):
+    """Generated grids (cells of any size, 1-row and 1-column meshes),
+    enriched cells (none to several, repeated dofs) and dropped candidates:
+    both backends give the COO sum of the kept entries, in canonical CSR
+    with the grid's pattern kept."""
+    rng = np.random.default_rng(seed)
+    mesh = _mesh(nx, ny, rng)
+    n_std = 2 * mesh.n_nodes
+    cells = np.arange(mesh.n_cells)
+    K_u = rng.standard_normal((1, 8, 8))
+    which = np.zeros(cells.size, np.int64)
+    chosen = rng.integers(0, mesh.n_cells, picked)
+    cand = n_std + rng.integers(0, max(extra, 1), (picked, 4))
+    dofs = np.concatenate([std_cell_dofs(mesh.cells[chosen]), cand], axis=1)
+    k = dofs.shape[1]
+    rows = np.repeat(dofs, k, axis=1).ravel()
+    cols = np.tile(dofs, (1, k)).ravel()
+    vals = rng.standard_normal(rows.size)
+    kept = rng.random(max(extra, 1)) >= drop
+    to_dof = np.concatenate([np.arange(n_std), -np.ones(max(extra, 1), np.int64)])
+    to_dof[n_std + np.nonzero(kept)[0]] = n_std + np.arange(np.count_nonzero(kept))
+    n = n_std + int(np.count_nonzero(kept))
+    r, c = to_dof[rows], to_dof[cols]
+    ok = (r >= 0) & (c >= 0)
+    ref = _coo_sum(std_cell_dofs(mesh.cells), K_u[which], n_std)
+    ref.resize((n, n))
+    ref = ref + sp.coo_matrix((vals[ok], (r[ok], c[ok])), shape=(n, n)).tocsr()
+    for backend in ("numpy", "numba"):
+        grid = grid_stiffness(mesh, cells, K_u, which)
+        stored = grid.nnz
+        K = add_to_grid(grid, [rows, cols, vals], to_dof, n, backend)
+        assert K.shape == (n, n) and K.has_canonical_format
+        assert abs(K - ref).max() <= 1e-13 * max(abs(ref).max(), 1.0)
+        appended = (r >= n_std) | (c >= n_std)
+        pairs = np.unique(r[ok & appended] * n + c[ok & appended])
+        assert K.nnz == stored + pairs.size
