@@ -7,13 +7,13 @@ MKL's threads still hold, and the next PARDISO phase for those OpenBLAS's
 threads hold.  A Newton solve on PARDISO alternates the two hundreds of
 times (partial solves between the low-rank updates' dense LUs and products,
 the vector norms of the residual), so there OpenBLAS (NumPy's and SciPy's)
-runs on one thread and leaves the cores to MKL.  Measured on the 100-fracture
-network (200 x 200 cells, 2 cores, no thread variable set, whole processes
-alternated, 3 runs each): 19.1-20.9 s with OpenBLAS's default of 2 threads,
-13.7-17.2 s with one thread during the Newton solve (CPU 26-27 -> 17-21 s);
-the single fracture at 700 x 700 cells (Schur path, dense LU of the contact
-block) unchanged within the machine's noise, 11.2-13.6 against 11.7-12.8 s.
-A user's own OPENBLAS_NUM_THREADS is a ceiling the limit stays under.
+runs on one thread (whatever OPENBLAS_NUM_THREADS says) and leaves the
+cores to MKL.  Measured on the 100-fracture network (200 x 200 cells, 2
+cores, no thread variable set, whole processes alternated, 3 runs each):
+16.1-18.6 s (CPU 23-26 s) with OpenBLAS's default of 2 threads, 12.4-16.8 s
+(CPU 16-21 s) with one thread during the Newton solve; the single fracture
+(Schur path, dense LU of the contact block) at 400 x 400 cells 3.94 against
+4.43 s (medians of 5), at 700 x 700 the same within the machine's noise.
 """
 
 from __future__ import annotations
