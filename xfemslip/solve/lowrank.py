@@ -68,6 +68,8 @@ MAX_ROWS = 6000
 # than this is none (the stuck patches' tangents, formed by the kernel, equal
 # D0 to round-off).
 FORM_RTOL = 1.0e-12
+# Patches checked for that form at a time (patch_tangents).
+FORM_CHUNK = 128
 
 
 def stick_tangents(weight, kn, kt, normal, tangent) -> np.ndarray:
@@ -121,11 +123,18 @@ def patch_tangents(blocks, coef, dofs):
     for a in (0, 1):
         for b in (0, 1):
             D[i, a, b] = blocks[i, 2 * k[i] + a, 2 * k[i] + b] / ck[i] ** 2
-    cc = coef[:, :, None] * coef[:, None, :]  # (m, J, J)
-    recon = (cc[:, :, None, :, None] * D[:, None, :, None, :]).reshape(m, 2 * J, 2 * J)
-    scale = np.abs(blocks).max(axis=(1, 2))
-    if np.any(np.abs(recon - blocks).max(axis=(1, 2)) > FORM_RTOL * scale):
-        return None
+    # the check in chunks of patches: its temporaries are a few copies of
+    # the blocks, which on a crowded network (988 patches of up to 96 x 96)
+    # would otherwise add to the run's peak memory
+    for p in range(0, m, FORM_CHUNK):
+        q = slice(p, p + FORM_CHUNK)
+        cc = coef[q, :, None] * coef[q, None, :]  # (chunk, J, J)
+        recon = cc[:, :, None, :, None] * D[q, None, :, None, :]
+        recon = recon.reshape(-1, 2 * J, 2 * J)
+        recon -= blocks[q]
+        scale = np.abs(blocks[q]).max(axis=(1, 2))
+        if np.any(np.abs(recon).max(axis=(1, 2)) > FORM_RTOL * scale):
+            return None
     return D
 
 
@@ -393,17 +402,10 @@ class AugmentedLU(LowRankSystems):
             del B
             if not jumps_last(lu):
                 raise RuntimeError("SuperLU pivoted a patch jump row forward")
-        rows, cols = lu.perm_r[n:] - n, lu.perm_c[n:] - n
         self._B = None  # factored: not needed again (12M entries at 147k dofs)
-        # the trailing blocks of L and U, one factor copy at a time
-        L22 = lu.L[n:, n:].toarray()
-        U22 = lu.U[n:, n:].toarray()
-        S = (L22 @ U22)[np.ix_(rows, cols)]
-        del L22, U22
         self._lu = lu
         self._order = order
-        self._S = S
-        self.G = 2.0 * np.eye(S.shape[0]) - S
+        self.G = _trailing_G(lu, n)
         self.stats["factorizations"] += 1
         elapsed = time.perf_counter() - t
         self.stats["factor_time"] += elapsed
@@ -420,7 +422,8 @@ class AugmentedLU(LowRankSystems):
         _, _, rows, pu, pv, lu = self._update
         n, m2 = self.n, self.M.shape[0]
         w = self._solve_B(np.concatenate([r, np.zeros(m2)]))
-        x0, g = w[:n], self._S @ w[n:]
+        z0 = w[n:]
+        x0, g = w[:n], 2.0 * z0 - self.G @ z0  # S z0
         if lu is not None:  # (I + G P_U P_V^T) g = S z0 by Woodbury
             y = sla.lu_solve(lu, pv[:, 0] * g[rows] + pv[:, 1] * g[rows + 1])
             g = g - self.G @ self._scatter(rows, pu, y)
@@ -439,3 +442,41 @@ class AugmentedLU(LowRankSystems):
         x = np.empty_like(b)
         x[self._order] = self._lu.solve(b[self._order])
         return x
+
+
+def _trailing_G(lu, n: int) -> np.ndarray:
+    """G = 2 I - S from SuperLU's factors of B with the jump rows last: S is
+    (L22 U22) in the original row and column order, Pr^T L U Pc^T = B.
+
+    This is the run's memory peak on a crowded network: reading L or U makes
+    SciPy keep CSC copies of both factors beside its own (633 MiB on 100
+    branch-tipped fractures at 200 x 200 cells), so the dense blocks are
+    read straight from those copies and formed with at most two of them
+    alive at once: U22's columns in order, L22 U22 in their place (BLAS
+    trmm), then the rows in order (measured there: 62 MiB above the factor
+    copies, against 125 MiB for sparse slices of L22 and U22, their dense
+    copies, their product and its permuted copy)."""
+    rows, cols = lu.perm_r[n:] - n, lu.perm_c[n:] - n
+    Q = _trailing_block(lu.U, n, cols)
+    L22 = _trailing_block(lu.L, n, np.arange(cols.size))
+    Q = sla.blas.dtrmm(1.0, L22, Q, lower=1, overwrite_b=1)
+    del L22
+    G = Q[rows]
+    del Q
+    np.negative(G, out=G)
+    G[np.diag_indices_from(G)] += 2.0
+    return G
+
+
+def _trailing_block(F, n: int, columns) -> np.ndarray:
+    """The dense trailing block F[n:, n + columns] of the CSC matrix F, in
+    Fortran order, without a sparse copy of it."""
+    m = F.shape[0] - n
+    out = np.zeros((m, len(columns)), order="F")
+    ptr, idx, val = F.indptr, F.indices, F.data
+    for c, j in enumerate(columns):
+        a, b = ptr[n + j], ptr[n + j + 1]
+        r = idx[a:b]
+        keep = r >= n
+        out[r[keep] - n, c] = val[a:b][keep]
+    return out

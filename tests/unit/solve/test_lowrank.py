@@ -69,6 +69,27 @@ def test_patch_tangents_reads_each_blocks_2x2():
     assert lowrank.patch_tangents(bad, coef, dofs) is None
 
 
+@pytest.mark.parametrize("chunk", [1, 3, 7, 100])
+def test_patch_tangents_checks_every_chunk(chunk, monkeypatch):
+    """The form check runs over the patches a chunk at a time: the same D
+    whatever the chunk, and a bad block is found in the first, a middle
+    and the last chunk."""
+    monkeypatch.setattr(lowrank, "FORM_CHUNK", chunk)
+    rng = np.random.default_rng(5)
+    m, J = 11, 4
+    coef = rng.standard_normal((m, J))
+    dofs = rng.integers(0, 100, size=(m, 2 * J))
+    D = rng.standard_normal((m, 2, 2))
+    blocks = np.einsum("mk,ml,mab->mkalb", coef, coef, D).reshape(m, 2 * J, 2 * J)
+    np.testing.assert_allclose(
+        lowrank.patch_tangents(blocks, coef, dofs), D, rtol=1e-14, atol=0
+    )
+    for i in (0, m // 2, m - 1):
+        bad = blocks.copy()
+        bad[i, 1, 2] += 1e-6 * np.abs(bad[i]).max()
+        assert lowrank.patch_tangents(bad, coef, dofs) is None
+
+
 def test_tangents_are_read_again_where_the_blocks_changed():
     """The systems' tangents after a first read: the changed patches read
     again, the others kept; the same as reading every block, and a changed
