@@ -23,8 +23,10 @@ processes alternated.
   the project's own benchmarks set).
 
 Every run takes each configuration once, in that order; wall times from
-start to exit in the parent, medians over --runs; the load average is read
-before every process.  The table goes to --markdown (and is printed).
+start to exit in the parent, medians over --runs, and each configuration's
+peak resident memory (the kernel's ru_maxrss of the process, the largest
+over the runs); the load average is read before every process.  The table
+goes to --markdown (and is printed).
 """
 
 from __future__ import annotations
@@ -105,12 +107,12 @@ CASE_EDIT = ("elements = [50, 50]", 'formats = ["h5", "vtu"]')
 
 def _environment(venvs: Path, name: str) -> Path:
     """The virtual environment ``name`` in ``venvs``, made by the README's
-    command when missing; its python."""
+    command when missing (and the command run again in a kept one, so it has
+    what the project requires now); its python."""
     python = venvs / name / "bin" / "python"
-    if python.exists():
-        return python
-    venvs.mkdir(parents=True, exist_ok=True)
-    subprocess.run([sys.executable, "-m", "venv", str(venvs / name)], check=True)
+    if not python.exists():
+        venvs.mkdir(parents=True, exist_ok=True)
+        subprocess.run([sys.executable, "-m", "venv", str(venvs / name)], check=True)
     target = str(ROOT) if name == "default" else f"{ROOT}[mkl]"
     subprocess.run(
         [str(python), "-m", "pip", "install", "-q", "-e", target], check=True
@@ -132,10 +134,16 @@ def _versions(python: Path) -> str:
     ).stdout.strip()
 
 
-def _timed(cmd: list[str], env: dict) -> float:
+def _timed(cmd: list[str], env: dict) -> tuple[float, float]:
+    """Wall time [s] and peak resident memory [MiB] of one whole process."""
     start = time.perf_counter()
-    subprocess.run(cmd, env=env, check=True, stdout=subprocess.DEVNULL)
-    return time.perf_counter() - start
+    proc = subprocess.Popen(cmd, env=env, stdout=subprocess.DEVNULL)
+    _, status, usage = os.wait4(proc.pid, 0)
+    elapsed = time.perf_counter() - start
+    proc.returncode = os.waitstatus_to_exitcode(status)
+    if proc.returncode:
+        raise subprocess.CalledProcessError(proc.returncode, cmd)
+    return elapsed, usage.ru_maxrss / 1024.0  # KiB on Linux
 
 
 def main() -> None:
@@ -179,10 +187,13 @@ def main() -> None:
             for cmd, env in configs.values():  # warm-up: caches, bytecode
                 subprocess.run(cmd, env=env, check=True, stdout=subprocess.DEVNULL)
             times: dict[str, list[float]] = {k: [] for k in configs}
+            peak: dict[str, float] = dict.fromkeys(configs, 0.0)
             for _ in range(opts.runs):
                 for name, (cmd, env) in configs.items():
                     loads.append(os.getloadavg()[0])
-                    times[name].append(_timed(cmd, env))
+                    seconds, mib = _timed(cmd, env)
+                    times[name].append(seconds)
+                    peak[name] = max(peak[name], mib)
             med = {k: statistics.median(v) for k, v in times.items()}
             dofs = 2 * (n + 1) ** 2
             rows.append(
@@ -192,16 +203,20 @@ def main() -> None:
                     for k in configs
                     if k != "floor"
                 )
+                + " | "
+                + " / ".join(f"{peak[k]:,.0f}" for k in ("floor", "default", "mkl"))
                 + " |"
             )
             print(rows[-1], flush=True)
     lines = [
         "| mesh | dofs | floor [s] | default [s] (/ floor) | mkl extra [s] (/ floor) "
-        "| default, OPENBLAS_NUM_THREADS=1 [s] (/ floor) |",
-        "| --- | --- | --- | --- | --- | --- |",
+        "| default, OPENBLAS_NUM_THREADS=1 [s] (/ floor) "
+        "| peak RSS: floor / default / mkl [MiB] |",
+        "| --- | --- | --- | --- | --- | --- | --- |",
         *rows,
         "",
-        f"Medians of {opts.runs} whole processes per configuration, alternated; "
+        f"Medians of {opts.runs} whole processes per configuration, alternated "
+        "(peak RSS: the largest of them); "
         f"{platform.machine()}, {os.cpu_count()} cores, load average "
         f"{min(loads):.1f}-{max(loads):.1f}. default: {_versions(pythons['default'])}; "
         f"mkl: {_versions(pythons['mkl'])}.",

@@ -2,10 +2,13 @@
 """A generated network of 100 fractures with branch tips against the
 PARDISO floor, whole processes, alternated in the same run.
 
-    MKL_NUM_THREADS=2 OPENBLAS_NUM_THREADS=1 NUMBA_NUM_THREADS=2 \\
     python benchmarks/network_floor.py [--runs 3] [--configs floor,pardiso,default]
         [--count 100] [--n 200] [--seed 1] [--json FILE]
         [--markdown docs/performance/network_floor.md]
+
+The runs get the caller's thread variables (MKL_NUM_THREADS,
+OPENBLAS_NUM_THREADS, NUMBA_NUM_THREADS), written under the table; the
+table in docs/performance is measured with none set, as a user runs it.
 
 The network: ``[network.generate]`` with ``count`` fractures, uniform
 orientations, power-law lengths (exponent 2.5) on [0.06, 0.25] m, friction
