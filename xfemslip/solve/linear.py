@@ -123,6 +123,13 @@ AUTO_PARDISO_MIN_DOFS = 50_000
 # reservoir's 10.
 PARDISO_HINT_MIN_DOFS = 200_000
 PARDISO_GAIN = (1.7, 5.2)
+# ... and a crowded network taking the augmented SuperLU path
+# (lowrank.AugmentedLU), below that size, what the whole run gained with it:
+# 100 branch-tipped fractures on 200 x 200 cells (147k dofs), whole
+# processes without thread variables (benchmarks/network_floor.py, docs/
+# performance/network_floor.md): 26.5 s by default against 14.4 s with
+# PARDISO, and 29.2 against 16.4 s on a slower day.
+PARDISO_NETWORK_GAIN = 1.8
 AUTO_AMG_MAX_ASPECT = 4.0
 # ... and whose AMG band (enriched dofs and AMG_BAND_LAYERS neighbours) holds
 # at most this share of the free dofs.  Measured on generated networks of
@@ -612,6 +619,14 @@ class LinearSolver:
             raise ValueError(
                 "linear_solver 'pardiso' needs MKL PARDISO: pip install 'xfemslip[mkl]'"
             )
+        # a crowded network on SuperLU says once what PARDISO would gain,
+        # unless the line below has (_solve_augmented)
+        self._network_hint = (
+            method == "auto"
+            and self.method != "pardiso"
+            and n < PARDISO_HINT_MIN_DOFS
+            and not pardiso.available()
+        )
         if method == "auto" and self.method != "pardiso" and n >= PARDISO_HINT_MIN_DOFS:
             logger.info(
                 "linear solver: %s; with MKL PARDISO (pip install "
@@ -767,6 +782,14 @@ class LinearSolver:
                 self.stats,
                 LU_FAST,
             )
+            if self._network_hint:
+                logger.info(
+                    "linear solver: SuperLU, one factorization bordered by %d "
+                    "patch jumps; with MKL PARDISO (pip install 'xfemslip[mkl]') "
+                    "crowded networks ran in about 1/%.1f of the time",
+                    rows,
+                    PARDISO_NETWORK_GAIN,
+                )
         assert isinstance(self._augmented, lowrank.AugmentedLU)
         t = time.perf_counter()
         try:

@@ -418,3 +418,29 @@ def test_network_run_on_superlu_matches_the_kept_factorization_path(monkeypatch)
     assert ref > 0.0
     assert np.abs(out["augmented"][1] - out["whole"][1]).max() <= 1e-7 * ref
     assert out["augmented"][2] == 1 < out["whole"][2]
+
+
+@pytest.mark.parametrize("method", ["auto", "superlu"])
+def test_network_on_superlu_says_what_pardiso_would_gain(method, monkeypatch, caplog):
+    """A network taking the augmented SuperLU path under "auto" without the
+    mkl extra says once what PARDISO gained on such networks (the measured
+    factor and the install command); asked for SuperLU by name, it does not."""
+    monkeypatch.setattr(pardiso, "available", lambda: False)
+    # this small network's contact dofs would go to the Schur path
+    monkeypatch.setattr(pardiso, "SCHUR_MAX_DOFS", 0)
+    text = NETWORK.read_text().replace("elements = [80, 80]", "elements = [40, 40]")
+    text = text.replace("[solver]", f'[solver]\nlinear_solver = "{method}"', 1)
+    assert "elements = [40, 40]" in text
+    model = build_model(loads_case(text, NETWORK))
+    solver = newton_solver(model)
+    with caplog.at_level(logging.INFO, logger="xfemslip.solve.linear"):
+        solver.run(model.spec.loading.steps)
+    assert solver.linear.stats["lowrank_superlu"] > 1
+    lines = [m for m in caplog.messages if "xfemslip[mkl]" in m]
+    if method == "superlu":
+        assert lines == []
+        return
+    assert len(lines) == 1
+    rows = 2 * len(solver.linear.contact_dofs)
+    assert f"bordered by {rows} patch jumps" in lines[0]
+    assert f"1/{linear.PARDISO_NETWORK_GAIN:.1f} of the time" in lines[0]
