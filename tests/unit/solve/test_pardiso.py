@@ -357,3 +357,46 @@ def test_row_sums_match_scipy_with_empty_rows():
     assert np.allclose(_row_sums(A.data, A.indptr), np.asarray(A.sum(axis=1)).ravel())
     counts = _row_sums(np.ones(3) > 0, np.array([0, 0, 2, 3, 3]))
     assert counts.tolist() == [0, 2, 1, 0]
+
+
+@needs_mkl
+@pytest.mark.parametrize("where", ["last", "scattered"])
+def test_schur_solve_takes_the_schur_unknowns_from_its_caller(where):
+    """Handle.solve_schur: the callback gets the forward-eliminated
+    right-hand side b_s - A_si A_ii^-1 b_i, and whatever it returns is x_s
+    in x_i = A_ii^-1 (b_i - A_is x_s) (dense formulas); solve_interior is
+    the same with x_s = 0."""
+    rng = np.random.default_rng(3)
+    n = 70
+    A = sp.random(n, n, density=0.08, random_state=4)
+    A = (A + A.T + 12.0 * sp.identity(n)).tocsr()
+    A.sort_indices()
+    s = np.arange(n - 9, n) if where == "last" else np.sort(rng.choice(n, 9, False))
+    i = np.setdiff1d(np.arange(n), s)
+    up = sp.triu(A, format="csr")
+    up.sort_indices()
+    h = pardiso.Handle(pardiso.MTYPE_SPD, up.indptr, up.indices, schur=s)
+    h.factor(up.data)
+    D = A.toarray()
+    A_ii, A_is, A_si = D[np.ix_(i, i)], D[np.ix_(i, s)], D[np.ix_(s, i)]
+    b = rng.standard_normal(n)
+    rhs_ref = b[s] - A_si @ np.linalg.solve(A_ii, b[i])
+    xs = rng.standard_normal(s.size)
+    seen = []
+
+    def given(rhs):
+        seen.append(rhs)
+        return xs
+
+    x = h.solve_schur(b, given)
+    np.testing.assert_allclose(seen[0], rhs_ref, rtol=1e-12, atol=1e-12)
+    np.testing.assert_allclose(
+        x[i], np.linalg.solve(A_ii, b[i] - A_is @ xs), rtol=1e-12, atol=1e-12
+    )
+    np.testing.assert_array_equal(x[s], xs)
+    x0, rhs = h.solve_interior(b)
+    np.testing.assert_allclose(rhs, rhs_ref, rtol=1e-12, atol=1e-12)
+    np.testing.assert_allclose(
+        x0[i], np.linalg.solve(A_ii, b[i]), rtol=1e-12, atol=1e-12
+    )
+    assert not x0[s].any()
