@@ -259,18 +259,6 @@ class Handle:
         self.solves += 1
         return x
 
-    def solve_interior(self, b):
-        """With schur rows: x with A_ii x_i = b_i on the other rows (x = 0 on
-        the schur rows) and the forward-eliminated right-hand side of the
-        Schur system, b_s - A_si A_ii^-1 b_i, as (x, rhs_s)."""
-        rhs = []
-
-        def zero(r):
-            rhs.append(r)
-            return np.zeros_like(r)
-
-        return self.solve_schur(b, zero), rhs[0]
-
     def solve(self, b):
         """x with A x = b for the last factored A."""
         x = self._call(33, self.factored, b)
