@@ -490,9 +490,9 @@ class SchurSystems:
         x_i = K_ii^-1 (b_i - K_ic x_c)                 (partial solves)
 
     so a new contact tangent costs one dense LU of size m = |c| and a solve
-    one forward and one backward substitution (Handle.solve_schur).  solve(values,
-    symmetric, r) as PardisoSystems (`symmetric` is not needed: the dense LU
-    takes either)."""
+    one forward and one backward substitution (Handle.solve_schur).
+    solve(values, symmetric, r) as PardisoSystems (`symmetric` is not
+    needed: the dense LU takes either)."""
 
     def __init__(self, K, rows, cols, max_error: float, stats: dict):
         K = sp.csr_matrix(K)
@@ -516,9 +516,7 @@ class SchurSystems:
         indptr_upper = np.concatenate(([0], np.cumsum(_row_sums(up, K.indptr))))
         self.handle = Handle(MTYPE_SPD, indptr_upper, K.indices[up], schur=self.c)
         self._upper = np.ascontiguousarray(K.data[up])
-        # rows c of K; K is symmetric, so K_ic x_c = (rows c)^T x_c
-        self.K_c = K[self.c]
-        self.K_cc = self.K_c[:, self.c].toarray()
+        self.K_cc = K[self.c][:, self.c].toarray()
         self._row_norm = _row_sums(np.abs(K.data), K.indptr)
         # |K| row sums of the rows c outside the columns c
         self._row_out = self._row_norm[self.c] - np.abs(self.K_cc).sum(axis=1)
