@@ -101,6 +101,35 @@ def test_signal_during_a_run_leaves_no_partial_file(tmp_path, sig, code, name):
     _no_partial_files(out)
 
 
+def test_interrupt_inside_a_string_exec_keeps_exit_130(tmp_path):
+    """A Ctrl-C whose handler runs while a source string is evaluated (a
+    module imported on the way defining a namedtuple or a dataclass), caught
+    and reported by the command: ``python -m xfemslip`` ends with 130, not
+    killed by SIGINT (CPython records such an interrupt for ``-m`` runs)."""
+    (tmp_path / "interrupted_exec.py").write_text(
+        "import xfemslip.cli as cli\n"
+        "import click\n"
+        "from xfemslip.cli.common import reported_errors\n"
+        "@click.command()\n"
+        "def command():\n"
+        "    with reported_errors(False):\n"
+        "        exec('raise KeyboardInterrupt', {})\n"
+        "cli.cli = command\n"
+        "cli.main()\n"
+    )
+    env = dict(os.environ, PYTHONPATH=os.pathsep.join([str(tmp_path), str(ROOT)]))
+    proc = subprocess.run(
+        [sys.executable, "-m", "interrupted_exec"],
+        capture_output=True,
+        text=True,
+        env=env,
+        cwd=tmp_path,
+        timeout=120,
+    )
+    assert proc.returncode == 130, (proc.returncode, proc.stderr)
+    assert _error_line(proc).startswith("Error: interrupted (SIGINT)")
+
+
 def test_interrupt_while_writing_removes_the_file(tmp_path, runner, monkeypatch):
     """Ctrl-C in the middle of writing result.h5: no result.h5, no temporary."""
     calls = []

@@ -61,3 +61,19 @@ def main() -> None:
 
         term = isinstance(exc, interrupt.Terminated)
         raise SystemExit(EXIT_TERMINATED if term else EXIT_INTERRUPTED) from None
+    finally:
+        _forget_interrupted_string_exec()
+
+
+def _forget_interrupted_string_exec() -> None:
+    """Keep the exit code the command chose after a caught Ctrl-C.
+
+    CPython records a KeyboardInterrupt that ends the evaluation of a source
+    string (``exec``/``eval`` of a ``str``: a namedtuple or a dataclass being
+    defined by a module imported on the way, say), even when a caller catches
+    it; under ``python -m`` the interpreter then kills itself with SIGINT at
+    exit, so a run that reported "interrupted" and chose 130 ends as killed
+    by the signal.  Every string evaluation clears that record when it
+    starts: an empty one here does, after the last place a signal handler
+    can raise (the command has put SIG_IGN in place)."""
+    exec("", {})
