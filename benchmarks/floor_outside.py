@@ -22,16 +22,20 @@ processes alternated.
 - default, 1 BLAS thread: the default run with OPENBLAS_NUM_THREADS=1 (what
   the project's own benchmarks set).
 
-Every run takes each configuration once, in that order; wall times from
-start to exit in the parent, medians over --runs, and each configuration's
-peak resident memory (the kernel's ru_maxrss of the process, the largest
-over the runs); the load average is read before every process.  The table
-goes to --markdown (and is printed).
+The sources are byte-compiled first, as an installed package has them (the
+editable installs read xfemslip from this tree; under
+PYTHONDONTWRITEBYTECODE=1 every process would compile its modules again,
+0.25-0.3 s).  Every run takes each configuration once, in that order; wall
+times from start to exit in the parent, medians over --runs, and each
+configuration's peak resident memory (the kernel's ru_maxrss of the
+process, the largest over the runs); the load average is read before every
+process.  The table goes to --markdown (and is printed).
 """
 
 from __future__ import annotations
 
 import argparse
+import compileall
 import os
 import platform
 import statistics
@@ -158,6 +162,7 @@ def main() -> None:
     ap.add_argument("--markdown", type=Path, default=None)
     opts = ap.parse_args()
     pythons = {name: _environment(opts.venvs, name) for name in ("default", "mkl")}
+    compileall.compile_dir(str(ROOT / "xfemslip"), quiet=1)
     user = {k: v for k, v in os.environ.items() if k not in THREAD_VARS}
     one = dict(user, OPENBLAS_NUM_THREADS="1")
     base = (ROOT / "cases" / "reservoir_depletion.toml").read_text()

@@ -36,7 +36,6 @@ import math
 
 import numpy as np
 import scipy.sparse as sp
-import scipy.sparse.linalg as spla
 
 from xfemslip.conventions import SLIP
 
@@ -95,6 +94,10 @@ def search(c, c_dofs, K_stick, u_free, res, r, idx):
     k = idx.size
     if k == 0 or k > MAX_CLUSTER:
         return None
+    # here, not at the top: scipy.sparse.linalg is 90 ms of imports that a
+    # run on the PARDISO path without stuck clusters does not need
+    import scipy.sparse.linalg as spla
+
     G = jump_rows(c, c_dofs, idx, u_free.size)
     lu = spla.splu(sp.csc_matrix(K_stick))
     M = G @ lu.solve(G.T.copy())

@@ -22,7 +22,6 @@ from __future__ import annotations
 
 from collections.abc import Callable
 from pathlib import Path
-from xml.sax.saxutils import escape, quoteattr
 
 import h5py
 import numpy as np
@@ -92,6 +91,28 @@ def _mesh_items(h5: h5py.File, h5_name: str) -> list[str]:
     ]
 
 
+def _text(text: str) -> str:
+    """``text`` as XML character data.  Written here rather than taken from
+    xml.sax.saxutils, whose import pulls in urllib.request, http and ssl
+    (20 ms of every run)."""
+    return text.replace("&", "&amp;").replace("<", "&lt;").replace(">", "&gt;")
+
+
+def _attr(text: str) -> str:
+    """``text`` as a double-quoted XML attribute value (white space other
+    than blanks kept as character references, as attribute normalisation
+    would turn it into blanks)."""
+    text = _text(text)
+    for char, ref in (
+        ('"', "&quot;"),
+        ("\n", "&#10;"),
+        ("\r", "&#13;"),
+        ("\t", "&#9;"),
+    ):
+        text = text.replace(char, ref)
+    return f'"{text}"'
+
+
 def _attribute(h5_name: str, dataset: h5py.Dataset, center: str) -> list[str]:
     """An attribute named as its dataset: Scalar (one value per node or cell),
     Vector (2 or 3 components) or Matrix."""
@@ -100,7 +121,7 @@ def _attribute(h5_name: str, dataset: h5py.Dataset, center: str) -> list[str]:
     kind = "Scalar" if width == 1 else ("Vector" if width in (2, 3) else "Matrix")
     name = dataset.name.rsplit("/", 1)[-1]
     return [
-        f'<Attribute Name={quoteattr(name)} AttributeType="{kind}" Center="{center}">',
+        f'<Attribute Name={_attr(name)} AttributeType="{kind}" Center="{center}">',
         f"  {_data_item(h5_name, dataset)}",
         "</Attribute>",
     ]
@@ -114,13 +135,13 @@ def _data_item(h5_name: str, dataset: h5py.Dataset) -> str:
     return (
         f'<DataItem Dimensions="{dims}" NumberType="{number}" '
         f'Precision="{precision}" Format="HDF">'
-        f"{escape(h5_name)}:{escape(dataset.name)}</DataItem>"
+        f"{_text(h5_name)}:{_text(dataset.name)}</DataItem>"
     )
 
 
 def _grid(name, mesh, attributes, time=None) -> list[str]:
     """A uniform grid of the mesh with its attributes (and time)."""
-    lines = [f'<Grid Name={quoteattr(name)} GridType="Uniform">']
+    lines = [f'<Grid Name={_attr(name)} GridType="Uniform">']
     if time is not None:
         lines.append(f'  <Time Value="{float(time)!r}"/>')
     lines += [f"  {line}" for line in mesh]

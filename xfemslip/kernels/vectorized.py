@@ -152,17 +152,28 @@ def enriched_cell_matrices(
     wx, wy = bx * qp_w[:, None], by * qp_w[:, None]
     blocks = K.reshape(nc, nf, 2, nf, 2)
     d = D
-    for e in np.nonzero(counts)[0]:
-        lo, hi = qp_offsets[e], qp_offsets[e + 1]
-        xx = wx[lo:hi].T @ bx[lo:hi]
-        xy = wx[lo:hi].T @ by[lo:hi]
-        yx = wy[lo:hi].T @ bx[lo:hi]
-        yy = wy[lo:hi].T @ by[lo:hi]
-        blk = blocks[e]
-        blk[:, 0, :, 0] = d[0, 0] * xx + d[0, 2] * xy + d[2, 0] * yx + d[2, 2] * yy
-        blk[:, 0, :, 1] = d[0, 1] * xy + d[0, 2] * xx + d[2, 1] * yy + d[2, 2] * yx
-        blk[:, 1, :, 0] = d[1, 0] * yx + d[1, 2] * yy + d[2, 0] * xx + d[2, 2] * xy
-        blk[:, 1, :, 1] = d[1, 1] * yy + d[1, 2] * yx + d[2, 1] * xy + d[2, 2] * xx
+    # cells with the same number of points (a handful of rules: uncut, cut,
+    # tip) as one batched product each, not one small product per cell
+    for count in np.unique(counts[counts > 0]):
+        group = np.nonzero(counts == count)[0]
+        at = qp_offsets[group][:, None] + np.arange(count)  # (g, count)
+        gx, gy, hx, hy = wx[at], wy[at], bx[at], by[at]  # (g, count, nf)
+        xx = np.matmul(gx.transpose(0, 2, 1), hx)  # (g, nf, nf)
+        xy = np.matmul(gx.transpose(0, 2, 1), hy)
+        yx = np.matmul(gy.transpose(0, 2, 1), hx)
+        yy = np.matmul(gy.transpose(0, 2, 1), hy)
+        blocks[group, :, 0, :, 0] = (
+            d[0, 0] * xx + d[0, 2] * xy + d[2, 0] * yx + d[2, 2] * yy
+        )
+        blocks[group, :, 0, :, 1] = (
+            d[0, 1] * xy + d[0, 2] * xx + d[2, 1] * yy + d[2, 2] * yx
+        )
+        blocks[group, :, 1, :, 0] = (
+            d[1, 0] * yx + d[1, 2] * yy + d[2, 0] * xx + d[2, 2] * xy
+        )
+        blocks[group, :, 1, :, 1] = (
+            d[1, 1] * yy + d[1, 2] * yx + d[2, 1] * xy + d[2, 2] * xx
+        )
     full = np.nonzero(counts)[0]
     sx = np.add.reduceat(wx, qp_offsets[full], axis=0)  # (k, nf)
     sy = np.add.reduceat(wy, qp_offsets[full], axis=0)

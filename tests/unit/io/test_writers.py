@@ -506,6 +506,21 @@ def test_write_pvd_lists_files(tmp_path):
 # --------------------------------------------------------------------------- atomic
 
 
+@pytest.mark.parametrize(
+    "text",
+    ["plain", 'a"b', "a'b", "a\"'b<&>", "x\ny\tz\rw", "&quot;", "", "]]>"],
+)
+def test_xdmf_names_read_back_by_an_xml_parser(text):
+    """The XDMF writer's own escaping: an attribute value and character data
+    parse back to the text (line ends in character data normalised to \\n,
+    as XML does)."""
+    from xfemslip.io.xdmf import _attr, _text
+
+    element = ET.fromstring(f"<a n={_attr(text)}>{_text(text)}</a>")
+    assert element.get("n") == text
+    assert (element.text or "") == text.replace("\r", "\n")
+
+
 def test_atomic_path_leaves_nothing_when_body_raises(tmp_path):
     final = tmp_path / "result.h5"
     with pytest.raises(RuntimeError, match="boom"), atomic_path(final) as tmp:
