@@ -114,6 +114,34 @@ def padded_slot_values(qp_offsets, slot_offsets, slot_F, slot_gradF, S):
     return F, gF
 
 
+# the largest batch of enriched_cell_matrices' products (cells, points)
+BATCH_CELLS = 256
+BATCH_POINTS = 32768
+
+
+def _add_rule_batch(blocks, group, count, qp_offsets, wx, wy, bx, by, d):
+    """K's blocks of the cells ``group``, each with ``count`` points:
+    sum_q w b_f b_g for the four (x|y, x|y) gradient pairs, combined with D."""
+    at = qp_offsets[group][:, None] + np.arange(count)  # (g, count)
+    gx, gy, hx, hy = wx[at], wy[at], bx[at], by[at]  # (g, count, nf)
+    xx = np.matmul(gx.transpose(0, 2, 1), hx)  # (g, nf, nf)
+    xy = np.matmul(gx.transpose(0, 2, 1), hy)
+    yx = np.matmul(gy.transpose(0, 2, 1), hx)
+    yy = np.matmul(gy.transpose(0, 2, 1), hy)
+    blocks[group, :, 0, :, 0] = (
+        d[0, 0] * xx + d[0, 2] * xy + d[2, 0] * yx + d[2, 2] * yy
+    )
+    blocks[group, :, 0, :, 1] = (
+        d[0, 1] * xy + d[0, 2] * xx + d[2, 1] * yy + d[2, 2] * yx
+    )
+    blocks[group, :, 1, :, 0] = (
+        d[1, 0] * yx + d[1, 2] * yy + d[2, 0] * xx + d[2, 2] * xy
+    )
+    blocks[group, :, 1, :, 1] = (
+        d[1, 1] * yy + d[1, 2] * yx + d[2, 1] * xy + d[2, 2] * xx
+    )
+
+
 def enriched_cell_matrices(
     bounds,
     qp_offsets,
@@ -151,29 +179,17 @@ def enriched_cell_matrices(
     )
     wx, wy = bx * qp_w[:, None], by * qp_w[:, None]
     blocks = K.reshape(nc, nf, 2, nf, 2)
-    d = D
     # cells with the same number of points (a handful of rules: uncut, cut,
-    # tip) as one batched product each, not one small product per cell
+    # tip) as batched products, not one small product per cell; a batch
+    # holds at most BATCH_CELLS cells and BATCH_POINTS points, so its
+    # gathered gradients and products stay small beside K
     for count in np.unique(counts[counts > 0]):
-        group = np.nonzero(counts == count)[0]
-        at = qp_offsets[group][:, None] + np.arange(count)  # (g, count)
-        gx, gy, hx, hy = wx[at], wy[at], bx[at], by[at]  # (g, count, nf)
-        xx = np.matmul(gx.transpose(0, 2, 1), hx)  # (g, nf, nf)
-        xy = np.matmul(gx.transpose(0, 2, 1), hy)
-        yx = np.matmul(gy.transpose(0, 2, 1), hx)
-        yy = np.matmul(gy.transpose(0, 2, 1), hy)
-        blocks[group, :, 0, :, 0] = (
-            d[0, 0] * xx + d[0, 2] * xy + d[2, 0] * yx + d[2, 2] * yy
-        )
-        blocks[group, :, 0, :, 1] = (
-            d[0, 1] * xy + d[0, 2] * xx + d[2, 1] * yy + d[2, 2] * yx
-        )
-        blocks[group, :, 1, :, 0] = (
-            d[1, 0] * yx + d[1, 2] * yy + d[2, 0] * xx + d[2, 2] * xy
-        )
-        blocks[group, :, 1, :, 1] = (
-            d[1, 1] * yy + d[1, 2] * yx + d[2, 1] * xy + d[2, 2] * xx
-        )
+        same = np.nonzero(counts == count)[0]
+        step = max(1, min(BATCH_CELLS, BATCH_POINTS // count))
+        for lo in range(0, same.size, step):
+            _add_rule_batch(
+                blocks, same[lo : lo + step], count, qp_offsets, wx, wy, bx, by, D
+            )
     full = np.nonzero(counts)[0]
     sx = np.add.reduceat(wx, qp_offsets[full], axis=0)  # (k, nf)
     sy = np.add.reduceat(wy, qp_offsets[full], axis=0)

@@ -75,6 +75,31 @@ def test_enriched_cell_matrices_agree(case, elements, tmp_path):
     assert _rel(B1, B0) < 1e-13
 
 
+def test_numpy_cell_matrices_do_not_depend_on_their_batches(tmp_path, monkeypatch):
+    """The NumPy kernel's batched products (cells of one rule together, at
+    most BATCH_CELLS cells and BATCH_POINTS points a batch): one cell a batch
+    gives the same K and Bbar, bit for bit, on a case whose cells have rules
+    of several sizes."""
+    shipped = build.file_case(
+        ROOT / "cases" / "reservoir_depletion.toml", **{"mesh.elements": [17, 23]}
+    )
+    spec = loads_case(build.case_text(shipped), tmp_path / "case.toml")
+    mesh, fractures = _geometry(spec)
+    ec = build_enriched_cells(mesh, fractures, find_candidates(mesh, fractures))
+    D = elasticity_matrix(spec.material.E, spec.material.nu, spec.material.model)
+    assert np.unique(np.diff(ec.qp_offsets)).size > 1  # several rules
+    K0, B0 = _enriched_matrices(mesh, ec, D, None, backend="numpy")
+    monkeypatch.setattr(vectorized, "BATCH_CELLS", 1)
+    K1, B1 = _enriched_matrices(mesh, ec, D, None, backend="numpy")
+    monkeypatch.setattr(vectorized, "BATCH_CELLS", 1000)
+    monkeypatch.setattr(vectorized, "BATCH_POINTS", 100)  # below one rule's size
+    K2, B2 = _enriched_matrices(mesh, ec, D, None, backend="numpy")
+    np.testing.assert_array_equal(K1, K0)
+    np.testing.assert_array_equal(K2, K0)
+    np.testing.assert_array_equal(B1, B0)
+    np.testing.assert_array_equal(B2, B0)
+
+
 def _contact_points(rng, n=600, J=3):
     dofs = rng.integers(0, 40, size=(n, 2 * J))
     dofs[rng.random((n, 2 * J)) < 0.15] = -1
