@@ -138,15 +138,24 @@ def _versions(python: Path) -> str:
     ).stdout.strip()
 
 
+def _failed(cmd: list[str], code: int, stderr: str) -> None:
+    """Stop the benchmark with the command, its exit code and its last lines."""
+    tail = "\n".join(stderr.strip().splitlines()[-10:])
+    sys.exit(f"{' '.join(cmd)} failed ({code}):\n{tail}")
+
+
 def _timed(cmd: list[str], env: dict) -> tuple[float, float]:
-    """Wall time [s] and peak resident memory [MiB] of one whole process."""
-    start = time.perf_counter()
-    proc = subprocess.Popen(cmd, env=env, stdout=subprocess.DEVNULL)
-    _, status, usage = os.wait4(proc.pid, 0)
-    elapsed = time.perf_counter() - start
-    proc.returncode = os.waitstatus_to_exitcode(status)
-    if proc.returncode:
-        raise subprocess.CalledProcessError(proc.returncode, cmd)
+    """Wall time [s] and peak resident memory [MiB] of one whole process (its
+    log goes to a file, read back only if it fails)."""
+    with tempfile.TemporaryFile("w+") as log:
+        start = time.perf_counter()
+        proc = subprocess.Popen(cmd, env=env, stdout=subprocess.DEVNULL, stderr=log)
+        _, status, usage = os.wait4(proc.pid, 0)
+        elapsed = time.perf_counter() - start
+        code = os.waitstatus_to_exitcode(status)
+        if code:
+            log.seek(0)
+            _failed(cmd, code, log.read())
     return elapsed, usage.ru_maxrss / 1024.0  # KiB on Linux
 
 
@@ -190,7 +199,9 @@ def main() -> None:
                 "default, OPENBLAS_NUM_THREADS=1": run("default", one),
             }
             for cmd, env in configs.values():  # warm-up: caches, bytecode
-                subprocess.run(cmd, env=env, check=True, stdout=subprocess.DEVNULL)
+                warm = subprocess.run(cmd, env=env, capture_output=True, text=True)
+                if warm.returncode:
+                    _failed(cmd, warm.returncode, warm.stderr)
             times: dict[str, list[float]] = {k: [] for k in configs}
             peak: dict[str, float] = dict.fromkeys(configs, 0.0)
             for _ in range(opts.runs):
