@@ -619,15 +619,13 @@ class LinearSolver:
             raise ValueError(
                 "linear_solver 'pardiso' needs MKL PARDISO: pip install 'xfemslip[mkl]'"
             )
+        hint = method == "auto" and self.method != "pardiso"
         # a crowded network on SuperLU says once what PARDISO would gain,
         # unless the line below has (_solve_augmented)
         self._network_hint = (
-            method == "auto"
-            and self.method != "pardiso"
-            and n < PARDISO_HINT_MIN_DOFS
-            and not pardiso.available()
+            hint and n < PARDISO_HINT_MIN_DOFS and not pardiso.available()
         )
-        if method == "auto" and self.method != "pardiso" and n >= PARDISO_HINT_MIN_DOFS:
+        if hint and n >= PARDISO_HINT_MIN_DOFS:
             logger.info(
                 "linear solver: %s; with MKL PARDISO (pip install "
                 "'xfemslip[mkl]') the linear solves of meshes this size took "

@@ -42,8 +42,9 @@ on the jump rows, and the correction goes into the backward one there:
 LowRankSystems._solve).  Measured on the 100-fracture network (147k dofs,
 988 patches, 2 threads, loaded machine): the factorization with the Schur
 block 7.9 s against 11.1 s analysis and 3.8 s per factorization of the
-unsymmetric matrix; each later system 0.4-0.6 s for k = 300-550.  Every solve is
-checked against the whole matrix by its backward error, as everywhere.
+unsymmetric matrix; each later system 0.4-0.6 s for k = 300-550.  Every
+solve is checked against the whole matrix by its backward error, as
+everywhere.
 """
 
 from __future__ import annotations
