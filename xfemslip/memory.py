@@ -9,8 +9,9 @@ The peak resident memory of a run is modelled from the sizes that set it
 - ``enriched``: the enriched-cell quadrature (enrichment.EnrichedCells), per
   quadrature point its position and weight and the sub-triangles' vertex
   values (padded to S, the slots of the widest cell): QP_BYTES +
-  QP_PAD_BYTES * S per point, and F and grad F of every used slot at every
-  point of its cell (QP_SLOT_BYTES each);
+  QP_PAD_BYTES * S per point, and F and grad F of every column of a cell
+  (the functions its slots take, one per group and function) at every
+  point of the cell (QP_COLUMN_BYTES each);
 - ``assembly``, while the stiffness is assembled: the padded element
   matrices of the enriched cells, (8 + 2 S)^2 doubles each, for at most
   assembly.ENRICHED_CHUNK cells at a time, the intact
@@ -82,7 +83,7 @@ ENV_LIMIT = "XFEMSLIP_MEMORY_LIMIT"
 BASE_NUMPY = 92e6  # measured 92 MB: a 10 x 10 case on the NumPy kernels [B]
 BASE_NUMBA = 202e6  # measured 201 MB: the same case on the Numba kernels [B]
 QP_BYTES = 48.0  # per enriched-cell quadrature point: xy, w, triangle share [B]
-QP_SLOT_BYTES = 24.0  # per used slot and point of its cell: F, grad F [B]
+QP_COLUMN_BYTES = 24.0  # per column and point of its cell: F, grad F [B]
 QP_PAD_BYTES = 4.0  # per point and slot of the widest cell: vertex values [B]
 TRIPLET_BYTES = 48.0  # per COO entry: rows, cols, values and the CSR copy [B]
 # per grid node while the intact cells are summed into the grid's CSR
@@ -125,9 +126,9 @@ class Footprint:
     entries: float = 0.0  # COO entries of all cells, sum of (8 + 2 s)^2
     enriched_entries: float = 0.0  # of them, those of the enriched cells
     qp: float = 0.0  # enriched-cell quadrature points
-    # F values stored: the points of each enriched cell times its used slots
-    # (None: every point with S slots, an upper bound)
-    qp_slots: float | None = None
+    # F values stored: the points of each enriched cell times its columns
+    # (None: every point with S columns, an upper bound)
+    qp_columns: float | None = None
     patches: float = 0.0  # contact patches
     block: float = 0.0  # dofs of the widest patch's tangent block (2 J)
     contact_entries: float = 0.0  # non-empty entries of the tangent blocks
@@ -139,8 +140,10 @@ class Footprint:
 def estimate_terms(fp: Footprint) -> dict[str, float]:
     """The terms of the module docstring [B] and their ``total``."""
     base = BASE_NUMBA if fp.numba else BASE_NUMPY
-    qp_slots = fp.qp * fp.slots if fp.qp_slots is None else fp.qp_slots
-    enriched = fp.qp * (QP_BYTES + QP_PAD_BYTES * fp.slots) + QP_SLOT_BYTES * qp_slots
+    qp_columns = fp.qp * fp.slots if fp.qp_columns is None else fp.qp_columns
+    enriched = (
+        fp.qp * (QP_BYTES + QP_PAD_BYTES * fp.slots) + QP_COLUMN_BYTES * qp_columns
+    )
     from xfemslip.fem.assembly import ENRICHED_CHUNK
 
     chunk = min(fp.enriched_cells, ENRICHED_CHUNK)
@@ -245,6 +248,16 @@ def enriched_footprint(spec: CaseSpec, mesh, fractures, cand) -> Footprint:
     inside = (ci >= 0) & (ci < nx) & (cj >= 0) & (cj < mesh.ny)
     cell = (cj * nx + ci)[inside]
     slots = np.bincount(cell, minlength=mesh.n_cells)
+    # the cells' columns: their distinct (fracture, tip, function) triples
+    k = np.nonzero(inside)[0]
+    _, function = np.unique(
+        np.column_stack([cand.fracture[k], cand.tip[k], cand.func[k]]),
+        axis=0,
+        return_inverse=True,
+    )
+    width = int(function.max(initial=0)) + 1
+    pairs = np.unique(cell * width + function.ravel())
+    columns = np.bincount(pairs // width, minlength=mesh.n_cells)
     branch = np.zeros(mesh.n_cells, bool)
     branch[(cj * nx + ci)[inside & (cand.func != HEAVISIDE)[:, None]]] = True
     pieces = np.zeros(mesh.n_cells)
@@ -254,7 +267,7 @@ def enriched_footprint(spec: CaseSpec, mesh, fractures, cand) -> Footprint:
     p = pieces[enr]
     qp_cell = QP_CELL + QP_PIECE * p + QP_PIECE2 * p * p + QP_BRANCH * branch[enr]
     qp = float(np.sum(qp_cell))
-    qp_slots = float(np.sum(qp_cell * slots[enr]))
+    qp_columns = float(np.sum(qp_cell * columns[enr]))
     S = int(slots.max(initial=0))
     enriched_entries = float(np.sum((8.0 + 2.0 * slots[enr]) ** 2))
     entries = 64.0 * (mesh.n_cells - enr.sum()) + enriched_entries
@@ -280,7 +293,7 @@ def enriched_footprint(spec: CaseSpec, mesh, fractures, cand) -> Footprint:
         entries=entries,
         enriched_entries=enriched_entries,
         qp=qp,
-        qp_slots=qp_slots,
+        qp_columns=qp_columns,
         patches=patches,
         block=2.0 * S,
         # a patch's block holds the slots of about one cut cell
@@ -322,7 +335,7 @@ def model_footprint(model) -> Footprint:
         entries=entries,
         enriched_entries=enriched_entries,
         qp=float(ec.qp_w.size),
-        qp_slots=float(ec.slot_F.size),
+        qp_columns=float(ec.column_F.size),
         patches=float(contact.dofs.shape[0]),
         block=float(contact.dofs.shape[1]),
         contact_entries=float(np.sum(dofs.astype(float) ** 2)),

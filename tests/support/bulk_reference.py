@@ -43,18 +43,22 @@ def enriched_reference(b, xy, w, F, gradF, slot_node, slot_fnode, D):
 
 
 def compact_slots(offsets, F, gradF, slot_node):
-    """The per-slot layout of enrichment.EnrichedCells (slot_offsets, slot_F,
-    slot_gradF) of padded values F (nq, S) and grad F (nq, S, 2) of cells
-    whose slots are filled from 0 (slot_node (nc, S), -1 = empty)."""
-    used = (np.asarray(slot_node) >= 0).sum(axis=1)
+    """The per-column layout of enrichment.EnrichedCells (column_offsets,
+    column_F, column_gradF, slot_column) of padded values F (nq, S) and grad
+    F (nq, S, 2) of cells whose slots are filled from 0 (slot_node (nc, S),
+    -1 = empty), each used slot in a column of its own."""
+    slot_node = np.asarray(slot_node)
+    used = (slot_node >= 0).sum(axis=1)
     vals, grads, off = [], [], [0]
     for e in range(used.size):
         q = slice(offsets[e], offsets[e + 1])
         vals.append(F[q, : used[e]].T.ravel())
         grads.append(gradF[q, : used[e]].transpose(1, 0, 2).reshape(-1, 2))
         off.append(off[-1] + vals[-1].size)
+    slot_column = np.where(slot_node >= 0, np.arange(slot_node.shape[1]), -1)
     return (
         np.array(off, np.int64),
         np.ascontiguousarray(np.concatenate(vals)),
         np.ascontiguousarray(np.concatenate(grads).reshape(-1, 2)),
+        np.ascontiguousarray(slot_column, dtype=np.int64),
     )

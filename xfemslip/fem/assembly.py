@@ -201,9 +201,10 @@ def _part_matrices(mesh, ec, rows, qp_w, D, backend):
     weight)."""
     if rows is None:
         rows = slice(0, ec.cells.size)
-    off, idx, v_off, slot_F, slot_gradF = ec.part(rows)
-    cells, slot_node, slot_fnode = (
+    off, idx, v_off, column_F, column_gradF = ec.part(rows)
+    cells, slot_column, slot_node, slot_fnode = (
         ec.cells[rows],
+        ec.slot_column[rows],
         ec.slot_node[rows],
         ec.slot_fnode[rows],
     )
@@ -213,8 +214,9 @@ def _part_matrices(mesh, ec, rows, qp_w, D, backend):
         np.ascontiguousarray(ec.qp_xy[idx]),
         np.ascontiguousarray(qp_w[idx], dtype=np.float64),
         v_off,
-        np.ascontiguousarray(slot_F),
-        np.ascontiguousarray(slot_gradF),
+        np.ascontiguousarray(column_F),
+        np.ascontiguousarray(column_gradF),
+        np.ascontiguousarray(slot_column),
         np.ascontiguousarray(slot_node),
         np.ascontiguousarray(slot_fnode),
         np.ascontiguousarray(D, dtype=np.float64),

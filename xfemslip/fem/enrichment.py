@@ -76,31 +76,35 @@ class EnrichedCells:
     qp_offsets: np.ndarray  # (nc+1,) int64
     qp_xy: np.ndarray  # (nq, 2) [m]
     qp_w: np.ndarray  # (nq,) [m^2]
-    # F and grad F of the used slots only (slots are filled from 0): cell e's
-    # value of slot s at its point q (q0 = qp_offsets[e], nq its points) is
-    # at slot_offsets[e] + s * nq + (q - q0), so each slot's values over its
-    # cell are one run (a padded (points, S) layout was 3.4 times larger on
-    # a 100-fracture network: 1.6M points x 48 slots, mostly zeros)
-    slot_offsets: np.ndarray  # (nc+1,) int64
-    slot_F: np.ndarray  # (nv,) [-]
-    slot_gradF: np.ndarray  # (nv, 2) [1/m]
+    # F and grad F at the points, once per column: the slots of a cell that
+    # take the same function of the same group (a fracture's H R, or one of
+    # a tip's B1..B4, from each of the cell's nodes) share one column, their
+    # values differing only by the node's shift slot_fnode.  Cell e's value
+    # of slot s at its point q (q0 = qp_offsets[e], nq its points) is at
+    # column_offsets[e] + slot_column[e, s] * nq + (q - q0).  Stored per slot
+    # they would be 3.1 times as many on a 100-fracture network: 27M points
+    # x slots against 8.7M points x columns, 640 MB against 210 MB.
+    slot_column: np.ndarray  # (nc, S) int64 column of each slot, -1 empty
+    column_offsets: np.ndarray  # (nc+1,) int64
+    column_F: np.ndarray  # (nv,) [-]
+    column_gradF: np.ndarray  # (nv, 2) [1/m]
     tri_offsets: np.ndarray  # (nc+1,) int64 sub-triangles of each cell
     tris: np.ndarray  # (nt, 3, 2) [m]
     tri_F: np.ndarray  # (nt, 3, S) F at the triangle's vertices, from its own side
-    # slot_F and slot_gradF dropped (without_point_values)
+    # column_F and column_gradF dropped (without_point_values)
     values_released: bool = False
 
     def without_point_values(self) -> EnrichedCells:
         """These cells without the enrichment values at their quadrature
-        points (slot_F, slot_gradF: 640 MB on a 100-fracture network at 200
-        x 200 cells, three fifths of its model), for a model assembled and
+        points (column_F, column_gradF: 210 MB on a 100-fracture network at
+        200 x 200 cells), for a model assembled and
         loaded, which is only solved and written from here on (the
         sub-triangles and their vertex values stay for the output);
         qp_values and part raise on the copy."""
         return dataclasses.replace(
             self,
-            slot_F=np.zeros(0),
-            slot_gradF=np.zeros((0, 2)),
+            column_F=np.zeros(0),
+            column_gradF=np.zeros((0, 2)),
             values_released=True,
         )
 
@@ -119,45 +123,46 @@ class EnrichedCells:
         S = self.slot_cand.shape[1]
         e = np.searchsorted(self.qp_offsets, q, side="right") - 1
         nq = np.diff(self.qp_offsets)[e]
-        used = self.slot_cand[e] >= 0  # (n, S)
+        col = self.slot_column[e]  # (n, S)
+        used = col >= 0
         v = (
-            self.slot_offsets[e][:, None]
-            + np.arange(S)[None, :] * nq[:, None]
+            self.column_offsets[e][:, None]
+            + col * nq[:, None]
             + (q - self.qp_offsets[e])[:, None]
         )
         F = np.zeros((q.size, S))
         gF = np.zeros((q.size, S, 2))
-        F[used] = self.slot_F[v[used]]
-        gF[used] = self.slot_gradF[v[used]]
+        F[used] = self.column_F[v[used]]
+        gF[used] = self.column_gradF[v[used]]
         return F, gF
 
     def part(self, rows) -> tuple[Any, ...]:
         """The points and slot values of the cells ``rows`` (indices into
         cells, or a slice of them: then views, no copy), as the cell kernels
-        take them: (qp_offsets, points (index array or slice), slot_offsets,
-        slot_F, slot_gradF), offsets from 0."""
+        take them: (qp_offsets, points (index array or slice),
+        column_offsets, column_F, column_gradF), offsets from 0."""
         self._check_values()
         if isinstance(rows, slice):
             lo, hi, _ = rows.indices(self.cells.size)
-            q0, v0 = self.qp_offsets[lo], self.slot_offsets[lo]
-            v1 = self.slot_offsets[hi]
+            q0, v0 = self.qp_offsets[lo], self.column_offsets[lo]
+            v1 = self.column_offsets[hi]
             return (
                 self.qp_offsets[lo : hi + 1] - q0,
                 slice(q0, self.qp_offsets[hi]),
-                self.slot_offsets[lo : hi + 1] - v0,
-                self.slot_F[v0:v1],
-                self.slot_gradF[v0:v1],
+                self.column_offsets[lo : hi + 1] - v0,
+                self.column_F[v0:v1],
+                self.column_gradF[v0:v1],
             )
         rows = np.asarray(rows, dtype=np.int64)
         counts = np.diff(self.qp_offsets)[rows]
         q_off = np.zeros(rows.size + 1, np.int64)
         np.cumsum(counts, out=q_off[1:])
         q_idx = ranges(self.qp_offsets[rows], counts)
-        v_counts = np.diff(self.slot_offsets)[rows]
+        v_counts = np.diff(self.column_offsets)[rows]
         v_off = np.zeros(rows.size + 1, np.int64)
         np.cumsum(v_counts, out=v_off[1:])
-        v_idx = ranges(self.slot_offsets[rows], v_counts)
-        return q_off, q_idx, v_off, self.slot_F[v_idx], self.slot_gradF[v_idx]
+        v_idx = ranges(self.column_offsets[rows], v_counts)
+        return q_off, q_idx, v_off, self.column_F[v_idx], self.column_gradF[v_idx]
 
 
 @dataclass(frozen=True)
@@ -424,16 +429,33 @@ def build_enriched_cells(
     qp_xy, qp_w, qp_off, per_tri = _cell_rules(tri_off, tris, branch)
     centroids = tris.mean(axis=1)
 
-    # pass 2: each enrichment group on every cell it reaches
+    # pass 2: each enrichment group on every cell it reaches; a cell's slots
+    # that take the same function of the same group share a column
     nq_cell = np.diff(qp_off)
     nt_cell = np.diff(tri_off)
-    slot_off = np.zeros(nc + 1, np.int64)
-    np.cumsum(nq_cell * n_slots, out=slot_off[1:])
-    F = np.zeros(slot_off[-1])
-    gF = np.zeros((slot_off[-1], 2))
-    Fv = np.zeros((tris.shape[0], 3, S))
-    scatter = kernels.backend(backend).scatter_slot_values
     group = cand.fracture[k_used] * (1 << 32) + (cand.tip[k_used] + (1 << 31))
+    func = cand.func[k_used]
+    _, group_rank = np.unique(group, return_inverse=True)
+    width = 4 * (int(group_rank.max(initial=0)) + 1)
+    # (cell, group, function index into the group's values) of every slot
+    key = (
+        e_used * width
+        + group_rank.ravel() * 4
+        + np.where(func == HEAVISIDE, 0, func - 1)
+    )
+    col_key, slot_key = np.unique(key, return_inverse=True)
+    slot_key = slot_key.ravel()
+    col_cell = col_key // width
+    col_in_cell = np.arange(col_key.size) - np.searchsorted(col_cell, col_cell)
+    slot_column = -np.ones((nc, S), np.int64)
+    slot_column[e_used, s_used] = col_in_cell[slot_key]
+    n_cols = np.bincount(col_cell, minlength=nc)
+    col_off = np.zeros(nc + 1, np.int64)
+    np.cumsum(nq_cell * n_cols, out=col_off[1:])
+    F = np.zeros(col_off[-1])
+    gF = np.zeros((col_off[-1], 2))
+    Fv_col = np.zeros((tris.shape[0], 3, int(n_cols.max(initial=0))))
+    scatter = kernels.backend(backend).scatter_column_values
     # the slots of each group as one slice of a stable sort (in the order a
     # mask `group == g` gives) rather than a mask over all slots per group:
     # 1,733 groups x 130k slots on a 100-fracture network
@@ -466,28 +488,33 @@ def build_enriched_cells(
             tol,
             np.repeat(centroids[ti], 3, axis=0),
         )[0].reshape(ti.size, 3, -1)
-        # every slot of the group, with its cell's first rows in the group's
-        # arrays
-        es, ss = e_used[mine], s_used[mine]
-        func = cand.func[slot_cand[es, ss]]
+        # every column of the group, with its cell's first rows in the
+        # group's arrays
+        cols = np.unique(slot_key[mine])
+        es = col_cell[cols]
         scatter(
             F,
             gF,
-            Fv,
+            Fv_col,
             np.ascontiguousarray(Fq),
             np.ascontiguousarray(gq),
             np.ascontiguousarray(Fvert),
             es,
-            ss,
-            np.where(func == HEAVISIDE, 0, func - 1),
+            col_in_cell[cols],
+            col_key[cols] % 4,
             np.searchsorted(cells, es),
-            slot_off,
+            col_off,
             nq_cell,
             np.concatenate([[0], np.cumsum(nq_cell[cells])]),
             tri_off,
             nt_cell,
             np.concatenate([[0], np.cumsum(nt_cell[cells])]),
         )
+    # the vertex values (for the output) per slot, each its column's
+    tri_slot = slot_column[np.repeat(np.arange(nc), nt_cell)]  # (nt, S)
+    Fv = np.zeros((tris.shape[0], 3, S))
+    t_used, s_of = np.nonzero(tri_slot >= 0)
+    Fv[t_used, :, s_of] = Fv_col[t_used, :, tri_slot[t_used, s_of]]
 
     return EnrichedCells(
         cells=cand_cells,
@@ -497,9 +524,10 @@ def build_enriched_cells(
         qp_offsets=qp_off,
         qp_xy=qp_xy,
         qp_w=qp_w,
-        slot_offsets=slot_off,
-        slot_F=F,
-        slot_gradF=gF,
+        slot_column=slot_column,
+        column_offsets=col_off,
+        column_F=F,
+        column_gradF=gF,
         tri_offsets=tri_off,
         tris=tris,
         tri_F=Fv,

@@ -36,7 +36,7 @@ KERNELS = (
     "csr_add_entries",
     "enriched_cell_matrices",
     "rectangle_stiffness",
-    "scatter_slot_values",
+    "scatter_column_values",
 )
 # "auto" takes NumPy up to this many enriched-cell quadrature points times
 # (8 + 2 S)^2 (simulation.kernel_work), and Numba above.  Measured

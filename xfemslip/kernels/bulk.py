@@ -122,9 +122,10 @@ def enriched_cell_matrices(
     qp_offsets,
     qp_xy,
     qp_w,
-    slot_offsets,
-    slot_F,
-    slot_gradF,
+    column_offsets,
+    column_F,
+    column_gradF,
+    slot_column,
     slot_node,
     slot_fnode,
     D,
@@ -136,10 +137,13 @@ def enriched_cell_matrices(
     bounds : (nc, 4) float64, [x0, x1, y0, y1] of each cell [m]
     qp_offsets : (nc + 1,) int64, qp range of each cell in the flat arrays
     qp_xy : (nq, 2) float64 [m]; qp_w : (nq,) float64 [m^2] (sub-cell rules)
-    slot_offsets : (nc + 1,) int64; slot_F : (nv,) float64 [-]; slot_gradF :
-        (nv, 2) float64 [1/m]: enrichment function F of each used slot at each
-        point of its cell, slot s of cell e at point q at slot_offsets[e] + s
-        * nq_e + (q - qp_offsets[e]) (enrichment.EnrichedCells)
+    column_offsets : (nc + 1,) int64; column_F : (nv,) float64 [-];
+        column_gradF : (nv, 2) float64 [1/m]: the enrichment functions of
+        each cell at its points, column c of cell e at point q at
+        column_offsets[e] + c * nq_e + (q - qp_offsets[e])
+        (enrichment.EnrichedCells)
+    slot_column : (nc, S) int64, the column of each slot's function, -1 =
+        empty
     slot_node : (nc, S) int64, local node (0..3) of each slot, -1 = empty
         (slots are filled from 0)
     slot_fnode : (nc, S) float64, F at the slot's node (the shift of eq. 11)
@@ -185,10 +189,10 @@ def enriched_cell_matrices(
                     P[k, 4 + s] = 0.0
                     P[k, nf + 4 + s] = 0.0
                     continue
-                v = slot_offsets[e] + s * nq + k
-                shift = slot_F[v] - slot_fnode[e, s]
-                P[k, 4 + s] = dN[a, 0] * shift + N[a] * slot_gradF[v, 0]
-                P[k, nf + 4 + s] = dN[a, 1] * shift + N[a] * slot_gradF[v, 1]
+                v = column_offsets[e] + slot_column[e, s] * nq + k
+                shift = column_F[v] - slot_fnode[e, s]
+                P[k, 4 + s] = dN[a, 0] * shift + N[a] * column_gradF[v, 0]
+                P[k, nf + 4 + s] = dN[a, 1] * shift + N[a] * column_gradF[v, 1]
             w = qp_w[q]
             for i in range(2 * nf):
                 Pw[k, i] = w * P[k, i]

@@ -6,7 +6,7 @@ from xfemslip.kernels.contact import contact_response, coulomb_return_map
 from xfemslip.kernels.scatter import (
     block_triplets,
     csr_add_entries,
-    scatter_slot_values,
+    scatter_column_values,
 )
 from xfemslip.kernels.subcells import cell_subtriangles
 
@@ -18,5 +18,5 @@ __all__ = [
     "csr_add_entries",
     "enriched_cell_matrices",
     "rectangle_stiffness",
-    "scatter_slot_values",
+    "scatter_column_values",
 ]

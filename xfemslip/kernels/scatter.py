@@ -153,18 +153,18 @@ def csr_add_entries(indptr, indices, data, rows, cols, vals, to_dof, n):
 
 
 @njit(cache=NUMBA_CACHE)
-def scatter_slot_values(
+def scatter_column_values(
     F,
     gF,
     Fv,
     Fq,
     gq,
     Fvert,
-    slot_cell,
-    slot,
+    col_cell,
+    col,
     func,
     group_cell,
-    slot_off,
+    col_off,
     qp_count,
     group_qp,
     tri_off,
@@ -172,23 +172,24 @@ def scatter_slot_values(
     group_tri,
 ):
     """The values of one enrichment group, evaluated on the points of the
-    cells it reaches, copied to each of its slots (enrichment.EnrichedCells):
-    for slot ``slot[i]`` of cell ``slot_cell[i]`` (row ``group_cell[i]`` of
-    the group's cells) taking the group's function ``func[i]``,
+    cells it reaches, copied to each of its columns (enrichment.
+    EnrichedCells): for column ``col[i]`` of cell ``col_cell[i]`` (row
+    ``group_cell[i]`` of the group's cells) taking the group's function
+    ``func[i]``,
 
-        F[slot_off[e] + s nq_e + q] = Fq[group_qp[g] + q, j]   (q < nq_e)
+        F[col_off[e] + c nq_e + q] = Fq[group_qp[g] + q, j]   (q < nq_e)
         gF[...] likewise from gq (., ., 2),
-        Fv[tri_off[e] + t, :, s] = Fvert[group_tri[g] + t, :, j]   (t < nt_e)
+        Fv[tri_off[e] + t, :, c] = Fvert[group_tri[g] + t, :, j]   (t < nt_e)
 
-    with e, s, g, j those of slot i, nq_e = qp_count[e], nt_e = tri_count[e].
-    F, gF and Fv are written in place."""
-    for i in range(slot_cell.size):
-        e = slot_cell[i]
-        s = slot[i]
+    with e, c, g, j those of column i, nq_e = qp_count[e], nt_e =
+    tri_count[e].  F, gF and Fv are written in place."""
+    for i in range(col_cell.size):
+        e = col_cell[i]
+        c = col[i]
         g = group_cell[i]
         j = func[i]
         nq = qp_count[e]
-        dst = slot_off[e] + s * nq
+        dst = col_off[e] + c * nq
         src = group_qp[g]
         for q in range(nq):
             F[dst + q] = Fq[src + q, j]
@@ -198,4 +199,4 @@ def scatter_slot_values(
         src = group_tri[g]
         for t in range(tri_count[e]):
             for v in range(3):
-                Fv[dst + t, v, s] = Fvert[src + t, v, j]
+                Fv[dst + t, v, c] = Fvert[src + t, v, j]

@@ -106,9 +106,9 @@ def test_without_point_values_keeps_the_rest_and_refuses_their_use():
 
     mesh, fractures = _network()
     ec = build_enriched_cells(mesh, fractures, find_candidates(mesh, fractures))
-    assert ec.slot_F.size > 0 and not ec.values_released
+    assert ec.column_F.size > 0 and not ec.values_released
     bare = ec.without_point_values()
-    assert bare.values_released and bare.slot_F.size == bare.slot_gradF.size == 0
+    assert bare.values_released and bare.column_F.size == bare.column_gradF.size == 0
     for name in ("cells", "slot_cand", "qp_xy", "qp_w", "tris", "tri_F"):
         assert getattr(bare, name) is getattr(ec, name)
     with pytest.raises(RuntimeError, match="released"):
