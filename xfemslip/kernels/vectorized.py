@@ -76,60 +76,97 @@ def rectangle_stiffness(hx, hy, D):
     return 0.5 * (K + K.transpose(0, 2, 1))  # exact symmetry
 
 
-def function_gradients(qp_xy, bounds, slot_node, slot_fnode, qp_F, qp_gradF):
-    """d/dx and d/dy (nq, 4 + S) of the cell's shape functions at every
-    quadrature point: the four Q4 functions N_a, then the shifted enrichment
-    Phi_s = N_a (F - F(x_a)) of each slot (paper eq. 11; 0 for an empty slot).
-    ``bounds``, ``slot_node``, ``slot_fnode`` are those of each point's cell,
-    (nq, 4), (nq, S), (nq, S).  Local dof 2 f + c is function f, component c,
-    as in bulk._enriched_B."""
+def function_gradients(xy, bounds, slot_node, slot_fnode, F, gradF):
+    """d/dx and d/dy (g, n, 4 + S) of the shape functions of g cells at n
+    points each: the four Q4 functions N_a, then the shifted enrichment
+    Phi_s = N_a (F - F(x_a)) of each slot (paper eq. 11; 0 for an empty
+    slot).  xy (g, n, 2) [m]; bounds (g, 4), slot_node (g, S), slot_fnode
+    (g, S) of each cell; F (g, n, S), gradF (g, n, S, 2) the slots' values
+    at the points (0 in empty slots).  Local dof 2 f + c is function f,
+    component c, as in bulk._enriched_B."""
     N, dN = q4_shape(
-        qp_xy[:, 0], qp_xy[:, 1], bounds[:, 0], bounds[:, 1], bounds[:, 2], bounds[:, 3]
+        xy[..., 0],
+        xy[..., 1],
+        bounds[:, 0, None],
+        bounds[:, 1, None],
+        bounds[:, 2, None],
+        bounds[:, 3, None],
     )
-    used = slot_node >= 0
-    a = np.where(used, slot_node, 0)
-    shift = np.where(used, qp_F - slot_fnode, 0.0)
-    Na = np.where(used, np.take_along_axis(N, a, 1), 0.0)
-    gx = np.take_along_axis(dN[:, :, 0], a, 1) * shift + Na * qp_gradF[:, :, 0]
-    gy = np.take_along_axis(dN[:, :, 1], a, 1) * shift + Na * qp_gradF[:, :, 1]
-    return np.concatenate([dN[:, :, 0], gx], 1), np.concatenate([dN[:, :, 1], gy], 1)
+    # N_a, dN_a/dx, dN_a/dy of each slot's node a: a product with the
+    # slots' 0/1 node matrix (g, 4, S), exact, and a third of the time of
+    # three gathers
+    pick = _one_hot(slot_node, 4)[:, None]
+    Na, dxa, dya = np.matmul(np.stack([N, dN[..., 0], dN[..., 1]], 1), pick).transpose(
+        1, 0, 2, 3
+    )
+    shift = F - slot_fnode[:, None, :]
+    gx = dxa * shift + Na * gradF[..., 0]
+    gy = dya * shift + Na * gradF[..., 1]
+    return np.concatenate([dN[..., 0], gx], 2), np.concatenate([dN[..., 1], gy], 2)
 
 
-def padded_slot_values(qp_offsets, column_offsets, column_F, column_gradF, slot_column):
-    """F (nq, S) and grad F (nq, S, 2) of every point, each slot in its
-    column (0 in empty slots), from the per-column layout of
-    enrichment.EnrichedCells."""
-    nq_cell = np.diff(qp_offsets)
-    nq = int(qp_offsets[-1]) if qp_offsets.size else 0
-    S = slot_column.shape[1]
-    F = np.zeros((nq, S))
-    gF = np.zeros((nq, S, 2))
-    e, s = np.nonzero(slot_column >= 0)
-    if e.size and nq:
-        # every (point, used slot) pair: its cell's points, slot by slot
-        n = nq_cell[e]
-        v = ranges(column_offsets[e] + slot_column[e, s] * n, n)
-        q = ranges(qp_offsets[e], n)
-        s = np.repeat(s, n)
-        F[q, s] = column_F[v]
-        gF[q, s] = column_gradF[v]
-    return F, gF
+def _one_hot(index, n):
+    """(g, n, S) with 1 at [i, index[i, s], s] where index >= 0, else 0."""
+    g, S = index.shape
+    out = np.zeros((g, n, S))
+    i, s = np.nonzero(index >= 0)
+    out[i, index[i, s], s] = 1.0
+    return out
 
 
-# the largest batch of enriched_cell_matrices' products (cells, points)
+def slot_values(group, count, column_offsets, column_F, column_gradF, slot_column):
+    """F (g, count, S) and grad F (g, count, S, 2) of the cells ``group``,
+    each with ``count`` points, each slot in its column (0 in empty slots),
+    from the per-column layout of enrichment.EnrichedCells: the cells'
+    columns gathered, then given to their slots by a product with the 0/1
+    column matrix (exact)."""
+    col = slot_column[group]  # (g, S)
+    n_col = np.diff(column_offsets)[group] // count  # columns of each cell
+    C = int(n_col.max(initial=0))
+    if C == 0:
+        return np.zeros((group.size, count, col.shape[1])), np.zeros(
+            (group.size, count, col.shape[1], 2)
+        )
+    c = np.arange(C)
+    at = (
+        column_offsets[group][:, None, None]
+        + np.minimum(c, np.maximum(n_col - 1, 0)[:, None])[:, None, :] * count
+        + np.arange(count)[None, :, None]
+    )  # (g, count, C)
+    values = np.stack(
+        [column_F[at], column_gradF[at, 0], column_gradF[at, 1]], 1
+    )  # (g, 3, count, C)
+    F, gx, gy = np.matmul(values, _one_hot(col, C)[:, None]).transpose(1, 0, 2, 3)
+    return F, np.stack([gx, gy], 3)
+
+
+# the largest batch of enriched_cell_matrices (cells, points): a batch's
+# arrays (points x functions) stay in the cache and below the allocator's
+# mmap threshold (memory.MMAP_THRESHOLD), so batches reuse the same memory
 BATCH_CELLS = 256
-BATCH_POINTS = 32768
+BATCH_POINTS = 4096
 
 
-def _add_rule_batch(blocks, group, count, qp_offsets, wx, wy, bx, by, d):
-    """K's blocks of the cells ``group``, each with ``count`` points:
-    sum_q w b_f b_g for the four (x|y, x|y) gradient pairs, combined with D."""
+def _add_rule_batch(blocks, bar, group, count, args, d):
+    """K's blocks and Bbar of the cells ``group``, each with ``count``
+    points: sum_q w b_f b_g for the four (x|y, x|y) gradient pairs, combined
+    with D, and (1/A) sum_q w b_f."""
+    bounds, qp_offsets, qp_xy, qp_w, column_offsets, F, gF, slot_column = args[:8]
+    slot_node, slot_fnode = args[8:]
     at = qp_offsets[group][:, None] + np.arange(count)  # (g, count)
-    gx, gy, hx, hy = wx[at], wy[at], bx[at], by[at]  # (g, count, nf)
-    xx = np.matmul(gx.transpose(0, 2, 1), hx)  # (g, nf, nf)
-    xy = np.matmul(gx.transpose(0, 2, 1), hy)
-    yx = np.matmul(gy.transpose(0, 2, 1), hx)
-    yy = np.matmul(gy.transpose(0, 2, 1), hy)
+    bx, by = function_gradients(
+        qp_xy[at],
+        bounds[group],
+        slot_node[group],
+        slot_fnode[group],
+        *slot_values(group, count, column_offsets, F, gF, slot_column),
+    )  # (g, count, nf)
+    w = qp_w[at][..., None]
+    wx, wy = bx * w, by * w
+    xx = np.matmul(wx.transpose(0, 2, 1), bx)  # (g, nf, nf)
+    xy = np.matmul(wx.transpose(0, 2, 1), by)
+    yx = np.matmul(wy.transpose(0, 2, 1), bx)
+    yy = np.matmul(wy.transpose(0, 2, 1), by)
     blocks[group, :, 0, :, 0] = (
         d[0, 0] * xx + d[0, 2] * xy + d[2, 0] * yx + d[2, 2] * yy
     )
@@ -142,6 +179,15 @@ def _add_rule_batch(blocks, group, count, qp_offsets, wx, wy, bx, by, d):
     blocks[group, :, 1, :, 1] = (
         d[1, 1] * yy + d[1, 2] * yx + d[2, 1] * xy + d[2, 2] * xx
     )
+    # sums in point order (reduceat adds in sequence), as the Numba kernel
+    starts = np.arange(0, group.size * count, count)
+    sx = np.add.reduceat(wx.reshape(-1, wx.shape[2]), starts)  # (g, nf)
+    sy = np.add.reduceat(wy.reshape(-1, wy.shape[2]), starts)
+    area = np.add.reduceat(w.ravel(), starts)[:, None]
+    bar[group, 0, :, 0] = sx / area
+    bar[group, 1, :, 1] = sy / area
+    bar[group, 2, :, 0] = sy / area
+    bar[group, 2, :, 1] = sx / area
 
 
 def enriched_cell_matrices(
@@ -163,11 +209,11 @@ def enriched_cell_matrices(
     With B's Voigt rows [exx, eyy, gxy] = [bx u_x, by u_y, by u_x + bx u_y]
     (paper eq. 16), each (x|y, x|y) block of K_e is a combination of the four
     gradient products sum_qp w b_f b_g: four small products per cell instead
-    of one over the 3 x (8 + 2S) B.
+    of one over the 3 x (8 + 2S) B.  Cells with the same number of points (a
+    handful of rules: uncut, cut, tip) are taken together, in batches of at
+    most BATCH_CELLS cells and BATCH_POINTS points, each evaluating its own
+    functions.
     """
-    qp_F, qp_gradF = padded_slot_values(
-        qp_offsets, column_offsets, column_F, column_gradF, slot_column
-    )
     nc = bounds.shape[0]
     S = slot_node.shape[1]
     nf = 4 + S
@@ -176,32 +222,25 @@ def enriched_cell_matrices(
     counts = np.diff(qp_offsets)
     if nc == 0 or counts.sum() == 0:
         return K, Bbar
-    cell = np.repeat(np.arange(nc), counts)
-    bx, by = function_gradients(
-        qp_xy, bounds[cell], slot_node[cell], slot_fnode[cell], qp_F, qp_gradF
-    )
-    wx, wy = bx * qp_w[:, None], by * qp_w[:, None]
     blocks = K.reshape(nc, nf, 2, nf, 2)
-    # cells with the same number of points (a handful of rules: uncut, cut,
-    # tip) as batched products, not one small product per cell; a batch
-    # holds at most BATCH_CELLS cells and BATCH_POINTS points, so its
-    # gathered gradients and products stay small beside K
+    bar = Bbar.reshape(nc, 3, nf, 2)
+    args = (
+        bounds,
+        qp_offsets,
+        qp_xy,
+        qp_w,
+        column_offsets,
+        column_F,
+        column_gradF,
+        slot_column,
+        slot_node,
+        slot_fnode,
+    )
     for count in np.unique(counts[counts > 0]):
         same = np.nonzero(counts == count)[0]
         step = max(1, min(BATCH_CELLS, BATCH_POINTS // count))
         for lo in range(0, same.size, step):
-            _add_rule_batch(
-                blocks, same[lo : lo + step], count, qp_offsets, wx, wy, bx, by, D
-            )
-    full = np.nonzero(counts)[0]
-    sx = np.add.reduceat(wx, qp_offsets[full], axis=0)  # (k, nf)
-    sy = np.add.reduceat(wy, qp_offsets[full], axis=0)
-    area = np.add.reduceat(qp_w, qp_offsets[full])[:, None]
-    bar = Bbar.reshape(nc, 3, nf, 2)
-    bar[full, 0, :, 0] = sx / area
-    bar[full, 1, :, 1] = sy / area
-    bar[full, 2, :, 0] = sy / area
-    bar[full, 2, :, 1] = sx / area
+            _add_rule_batch(blocks, bar, same[lo : lo + step], int(count), args, D)
     return K, Bbar
 
 
