@@ -251,8 +251,7 @@ def enriched_footprint(spec: CaseSpec, mesh, fractures, cand) -> Footprint:
     # the cells' columns: their distinct (fracture, tip, function) triples
     k = np.nonzero(inside)[0]
     _, function = np.unique(
-        np.column_stack([cand.fracture[k], cand.tip[k], cand.func[k]]),
-        axis=0,
+        (cand.fracture[k] * (1 << 32) + (cand.tip[k] + (1 << 31))) * 8 + cand.func[k],
         return_inverse=True,
     )
     width = int(function.max(initial=0)) + 1
