@@ -14,7 +14,7 @@ The peak resident memory of a run is modelled from the sizes that set it
   point of the cell (QP_COLUMN_BYTES each);
 - ``assembly``, while the stiffness is assembled: the padded element
   matrices of the enriched cells, (8 + 2 S)^2 doubles each, for at most
-  assembly.ENRICHED_CHUNK cells at a time, the intact
+  assembly.enriched_chunk cells at a time, the intact
   cells summed into the grid's CSR (GRID_BYTES per node), the COO triplets
   of the enriched cells' entries with their conversion to CSR
   (TRIPLET_BYTES per entry) and, on the NumPy kernels, the shape-function
@@ -144,9 +144,9 @@ def estimate_terms(fp: Footprint) -> dict[str, float]:
     enriched = (
         fp.qp * (QP_BYTES + QP_PAD_BYTES * fp.slots) + QP_COLUMN_BYTES * qp_columns
     )
-    from xfemslip.fem.assembly import ENRICHED_CHUNK
+    from xfemslip.fem.assembly import enriched_chunk
 
-    chunk = min(fp.enriched_cells, ENRICHED_CHUNK)
+    chunk = min(fp.enriched_cells, enriched_chunk(fp.slots))
     share = chunk / fp.enriched_cells if fp.enriched_cells else 1.0
     gradients = (
         0.0 if fp.numba else NUMPY_QP_FUNCTION_BYTES * share * fp.qp * (4 + fp.slots)

@@ -270,11 +270,20 @@ def _enriched_matrices(mesh, ec, D, material, qp_material=None, *, backend, rows
     return out
 
 
-# Enriched cells per call of the cell kernel: their padded element matrices,
-# (8 + 2S)^2 doubles each, are reduced to their diagonal and entries chunk by
-# chunk (all at once: 1.1 GB on a 100-fracture network of 13k enriched cells
-# with S = 48).
-ENRICHED_CHUNK = 2048
+# Bytes of the padded element matrices ((8 + 2S)^2 doubles a cell) of one call
+# of the cell kernel, which are reduced to their diagonal and entries chunk
+# by chunk (all at once: 1.1 GB on a 100-fracture network of 13k enriched
+# cells with S = 48).  Below the allocator's mmap threshold
+# (memory.MMAP_THRESHOLD) a chunk reuses the heap memory of the last one,
+# already in the cache, instead of mapping and faulting in fresh pages: the
+# network's entries took 1.85-2.03 s in chunks of 2048 cells (177 MB),
+# 0.83-1.05 s in chunks of 8 to 46 cells.
+ENRICHED_CHUNK_BYTES = 2 << 20
+
+
+def enriched_chunk(S: int) -> int:
+    """Enriched cells per call of the cell kernel with S slots a cell."""
+    return max(1, ENRICHED_CHUNK_BYTES // (8 * (8 + 2 * S) ** 2))
 
 
 def _candidate_dofs(mesh, ec):
@@ -292,7 +301,7 @@ def _candidate_dofs(mesh, ec):
 
 
 def _enriched_entries(mesh, ec, D, material, qp_material, backend):
-    """Chunk by chunk of ENRICHED_CHUNK cells: the diagonal (nc, 8+2S) and
+    """Chunk by chunk (enriched_chunk cells): the diagonal (nc, 8+2S) and
     Bbar (nc, 3, 8+2S) of the enriched-cell matrices and their entries (rows,
     cols, values) in candidate numbering (_candidate_dofs; int32 where the
     numbers fit), in the order of kernels.block_triplets over all the cells."""
@@ -308,8 +317,9 @@ def _enriched_entries(mesh, ec, D, material, qp_material, backend):
     cols = np.empty(total, index_type)
     vals = np.empty(total)
     p = 0
-    for lo in range(0, nc, ENRICHED_CHUNK):
-        part = slice(lo, min(lo + ENRICHED_CHUNK, nc))
+    chunk = enriched_chunk(ec.slot_cand.shape[1])
+    for lo in range(0, nc, chunk):
+        part = slice(lo, min(lo + chunk, nc))
         K_e, Bbar[part] = _enriched_matrices(
             mesh, ec, D, material, qp_material, backend=backend, rows=part
         )
