@@ -40,13 +40,13 @@ KERNELS = (
 )
 # "auto" takes NumPy up to this many enriched-cell quadrature points times
 # (8 + 2 S)^2 (simulation.kernel_work), and Numba above.  Measured
-# (benchmarks/kernels_backend.py, docs/performance.md *Kernel backends*): NumPy's
-# enriched-cell assembly and contact law cost 0.06 s more than Numba's on the
-# 50 x 50 reservoir case (work 3.6e7) and about 0.35 s more on the shipped
-# 15-fracture network (1.9e8), against about 0.5 s of Numba import and
-# set-up in every process (9 s of compilation after install); at 1.4e9 (100
-# fractures on 200 x 200 cells) they cost 1.4 s more per assembly and 0.14 s
-# more per contact evaluation.
+# (benchmarks/kernels_backend.py, docs/performance.md *Kernel backends*): whole
+# runs with NumPy are as fast or faster on every shipped case (up to the
+# shipped 15-fracture network, work 1.9e8), for Numba's import and set-up
+# in every process (about 0.5 s; 9 s of compilation after install); at
+# 1.4e9 (100 branch-tipped fractures on 200 x 200 cells) NumPy's
+# enriched-cell entries took 5.5 s against Numba's 0.6 s, and its sum into
+# the grid's matrix 1.4 s against 0.4 s.
 AUTO_NUMPY_MAX_WORK = 2.5e8
 # XFEMSLIP_KERNELS=numba|numpy overrides "auto" (the test suite runs both).
 ENV_OVERRIDE = "XFEMSLIP_KERNELS"
