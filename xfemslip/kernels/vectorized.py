@@ -147,12 +147,14 @@ BATCH_CELLS = 256
 BATCH_POINTS = 4096
 
 
-def _add_rule_batch(blocks, bar, group, count, args, d):
+def _add_rule_batch(blocks, bar, group, count, points, slots, d):
     """K's blocks and Bbar of the cells ``group``, each with ``count``
     points: sum_q w b_f b_g for the four (x|y, x|y) gradient pairs, combined
-    with D, and (1/A) sum_q w b_f."""
-    bounds, qp_offsets, qp_xy, qp_w, column_offsets, F, gF, slot_column = args[:8]
-    slot_node, slot_fnode = args[8:]
+    with D, and (1/A) sum_q w b_f.  points: (bounds, qp_offsets, qp_xy,
+    qp_w), slots: (column_offsets, column_F, column_gradF, slot_column,
+    slot_node, slot_fnode), as enriched_cell_matrices takes them."""
+    bounds, qp_offsets, qp_xy, qp_w = points
+    column_offsets, F, gF, slot_column, slot_node, slot_fnode = slots
     at = qp_offsets[group][:, None] + np.arange(count)  # (g, count)
     bx, by = function_gradients(
         qp_xy[at],
@@ -224,23 +226,15 @@ def enriched_cell_matrices(
         return K, Bbar
     blocks = K.reshape(nc, nf, 2, nf, 2)
     bar = Bbar.reshape(nc, 3, nf, 2)
-    args = (
-        bounds,
-        qp_offsets,
-        qp_xy,
-        qp_w,
-        column_offsets,
-        column_F,
-        column_gradF,
-        slot_column,
-        slot_node,
-        slot_fnode,
-    )
+    points = (bounds, qp_offsets, qp_xy, qp_w)
+    slots = (column_offsets, column_F, column_gradF, slot_column)
+    slots += (slot_node, slot_fnode)
     for count in np.unique(counts[counts > 0]):
         same = np.nonzero(counts == count)[0]
         step = max(1, min(BATCH_CELLS, BATCH_POINTS // count))
         for lo in range(0, same.size, step):
-            _add_rule_batch(blocks, bar, same[lo : lo + step], int(count), args, D)
+            group = same[lo : lo + step]
+            _add_rule_batch(blocks, bar, group, int(count), points, slots, D)
     return K, Bbar
 
 
