@@ -127,11 +127,14 @@ def slot_values(group, count, column_offsets, column_F, column_gradF, slot_colum
         return np.zeros((group.size, count, col.shape[1])), np.zeros(
             (group.size, count, col.shape[1], 2)
         )
-    c = np.arange(C)
-    at = (
+    # a cell's columns past its last read its last one (any stored value:
+    # the 0/1 product drops them), within the array for a cell without any
+    c = np.minimum(np.arange(C), np.maximum(n_col - 1, 0)[:, None])  # (g, C)
+    at = np.minimum(
         column_offsets[group][:, None, None]
-        + np.minimum(c, np.maximum(n_col - 1, 0)[:, None])[:, None, :] * count
-        + np.arange(count)[None, :, None]
+        + c[:, None, :] * count
+        + np.arange(count)[None, :, None],
+        column_F.size - 1,
     )  # (g, count, C)
     values = np.stack(
         [column_F[at], column_gradF[at, 0], column_gradF[at, 1]], 1

@@ -309,6 +309,44 @@ def test_shared_columns_give_the_matrices_of_one_column_per_slot(key, backend):
     np.testing.assert_array_equal(B_shared, B_slot)
 
 
+def test_a_cell_without_slots_in_a_batch_of_enriched_ones():
+    """NumPy's batches gather each cell's columns; a cell with no slot (no
+    column, the last of the stored values) beside enriched cells with the
+    same rule gives the plain Q4 block and leaves the others' matrices as
+    the Numba kernel's."""
+    from xfemslip import kernels
+
+    m = _model("branch-generic")
+    ec = m.ec
+    e = int(np.argmax(np.diff(ec.qp_offsets)))  # a tip cell, several columns
+    q = slice(ec.qp_offsets[e], ec.qp_offsets[e + 1])
+    n = q.stop - q.start
+    v = slice(ec.column_offsets[e], ec.column_offsets[e + 1])
+    S = ec.slot_node.shape[1]
+    empty = -np.ones((1, S), np.int64)
+    args = (
+        np.repeat(m.mesh.bounds[ec.cells[[e]]], 2, axis=0),
+        np.array([0, n, 2 * n], np.int64),
+        np.concatenate([ec.qp_xy[q]] * 2),
+        np.concatenate([ec.qp_w[q]] * 2),
+        np.array([0, v.stop - v.start, v.stop - v.start], np.int64),
+        ec.column_F[v],
+        ec.column_gradF[v],
+        np.concatenate([ec.slot_column[[e]], empty]),
+        np.concatenate([ec.slot_node[[e]], empty]),
+        np.concatenate([ec.slot_fnode[[e]], np.zeros((1, S))]),
+        m.D,
+    )
+    K, Bbar = kernels.backend("numpy").enriched_cell_matrices(*args)
+    K_ref, B_ref = kernels.backend("numba").enriched_cell_matrices(*args)
+    scale = np.abs(K_ref).max()
+    np.testing.assert_allclose(K, K_ref, rtol=0, atol=1e-13 * scale)
+    np.testing.assert_allclose(Bbar, B_ref, rtol=0, atol=1e-13 * np.abs(B_ref).max())
+    assert np.abs(K[0, 8:, 8:]).max() > 0.0
+    np.testing.assert_array_equal(K[1, 8:, :], 0.0)
+    np.testing.assert_allclose(K[1, :8, :8], K_ref[1, :8, :8], rtol=1e-13)
+
+
 @pytest.mark.parametrize("n_slots", [0, 2])
 def test_uncut_cell_without_slots_reproduces_the_q4(n_slots):
     """A cell integrated with the sub-cell machinery (two triangles, degree-5 rule,
