@@ -18,8 +18,9 @@ The peak resident memory of a run is modelled from the sizes that set it
   cells summed into the grid's CSR (GRID_BYTES per node), the COO triplets
   of the enriched cells' entries with their conversion to CSR
   (TRIPLET_BYTES per entry) and, on the NumPy kernels, the shape-function
-  gradients of all quadrature points at once (NUMPY_QP_FUNCTION_BYTES per
-  point and function, 4 + S functions);
+  gradients of a chunk's quadrature points (NUMPY_QP_FUNCTION_BYTES per
+  point and function, 4 + S functions; an upper bound, the kernel takes
+  them in smaller batches);
 - ``solver``: what the linear solver the run will take holds at once
   (xfemslip.solve.linear: planned_solver states the choice, solver_bytes
   the bytes of its matrices, factorizations -- with the Schur complement
