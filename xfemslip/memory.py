@@ -249,11 +249,11 @@ def enriched_footprint(spec: CaseSpec, mesh, fractures, cand) -> Footprint:
     inside = (ci >= 0) & (ci < nx) & (cj >= 0) & (cj < mesh.ny)
     cell = (cj * nx + ci)[inside]
     slots = np.bincount(cell, minlength=mesh.n_cells)
-    # the cells' columns: their distinct (fracture, tip, function) triples
+    # the cells' columns: their distinct (group, function) pairs, as
+    # enrichment.build_enriched_cells shares them
     k = np.nonzero(inside)[0]
     _, function = np.unique(
-        (cand.fracture[k] * (1 << 32) + (cand.tip[k] + (1 << 31))) * 8 + cand.func[k],
-        return_inverse=True,
+        cand.groups()[k] * 4 + cand.function_index()[k], return_inverse=True
     )
     width = int(function.max(initial=0)) + 1
     pairs = np.unique(cell * width + function.ravel())

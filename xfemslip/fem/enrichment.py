@@ -175,6 +175,17 @@ class Candidates:
     tip: np.ndarray  # (k,) int64 index in fracture.tips for branch functions,
     # else -1 - arm (Heaviside of that arm, geometry.Fracture.arms)
 
+    def groups(self) -> np.ndarray:
+        """(k,) int64: each candidate's group (its fracture and tip or arm) as
+        one number; a group's functions are evaluated together
+        (group_values)."""
+        return self.fracture * (1 << 32) + (self.tip + (1 << 31))
+
+    def function_index(self) -> np.ndarray:
+        """(k,) int64: the column of each candidate's function among its
+        group's values (H R: 0; B1..B4: 0..3)."""
+        return np.where(self.func == HEAVISIDE, 0, self.func - 1)
+
 
 @dataclass(frozen=True)
 class DofMap:
@@ -433,16 +444,11 @@ def build_enriched_cells(
     # that take the same function of the same group share a column
     nq_cell = np.diff(qp_off)
     nt_cell = np.diff(tri_off)
-    group = cand.fracture[k_used] * (1 << 32) + (cand.tip[k_used] + (1 << 31))
-    func = cand.func[k_used]
+    group = cand.groups()[k_used]
     _, group_rank = np.unique(group, return_inverse=True)
     width = 4 * (int(group_rank.max(initial=0)) + 1)
     # (cell, group, function index into the group's values) of every slot
-    key = (
-        e_used * width
-        + group_rank.ravel() * 4
-        + np.where(func == HEAVISIDE, 0, func - 1)
-    )
+    key = e_used * width + group_rank.ravel() * 4 + cand.function_index()[k_used]
     col_key, slot_key = np.unique(key, return_inverse=True)
     slot_key = slot_key.ravel()
     col_cell = col_key // width

@@ -121,18 +121,12 @@ def slot_values(group, count, column_offsets, column_F, column_gradF, slot_colum
     columns gathered, then given to their slots by a product with the 0/1
     column matrix (exact)."""
     col = slot_column[group]  # (g, S)
-    n_col = np.diff(column_offsets)[group] // count  # columns of each cell
-    C = int(n_col.max(initial=0))
-    if C == 0:
-        return np.zeros((group.size, count, col.shape[1])), np.zeros(
-            (group.size, count, col.shape[1], 2)
-        )
-    # a cell's columns past its last read its last one (any stored value:
-    # the 0/1 product drops them), within the array for a cell without any
-    c = np.minimum(np.arange(C), np.maximum(n_col - 1, 0)[:, None])  # (g, C)
+    C = int(col.max(initial=-1)) + 1  # the most columns of a cell
+    # a cell's C first columns; past its own, whatever is stored there (the
+    # 0/1 product drops it), within the array
     at = np.minimum(
         column_offsets[group][:, None, None]
-        + c[:, None, :] * count
+        + np.arange(C)[None, None, :] * count
         + np.arange(count)[None, :, None],
         column_F.size - 1,
     )  # (g, count, C)
@@ -148,51 +142,6 @@ def slot_values(group, count, column_offsets, column_F, column_gradF, slot_colum
 # mmap threshold (memory.MMAP_THRESHOLD), so batches reuse the same memory
 BATCH_CELLS = 256
 BATCH_POINTS = 4096
-
-
-def _add_rule_batch(blocks, bar, group, count, points, slots, d):
-    """K's blocks and Bbar of the cells ``group``, each with ``count``
-    points: sum_q w b_f b_g for the four (x|y, x|y) gradient pairs, combined
-    with D, and (1/A) sum_q w b_f.  points: (bounds, qp_offsets, qp_xy,
-    qp_w), slots: (column_offsets, column_F, column_gradF, slot_column,
-    slot_node, slot_fnode), as enriched_cell_matrices takes them."""
-    bounds, qp_offsets, qp_xy, qp_w = points
-    column_offsets, F, gF, slot_column, slot_node, slot_fnode = slots
-    at = qp_offsets[group][:, None] + np.arange(count)  # (g, count)
-    bx, by = function_gradients(
-        qp_xy[at],
-        bounds[group],
-        slot_node[group],
-        slot_fnode[group],
-        *slot_values(group, count, column_offsets, F, gF, slot_column),
-    )  # (g, count, nf)
-    w = qp_w[at][..., None]
-    wx, wy = bx * w, by * w
-    xx = np.matmul(wx.transpose(0, 2, 1), bx)  # (g, nf, nf)
-    xy = np.matmul(wx.transpose(0, 2, 1), by)
-    yx = np.matmul(wy.transpose(0, 2, 1), bx)
-    yy = np.matmul(wy.transpose(0, 2, 1), by)
-    blocks[group, :, 0, :, 0] = (
-        d[0, 0] * xx + d[0, 2] * xy + d[2, 0] * yx + d[2, 2] * yy
-    )
-    blocks[group, :, 0, :, 1] = (
-        d[0, 1] * xy + d[0, 2] * xx + d[2, 1] * yy + d[2, 2] * yx
-    )
-    blocks[group, :, 1, :, 0] = (
-        d[1, 0] * yx + d[1, 2] * yy + d[2, 0] * xx + d[2, 2] * xy
-    )
-    blocks[group, :, 1, :, 1] = (
-        d[1, 1] * yy + d[1, 2] * yx + d[2, 1] * xy + d[2, 2] * xx
-    )
-    # sums in point order (reduceat adds in sequence), as the Numba kernel
-    starts = np.arange(0, group.size * count, count)
-    sx = np.add.reduceat(wx.reshape(-1, wx.shape[2]), starts)  # (g, nf)
-    sy = np.add.reduceat(wy.reshape(-1, wy.shape[2]), starts)
-    area = np.add.reduceat(w.ravel(), starts)[:, None]
-    bar[group, 0, :, 0] = sx / area
-    bar[group, 1, :, 1] = sy / area
-    bar[group, 2, :, 0] = sy / area
-    bar[group, 2, :, 1] = sx / area
 
 
 def enriched_cell_matrices(
@@ -229,15 +178,55 @@ def enriched_cell_matrices(
         return K, Bbar
     blocks = K.reshape(nc, nf, 2, nf, 2)
     bar = Bbar.reshape(nc, 3, nf, 2)
-    points = (bounds, qp_offsets, qp_xy, qp_w)
-    slots = (column_offsets, column_F, column_gradF, slot_column)
-    slots += (slot_node, slot_fnode)
+    d = D
+
+    def add_batch(group, count):
+        """K's blocks and Bbar of the cells ``group``, each with ``count``
+        points: sum_q w b_f b_g for the four (x|y, x|y) gradient pairs,
+        combined with D, and (1/A) sum_q w b_f."""
+        at = qp_offsets[group][:, None] + np.arange(count)  # (g, count)
+        bx, by = function_gradients(
+            qp_xy[at],
+            bounds[group],
+            slot_node[group],
+            slot_fnode[group],
+            *slot_values(
+                group, count, column_offsets, column_F, column_gradF, slot_column
+            ),
+        )  # (g, count, nf)
+        w = qp_w[at][..., None]
+        wx, wy = bx * w, by * w
+        xx = np.matmul(wx.transpose(0, 2, 1), bx)  # (g, nf, nf)
+        xy = np.matmul(wx.transpose(0, 2, 1), by)
+        yx = np.matmul(wy.transpose(0, 2, 1), bx)
+        yy = np.matmul(wy.transpose(0, 2, 1), by)
+        blocks[group, :, 0, :, 0] = (
+            d[0, 0] * xx + d[0, 2] * xy + d[2, 0] * yx + d[2, 2] * yy
+        )
+        blocks[group, :, 0, :, 1] = (
+            d[0, 1] * xy + d[0, 2] * xx + d[2, 1] * yy + d[2, 2] * yx
+        )
+        blocks[group, :, 1, :, 0] = (
+            d[1, 0] * yx + d[1, 2] * yy + d[2, 0] * xx + d[2, 2] * xy
+        )
+        blocks[group, :, 1, :, 1] = (
+            d[1, 1] * yy + d[1, 2] * yx + d[2, 1] * xy + d[2, 2] * xx
+        )
+        # sums in point order (reduceat adds in sequence), as the Numba kernel
+        starts = np.arange(0, group.size * count, count)
+        sx = np.add.reduceat(wx.reshape(-1, nf), starts)  # (g, nf)
+        sy = np.add.reduceat(wy.reshape(-1, nf), starts)
+        area = np.add.reduceat(w.ravel(), starts)[:, None]
+        bar[group, 0, :, 0] = sx / area
+        bar[group, 1, :, 1] = sy / area
+        bar[group, 2, :, 0] = sy / area
+        bar[group, 2, :, 1] = sx / area
+
     for count in np.unique(counts[counts > 0]):
         same = np.nonzero(counts == count)[0]
         step = max(1, min(BATCH_CELLS, BATCH_POINTS // count))
         for lo in range(0, same.size, step):
-            group = same[lo : lo + step]
-            _add_rule_batch(blocks, bar, group, int(count), points, slots, D)
+            add_batch(same[lo : lo + step], int(count))
     return K, Bbar
 
 
