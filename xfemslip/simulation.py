@@ -293,6 +293,7 @@ def build_model(spec: CaseSpec) -> Model:
         * mesh.h_min
         / mat.E,
         node_xy=mesh.nodes,
+        dof_node=bulk.dofmap.dof_node(cand.node),
         load_stress=stress_increment(spec.loading),
         load_pieces=pieces,
     )

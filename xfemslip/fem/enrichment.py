@@ -198,6 +198,18 @@ class DofMap:
         """Kept (node, function) enrichments, each with 2 dofs."""
         return int(np.count_nonzero(self.cand_dof >= 0))
 
+    def dof_node(self, cand_node: np.ndarray) -> np.ndarray:
+        """(n_dofs,) the node each dof belongs to: node d // 2 for a
+        standard dof d, the enriched node (cand_node, Candidates.node) for
+        the two dofs of a kept enrichment."""
+        node = np.empty(self.n_dofs, np.int64)
+        node[: self.n_std] = np.arange(self.n_std) // 2
+        kept = self.cand_dof >= 0
+        first = self.cand_dof[kept]
+        node[first] = cand_node[kept]
+        node[first + 1] = cand_node[kept]
+        return node
+
 
 def find_candidates(mesh, fractures) -> Candidates:
     """Heaviside candidates on the nodes of cut cells; branch candidates within

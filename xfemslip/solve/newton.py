@@ -93,6 +93,10 @@ class Problem:
     penalty_ratio: float = 0.0
     # (n_nodes, 2) node coordinates: rigid-body modes of the AMG linear solver
     node_xy: np.ndarray | None = None
+    # (n_dofs,) the node of each dof (an enriched dof's: the node it
+    # enriches): SuperLU's elimination order is a nested dissection of the
+    # grid (xfemslip.solve.ordering); None: SuperLU's minimum degree
+    dof_node: np.ndarray | None = None
     # far-field stress (xx, yy, xy) [Pa] added from load factor 0 to 1
     # (predictor.stress_increment), or None: only used to guess the stick/slip
     # set of a step (predictor.py)
@@ -178,6 +182,7 @@ class NewtonSolver:
             kernels=c.kernels,
             contact_coef=c.coef,
             contact_stick=stick_tangents(c.weight, c.kn, c.kt, c.normal, c.tangent),
+            dof_node=None if problem.dof_node is None else problem.dof_node[self.free],
         )
         # tangent blocks of the contact evaluations whose tangent is never
         # used (_scratch_blocks)
