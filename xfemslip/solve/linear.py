@@ -60,8 +60,8 @@ them; PARDISO's own machinery is in pardiso.py.
   failure sends the run to SuperLU (warning, stats["pardiso_fallbacks"]).
 - ``"auto"`` (default): ``"pardiso"`` from AUTO_PARDISO_MIN_DOFS free dofs
   when the mkl extra is installed; otherwise ``"superlu"`` in the grid's
-  order below AUTO_GRID_LU_MAX_DOFS free dofs where that order applies,
-  ``"amg"`` from AUTO_AMG_MIN_DOFS free dofs up on
+  order below AUTO_GRID_LU_MAX_DOFS free dofs with few enriched
+  (AUTO_GRID_LU_MAX_ENRICHED), ``"amg"`` from AUTO_AMG_MIN_DOFS free dofs up on
   meshes with cell aspect ratios up to AUTO_AMG_MAX_ASPECT whose AMG band
   (the enriched dofs and AMG_BAND_LAYERS matrix neighbours: what the band LU
   of every Newton system factors) holds at most AUTO_AMG_MAX_BAND of the
@@ -157,13 +157,19 @@ AUTO_AMG_MAX_BAND = 0.65
 # the shipped cases of 6k-29k dofs with 2-11 % enriched within 0.03-0.9 s
 # either way.
 GRID_ORDER_MAX_ENRICHED = 0.10
-# "auto" takes SuperLU in that order below this many free dofs, where AMG
-# would otherwise start (AUTO_AMG_MIN_DOFS).  Whole `xfemslip run`
-# processes of the reservoir case, 3 each alternated: 2.12-2.43 against
-# 2.81-3.00 s with AMG at 200 x 200 cells (83k dofs), 3.51-5.02 against
-# 4.86-5.92 s at 283 x 283 (163k), 6.59-7.34 against 6.95-8.73 s at
-# 400 x 400 (322k), where SuperLU held 1.2 GB against AMG's 0.63 GB.
-AUTO_GRID_LU_MAX_DOFS = 250_000
+# "auto" takes SuperLU in that order, where AMG would otherwise start
+# (AUTO_AMG_MIN_DOFS), below this many free dofs when at most
+# AUTO_GRID_LU_MAX_ENRICHED of them are enriched.  Whole `xfemslip run`
+# processes without the mkl extra, alternated (benchmarks/grid_order.py,
+# docs/performance/grid_order.md): the reservoir case (1-3 % enriched) at
+# 200 x 200 cells (83k dofs) 1.98 against 2.29 s with AMG (medians of 5),
+# at 283 x 283 (164k) 4.15 against 4.20 s and at 400 x 400 (324k) 7.74
+# against 8.27 s (medians of 3, SuperLU holding twice AMG's memory); a
+# network of 10 fractures on 200 x 200 cells (88k dofs, 8.4 % enriched)
+# 5.38 against 4.57 s: its Newton systems after the first solve a band of
+# 12 layers around the enriched dofs exactly, AMG's path 3.
+AUTO_GRID_LU_MAX_DOFS = 120_000
+AUTO_GRID_LU_MAX_ENRICHED = 0.05
 # Relative residual ||A x - b|| / ||b|| at which the Krylov solves stop.
 KRYLOV_RTOL = 1.0e-10
 # GMRES iterations with a kept factorization tried before refactoring, and
@@ -309,12 +315,13 @@ def auto_choice(
     enriched_share: float | None = None,
 ) -> str:
     """The strategy "auto" stands for: "pardiso" from AUTO_PARDISO_MIN_DOFS
-    free dofs when the mkl extra is installed; else "superlu" below
-    AUTO_GRID_LU_MAX_DOFS free dofs when it takes the grid's order
-    (grid_order_applies); else "amg" from AUTO_AMG_MIN_DOFS free dofs on
-    meshes with cells up to AUTO_AMG_MAX_ASPECT : 1 whose AMG band (the
-    enriched dofs and AMG_BAND_LAYERS matrix neighbours, system_facts)
-    holds at most AUTO_AMG_MAX_BAND of the free dofs; "superlu" otherwise.
+    free dofs when the mkl extra is installed; else "superlu" (in the
+    grid's order) below AUTO_GRID_LU_MAX_DOFS free dofs with at most
+    AUTO_GRID_LU_MAX_ENRICHED of them enriched; else "amg" from
+    AUTO_AMG_MIN_DOFS free dofs on meshes with cells up to
+    AUTO_AMG_MAX_ASPECT : 1 whose AMG band (the enriched dofs and
+    AMG_BAND_LAYERS matrix neighbours, system_facts) holds at most
+    AUTO_AMG_MAX_BAND of the free dofs; "superlu" otherwise.
 
     aspect() gives the mesh's largest cell aspect ratio (None: the mesh is
     not known, no AMG), band_share() the share of the free dofs in the AMG
@@ -323,7 +330,11 @@ def auto_choice(
     is enriched (None: not known)."""
     if n_free >= AUTO_PARDISO_MIN_DOFS and pardiso.available():
         return "pardiso"
-    if n_free < AUTO_GRID_LU_MAX_DOFS and grid_order_applies(enriched_share):
+    if (
+        n_free < AUTO_GRID_LU_MAX_DOFS
+        and enriched_share is not None
+        and enriched_share <= min(AUTO_GRID_LU_MAX_ENRICHED, GRID_ORDER_MAX_ENRICHED)
+    ):
         return "superlu"
     if (
         n_free >= AUTO_AMG_MIN_DOFS
@@ -772,7 +783,7 @@ class LinearSolver:
                 self.method,
                 n,
                 AUTO_AMG_MIN_DOFS
-                if not grid_order_applies(self.enriched_share)
+                if self.method != "superlu" or n < AUTO_AMG_MIN_DOFS
                 else AUTO_GRID_LU_MAX_DOFS,
             )
         else:

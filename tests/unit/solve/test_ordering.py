@@ -176,13 +176,13 @@ def test_a_run_gives_the_same_answer_in_either_order(monkeypatch):
     assert np.max(np.abs(gt1 - gt2)) <= 1e-9 * np.max(np.abs(gt1))
 
 
-def test_auto_takes_superlu_in_the_grid_order_below_its_limit(monkeypatch):
+def test_auto_takes_superlu_in_the_grid_order_below_its_limits(monkeypatch):
     monkeypatch.setattr(linsolve.pardiso, "available", lambda: False)
     xy = _xy(10, 10)
-    top, small = linsolve.AUTO_GRID_LU_MAX_DOFS, linsolve.GRID_ORDER_MAX_ENRICHED
+    top, few = linsolve.AUTO_GRID_LU_MAX_DOFS, linsolve.AUTO_GRID_LU_MAX_ENRICHED
     assert linsolve.AUTO_AMG_MIN_DOFS < top
-    assert choose("auto", top - 1, xy, 0.0, small) == "superlu"
-    assert choose("auto", top, xy, 0.0, small) == "amg"
-    crowded = np.nextafter(small, 1.0)
-    assert choose("auto", top - 1, xy, 0.0, crowded) == "amg"
+    assert few <= linsolve.GRID_ORDER_MAX_ENRICHED  # the order applies
+    assert choose("auto", top - 1, xy, 0.0, few) == "superlu"
+    assert choose("auto", top, xy, 0.0, few) == "amg"
+    assert choose("auto", top - 1, xy, 0.0, np.nextafter(few, 1.0)) == "amg"
     assert choose("auto", top - 1, xy, 0.0, None) == "amg"  # not known
