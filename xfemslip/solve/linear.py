@@ -308,6 +308,17 @@ def grid_order_applies(enriched_share: float | None) -> bool:
     return enriched_share is not None and enriched_share <= GRID_ORDER_MAX_ENRICHED
 
 
+def grid_lu_preferred(n_free: int, enriched_share: float | None) -> bool:
+    """Whether "auto" takes SuperLU in the grid's order whatever the AMG
+    rule says: below AUTO_GRID_LU_MAX_DOFS free dofs with at most
+    AUTO_GRID_LU_MAX_ENRICHED of them enriched."""
+    return (
+        n_free < AUTO_GRID_LU_MAX_DOFS
+        and enriched_share is not None
+        and enriched_share <= min(AUTO_GRID_LU_MAX_ENRICHED, GRID_ORDER_MAX_ENRICHED)
+    )
+
+
 def auto_choice(
     n_free: int,
     aspect: Callable[[], float] | None,
@@ -330,11 +341,7 @@ def auto_choice(
     is enriched (None: not known)."""
     if n_free >= AUTO_PARDISO_MIN_DOFS and pardiso.available():
         return "pardiso"
-    if (
-        n_free < AUTO_GRID_LU_MAX_DOFS
-        and enriched_share is not None
-        and enriched_share <= min(AUTO_GRID_LU_MAX_ENRICHED, GRID_ORDER_MAX_ENRICHED)
-    ):
+    if grid_lu_preferred(n_free, enriched_share):
         return "superlu"
     if (
         n_free >= AUTO_AMG_MIN_DOFS
@@ -777,14 +784,26 @@ class LinearSolver:
                 cell_aspect_ratio(node_xy),
                 AUTO_AMG_MAX_ASPECT,
             )
+        elif (
+            method == "auto"
+            and n >= AUTO_AMG_MIN_DOFS
+            and grid_lu_preferred(n, self.enriched_share)
+        ):
+            logger.debug(
+                "linear solver: superlu (auto: %d free dofs, %.1f %% enriched: "
+                "SuperLU in the grid's order below %d free dofs with at most "
+                "%.0f %% enriched)",
+                n,
+                100.0 * self.enriched_share,
+                AUTO_GRID_LU_MAX_DOFS,
+                100.0 * AUTO_GRID_LU_MAX_ENRICHED,
+            )
         elif method == "auto":
             logger.debug(
                 "linear solver: %s (auto: %d free dofs, AMG from %d)",
                 self.method,
                 n,
-                AUTO_AMG_MIN_DOFS
-                if self.method != "superlu" or n < AUTO_AMG_MIN_DOFS
-                else AUTO_GRID_LU_MAX_DOFS,
+                AUTO_AMG_MIN_DOFS,
             )
         else:
             logger.debug("linear solver: %s (%d free dofs)", self.method, n)

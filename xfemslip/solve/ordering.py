@@ -11,11 +11,13 @@ Numer. Anal. 10, 345-363) the factor of a 2-D grid has O(n log n) entries
 and costs O(n^1.5) operations, the best an ordering can do there.  SuperLU's
 own choice, minimum degree on A^T + A, knows nothing of the grid; measured
 on the uncracked 200 x 200 stiffness (81k dofs, one BLAS thread): 17.3M
-entries in L + U and 1.18-1.57 s against 12.3M and 0.52 s in this order
-(MKL PARDISO's SPD factor-and-solve: 0.44 s on two threads); at 400 x 400
-(321k dofs) 96.8M entries and 10.2 s against 58.4M and 3.7 s.  Contact
-patches couple nodes a cell or two apart along a fracture, across a
-separator now and then: the order stays valid, with a little more fill.
+entries in L + U and 1.18-1.57 s against 12.3M and 0.52-0.83 s in this
+order (MKL PARDISO's SPD factor-and-solve: 0.44 s on two threads); at
+400 x 400 (321k dofs) 96.8M entries and 10.2 s against 58.4M and 3.7 s.
+Contact patches couple nodes along a fracture across a separator, and
+enriched nodes carry more dofs on its lines: the order stays valid, but
+where many dofs are enriched (networks) minimum degree does better, so
+the solver takes this order only with few (linear.GRID_ORDER_MAX_ENRICHED).
 """
 
 from __future__ import annotations
@@ -38,9 +40,10 @@ def grid_dissection(nx: int, ny: int, leaf: int = LEAF) -> np.ndarray:
     if nx < 0 or ny < 0 or leaf < 1:
         raise ValueError(f"grid_dissection: nx, ny >= 0, leaf >= 1: {nx, ny, leaf}")
     boxes = []  # (i0, i1, j0, j1) inclusive, in elimination order
-    # an explicit stack: a box is pushed back, marked, below its halves, so
-    # its line comes after them (Python calls per box took 2 s at 1000 x
-    # 1000 cells, the boxes themselves made as arrays)
+    # an explicit stack of box tuples, a box's line pushed below its halves
+    # so that it comes after them; the nodes of all boxes are made in one
+    # pass below (a recursion making each box's nodes as arrays took 2 s at
+    # 1000 x 1000 cells, this 0.2 s)
     stack = [(0, nx, 0, ny, False)]
     while stack:
         i0, i1, j0, j1, line = stack.pop()
