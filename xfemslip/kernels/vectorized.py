@@ -178,7 +178,6 @@ def enriched_cell_matrices(
         return K, Bbar
     blocks = K.reshape(nc, nf, 2, nf, 2)
     bar = Bbar.reshape(nc, 3, nf, 2)
-    d = D
 
     def add_batch(group, count):
         """K's blocks and Bbar of the cells ``group``, each with ``count``
@@ -201,16 +200,16 @@ def enriched_cell_matrices(
         yx = np.matmul(wy.transpose(0, 2, 1), bx)
         yy = np.matmul(wy.transpose(0, 2, 1), by)
         blocks[group, :, 0, :, 0] = (
-            d[0, 0] * xx + d[0, 2] * xy + d[2, 0] * yx + d[2, 2] * yy
+            D[0, 0] * xx + D[0, 2] * xy + D[2, 0] * yx + D[2, 2] * yy
         )
         blocks[group, :, 0, :, 1] = (
-            d[0, 1] * xy + d[0, 2] * xx + d[2, 1] * yy + d[2, 2] * yx
+            D[0, 1] * xy + D[0, 2] * xx + D[2, 1] * yy + D[2, 2] * yx
         )
         blocks[group, :, 1, :, 0] = (
-            d[1, 0] * yx + d[1, 2] * yy + d[2, 0] * xx + d[2, 2] * xy
+            D[1, 0] * yx + D[1, 2] * yy + D[2, 0] * xx + D[2, 2] * xy
         )
         blocks[group, :, 1, :, 1] = (
-            d[1, 1] * yy + d[1, 2] * yx + d[2, 1] * xy + d[2, 2] * xx
+            D[1, 1] * yy + D[1, 2] * yx + D[2, 1] * xy + D[2, 2] * xx
         )
         # sums in point order (reduceat adds in sequence), as the Numba kernel
         starts = np.arange(0, group.size * count, count)

@@ -311,11 +311,12 @@ def grid_order_applies(enriched_share: float | None) -> bool:
 def grid_lu_preferred(n_free: int, enriched_share: float | None) -> bool:
     """Whether "auto" takes SuperLU in the grid's order whatever the AMG
     rule says: below AUTO_GRID_LU_MAX_DOFS free dofs with at most
-    AUTO_GRID_LU_MAX_ENRICHED of them enriched."""
+    AUTO_GRID_LU_MAX_ENRICHED of them enriched (below
+    GRID_ORDER_MAX_ENRICHED, so the order applies)."""
     return (
         n_free < AUTO_GRID_LU_MAX_DOFS
         and enriched_share is not None
-        and enriched_share <= min(AUTO_GRID_LU_MAX_ENRICHED, GRID_ORDER_MAX_ENRICHED)
+        and enriched_share <= AUTO_GRID_LU_MAX_ENRICHED
     )
 
 
@@ -499,8 +500,6 @@ class OrderedLU:
         self.lu = _splu(
             ordering.permuted(A, self.order), dict(settings, permc_spec="NATURAL")
         )
-        self.shape = self.lu.shape
-        self.nnz = self.lu.nnz
 
     def solve(self, b):
         x = np.empty(np.shape(b))
@@ -822,13 +821,8 @@ class LinearSolver:
         """SuperLU's order of the free dofs for the whole matrix: the nested
         dissection of the grid (ordering.py) where it applies
         (grid_order_applies), made once; None: SuperLU's minimum degree
-        (also without dof_node or node_xy)."""
-        if (
-            self._order is None
-            and self.dof_node is not None
-            and self.node_xy is not None
-            and grid_order_applies(self.enriched_share)
-        ):
+        (also without dof_node or node_xy: no enriched share then)."""
+        if self._order is None and grid_order_applies(self.enriched_share):
             self._order = ordering.grid_order(self.dof_node, self.node_xy)
         return self._order
 
