@@ -1,6 +1,10 @@
-"""The AMG hierarchy (xfemslip.solve.amg): pyamg's smoothed aggregation with
-the spectral radius of its prolongation smoother from Lanczos, against a
-dense eigenvalue solve, pyamg's own hierarchy and a direct solve."""
+"""The multigrid hierarchies (xfemslip.solve.amg): the grid's geometric one
+(its interpolation against linear fields, its coarse dofs against the fixed
+ones, as a preconditioner against a direct solve and against smoothed
+aggregation, on uniform, graded and layered grids), and pyamg's smoothed
+aggregation with the spectral radius of its prolongation smoother from
+Lanczos, against a dense eigenvalue solve, pyamg's own hierarchy and a
+direct solve."""
 
 from __future__ import annotations
 
@@ -14,29 +18,45 @@ import scipy.sparse.linalg as spla
 
 from xfemslip.case import build, loads_case
 from xfemslip.simulation import build_model
-from xfemslip.solve.amg import jacobi_spectral_radius, smoothed_aggregation
+from xfemslip.solve.amg import (
+    geometric,
+    grid_interpolation,
+    jacobi_spectral_radius,
+    smoothed_aggregation,
+)
 from xfemslip.solve.linear import rigid_body_modes
 
 pyamg = pytest.importorskip("pyamg")
 
-CASE = Path(__file__).resolve().parents[3] / "cases" / "reservoir_depletion.toml"
+ROOT = Path(__file__).resolve().parents[3]
+CASE = ROOT / "cases" / "reservoir_depletion.toml"
+# graded cells (10 m growing by 1.2 to 100 m) and three rock units
+FIELD = ROOT / "cases" / "field_section.toml"
 # coarsest level of the hierarchies here: 3 levels on the 40 x 40 mesh, the
 # coarse ones in 3 x 3 blocks (nodes) as on the large meshes of the AMG path
 COARSE = 50
 
 
+def _problem(case=CASE, **keys):
+    """K on the free standard dofs of the case (uncracked where the case
+    allows; a fracture enriches other dofs), those dofs and the node
+    coordinates."""
+    table = build.file_case(case, **keys)
+    if case == CASE:
+        table = build.with_keys(table, fractures=None)
+    problem = build_model(loads_case(build.case_text(table), case)).problem
+    free = np.zeros(problem.n_dofs, bool)
+    free[: 2 * problem.node_xy.shape[0]] = True
+    free[problem.fixed] = False
+    dof = np.nonzero(free)[0]
+    return problem.K[dof][:, dof].tocsr(), dof, problem.node_xy
+
+
 def _elasticity(n):
     """K of the uncracked reservoir case on n x n cells on its free dofs,
     and the rigid-body modes of those dofs."""
-    text = build.case_text(
-        build.file_case(CASE, **{"mesh.elements": [n, n], "fractures": None})
-    )
-    problem = build_model(loads_case(text, CASE)).problem
-    free = np.ones(problem.n_dofs, bool)
-    free[problem.fixed] = False
-    dof = np.nonzero(free)[0]
-    K = problem.K[dof][:, dof].tocsr()
-    return K, rigid_body_modes(problem.node_xy[dof // 2], dof % 2)
+    K, dof, xy = _problem(**{"mesh.elements": [n, n]})
+    return K, rigid_body_modes(xy[dof // 2], dof % 2)
 
 
 @pytest.fixture(scope="module")
@@ -110,3 +130,108 @@ def test_the_hierarchy_does_not_depend_on_numpys_random_state(elasticity):
         np.random.set_state(state)  # noqa: NPY002
     for la, lb in zip(a.levels[:-1], b.levels[:-1], strict=True):
         assert (la.P != lb.P).nnz == 0
+
+
+# ------------------------------------------------------------ geometric
+
+
+@pytest.mark.parametrize("m", [1, 2, 5, 8], ids=lambda m: f"{m}-cells")
+def test_grid_interpolation_is_linear_between_the_coarse_nodes(m):
+    """Every other node and the last are the coarse grid; the interpolation
+    is the identity on them and reproduces a linear function exactly on
+    a graded grid (weights by the coordinates), each row summing to 1."""
+    x = np.cumsum(np.r_[0.0, 1.3 ** np.arange(m)])
+    keep, P = grid_interpolation(x)
+    want = list(range(0, m + 1, 2))
+    assert keep.tolist() == (want if want[-1] == m else [*want, m])
+    assert P.shape == (m + 1, keep.size)
+    np.testing.assert_allclose(P[keep].toarray(), np.eye(keep.size))
+    np.testing.assert_allclose(P @ (2.0 - 3.0 * x[keep]), 2.0 - 3.0 * x, rtol=1e-14)
+    np.testing.assert_allclose(P.sum(axis=1).A1, 1.0, rtol=1e-14)
+
+
+def test_the_coarse_grids_leave_out_the_fixed_dofs():
+    """On 11 x 7 cells (odd in both directions): the first coarse level is
+    the nodes of every other grid line and the last, with both components
+    except where the fine dof is fixed (u_y along the bottom, the pinned
+    u_x); it interpolates a linear displacement field exactly wherever its
+    stencil holds no fixed dof."""
+    K, dof, xy = _problem(**{"mesh.elements": [11, 7]})
+    ml = geometric(K, xy, dof, max_coarse=4)
+    assert ml is not None and len(ml.levels) >= 3
+    P = ml.levels[0].P
+    xs, ys = np.unique(xy[:, 0]), np.unique(xy[:, 1])
+    coarse = [(i, j) for j in (0, 2, 4, 6, 7) for i in (0, 2, 4, 6, 8, 10, 11)]
+    fixed = set(range(2 * xy.shape[0])) - set(dof.tolist())
+    node = {(float(x), float(y)): k for k, (x, y) in enumerate(xy)}
+    want = [
+        2 * node[(float(xs[i]), float(ys[j]))] + c
+        for i, j in coarse
+        for c in (0, 1)
+        if 2 * node[(float(xs[i]), float(ys[j]))] + c not in fixed
+    ]
+    assert P.shape == (dof.size, len(want))
+    # the coarse dofs in the order of their fine dofs on the grid
+    order = sorted(want, key=lambda d: (xy[d // 2, 1], xy[d // 2, 0], d % 2))
+    cx, cy = xy[np.array(order) // 2].T
+    comp = np.array(order) % 2
+    u_c = np.where(comp == 0, 1.0 + 2.0 * cx - cy, -0.5 + cx + 3.0 * cy)
+    fx, fy = xy[dof // 2].T
+    u_f = np.where(dof % 2 == 0, 1.0 + 2.0 * fx - fy, -0.5 + fx + 3.0 * fy)
+    full = np.abs(P).sum(axis=1).A1
+    rows = np.isclose(P.sum(axis=1).A1, 1.0) & np.isclose(full, 1.0)
+    assert rows.mean() > 0.8
+    np.testing.assert_allclose((P @ u_c)[rows], u_f[rows], rtol=1e-12, atol=1e-12)
+
+
+def test_nodes_that_are_not_a_whole_grid_have_no_geometric_hierarchy():
+    """A node missing from the grid, or one off its lines: None (the AMG
+    path then takes smoothed aggregation)."""
+    K, dof, xy = _problem(**{"mesh.elements": [6, 6]})
+    assert geometric(K, xy, dof, 4) is not None
+    moved = xy.copy()
+    moved[10, 0] += 1e-3
+    assert geometric(K, moved, dof, 4) is None
+    assert geometric(K, xy[:-1], dof, 4) is None
+
+
+@pytest.mark.parametrize(
+    ("case", "keys"),
+    [
+        (CASE, {"mesh.elements": [40, 40]}),
+        (CASE, {"mesh.elements": [33, 47]}),
+        (FIELD, {"mesh.size": 25.0, "mesh.max_size": 200.0}),
+    ],
+    ids=["uniform", "odd", "graded-layered"],
+)
+def test_geometric_preconditioner_is_the_direct_solve(case, keys):
+    """CG with one geometric V-cycle per step, to a relative residual of
+    1e-10, gives the direct solution to 1e-8 on a uniform grid, one with
+    odd cell counts, and the field section's graded grid with three rock
+    units; in at most one iteration more than smoothed aggregation needs
+    (measured: 11 against 14, 14 against 15 and 26 against 27)."""
+    K, dof, xy = _problem(case, **keys)
+    b = np.random.default_rng(3).random(K.shape[0])
+    direct = spla.spsolve(K.tocsc(), b)
+    its = {}
+    for name, ml in (
+        ("geometric", geometric(K, xy, dof, COARSE)),
+        (
+            "aggregation",
+            smoothed_aggregation(K, rigid_body_modes(xy[dof // 2], dof % 2), COARSE),
+        ),
+    ):
+        count = [0]
+        x, info = spla.cg(
+            K,
+            b,
+            M=ml.aspreconditioner(cycle="V"),
+            rtol=1e-10,
+            atol=0.0,
+            maxiter=300,
+            callback=lambda _, c=count: c.__setitem__(0, c[0] + 1),
+        )
+        assert info == 0
+        assert np.abs(x - direct).max() <= 1e-8 * np.abs(direct).max()
+        its[name] = count[0]
+    assert its["geometric"] <= its["aggregation"] + 1
