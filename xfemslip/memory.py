@@ -213,7 +213,7 @@ def case_footprint(spec: CaseSpec) -> Footprint:
         n_cells=n_cells,
         n_dofs=n_dofs,
         # the band of the enriched dofs is not known yet: AMG if large enough
-        linear=_linear(spec, spec.mesh.x, spec.mesh.y, n_dofs, 2 * n_nodes),
+        linear=_linear(spec, spec.mesh.x, spec.mesh.y, n_dofs),
         nnz=NNZ_PER_ENTRY * entries + 20.0 * (n_dofs - 2 * n_nodes),
         steps=spec.loading.steps,
         entries=entries,
@@ -284,7 +284,6 @@ def enriched_footprint(spec: CaseSpec, mesh, fractures, cand) -> Footprint:
             mesh.x,
             mesh.y,
             n_dofs,
-            2 * mesh.n_nodes,
             lambda: _band_share(mesh, cand, n_dofs),
         ),
         nnz=NNZ_PER_ENTRY * entries,
@@ -329,7 +328,6 @@ def model_footprint(model) -> Footprint:
             model.mesh.x,
             model.mesh.y,
             p.n_dofs,
-            2 * model.mesh.n_nodes,
             lambda: _problem_band_share(p),
         ),
         nnz=float(model.problem.K.nnz),
@@ -403,21 +401,13 @@ def configure_allocator() -> bool:
     return True
 
 
-def _linear(spec: CaseSpec, x, y, n_dofs, n_std, band_share=None) -> str:
+def _linear(spec: CaseSpec, x, y, n_dofs, band_share=None) -> str:
     """The linear solver the run will take (linsolve.planned_solver) on a
-    mesh with grid lines x, y and about n_dofs free dofs, n_std of them
-    standard; ``band_share()`` gives the share of them in the AMG band
-    (None: not known yet)."""
+    mesh with grid lines x, y and about n_dofs free dofs; ``band_share()``
+    gives the share of them in the AMG band (None: not known yet)."""
     from xfemslip.solve.linear import planned_solver
 
-    return planned_solver(
-        spec.solver.linear_solver,
-        n_dofs,
-        x,
-        y,
-        band_share,
-        enriched_share=(n_dofs - n_std) / max(n_dofs, 1),
-    )
+    return planned_solver(spec.solver.linear_solver, n_dofs, x, y, band_share)
 
 
 def _problem_band_share(problem) -> float:

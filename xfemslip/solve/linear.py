@@ -36,12 +36,15 @@ them; PARDISO's own machinery is in pardiso.py.
   GMRES preconditioned with the kept factorization alone, within that rank
   bound (KEPT_GMRES_MAX); a larger change is refactored.
 - ``"amg"``: GMRES preconditioned with the same Schwarz sweep: one
-  smoothed-aggregation AMG V-cycle (pyamg, rigid-body modes as near-nullspace)
-  on the standard dofs in place of the back-solve, then the exact band solve,
-  which carries the enrichment and the stiff, non-symmetric contact coupling
-  (a second V-cycle after it saves iterations but not time: 28 against 42
-  iterations, 2.0 against 1.5 s CPU at 200 x 200).  The
-  AMG hierarchy is built once per run (the standard block is part of K_ff);
+  multigrid V-cycle on the standard dofs in place of the back-solve (the
+  grid's own coarse grids, xfemslip.solve.amg; smoothed aggregation with
+  the rigid-body modes where the nodes are not a whole rectilinear grid),
+  then the exact band solve, which carries the enrichment and the stiff,
+  non-symmetric contact coupling (a second V-cycle after it saves
+  iterations but not time: 28 against 42 iterations, 2.0 against 1.5 s
+  CPU at 200 x 200 with smoothed aggregation; 21 against 23 iterations,
+  5.6 against 3.6 s at 400 x 400 with the grid's).  The
+  multigrid hierarchy is built once per run (the standard block is part of K_ff);
   only the small band is refactored per Newton system.  A system without
   enriched dofs is solved by AMG-preconditioned CG.
   If the Krylov solve does not converge, that system and the rest of the run
@@ -59,14 +62,12 @@ them; PARDISO's own machinery is in pardiso.py.
   jumps, and per contact tangent a dense LU of its low-rank change.  A PARDISO
   failure sends the run to SuperLU (warning, stats["pardiso_fallbacks"]).
 - ``"auto"`` (default): ``"pardiso"`` from AUTO_PARDISO_MIN_DOFS free dofs
-  when the mkl extra is installed; otherwise ``"superlu"`` in the grid's
-  order below AUTO_GRID_LU_MAX_DOFS free dofs with few enriched
-  (AUTO_GRID_LU_MAX_ENRICHED), ``"amg"`` from AUTO_AMG_MIN_DOFS free dofs up on
-  meshes with cell aspect ratios up to AUTO_AMG_MAX_ASPECT whose AMG band
-  (the enriched dofs and AMG_BAND_LAYERS matrix neighbours: what the band LU
-  of every Newton system factors) holds at most AUTO_AMG_MAX_BAND of the
-  free dofs (pyamg installed, node coordinates known), ``"superlu"``
-  otherwise.  All three inputs are known before the first solve
+  when the mkl extra is installed; otherwise ``"amg"`` from AUTO_AMG_MIN_DOFS
+  free dofs up on meshes with cell aspect ratios up to AUTO_AMG_MAX_ASPECT
+  whose AMG band (the enriched dofs and AMG_BAND_LAYERS matrix neighbours:
+  what the band LU of every Newton system factors) holds at most
+  AUTO_AMG_MAX_BAND of the free dofs (pyamg installed, node coordinates
+  known), ``"superlu"`` otherwise.  All three inputs are known before the first solve
   (system_facts); the choice is logged at debug level.
 
 Why SuperLU refactors a single fracture's matrix instead of a low-rank
@@ -157,19 +158,6 @@ AUTO_AMG_MAX_BAND = 0.65
 # the shipped cases of 6k-29k dofs with 2-11 % enriched within 0.03-0.9 s
 # either way.
 GRID_ORDER_MAX_ENRICHED = 0.10
-# "auto" takes SuperLU in that order, where AMG would otherwise start
-# (AUTO_AMG_MIN_DOFS), below this many free dofs when at most
-# AUTO_GRID_LU_MAX_ENRICHED of them are enriched.  Whole `xfemslip run`
-# processes without the mkl extra, alternated (benchmarks/grid_order.py,
-# docs/performance/grid_order.md): the reservoir case (1-3 % enriched) at
-# 200 x 200 cells (83k dofs) 1.98 against 2.29 s with AMG (medians of 5),
-# at 283 x 283 (164k) 4.15 against 4.20 s and at 400 x 400 (324k) 7.74
-# against 8.27 s (medians of 3, SuperLU holding twice AMG's memory); a
-# network of 10 fractures on 200 x 200 cells (88k dofs, 8.4 % enriched)
-# 5.38 against 4.57 s: its Newton systems after the first solve a band of
-# 12 layers around the enriched dofs exactly, AMG's path 3.
-AUTO_GRID_LU_MAX_DOFS = 120_000
-AUTO_GRID_LU_MAX_ENRICHED = 0.05
 # Relative residual ||A x - b|| / ||b|| at which the Krylov solves stop.
 KRYLOV_RTOL = 1.0e-10
 # GMRES iterations with a kept factorization tried before refactoring, and
@@ -308,28 +296,13 @@ def grid_order_applies(enriched_share: float | None) -> bool:
     return enriched_share is not None and enriched_share <= GRID_ORDER_MAX_ENRICHED
 
 
-def grid_lu_preferred(n_free: int, enriched_share: float | None) -> bool:
-    """Whether "auto" takes SuperLU in the grid's order whatever the AMG
-    rule says: below AUTO_GRID_LU_MAX_DOFS free dofs with at most
-    AUTO_GRID_LU_MAX_ENRICHED of them enriched (below
-    GRID_ORDER_MAX_ENRICHED, so the order applies)."""
-    return (
-        n_free < AUTO_GRID_LU_MAX_DOFS
-        and enriched_share is not None
-        and enriched_share <= AUTO_GRID_LU_MAX_ENRICHED
-    )
-
-
 def auto_choice(
     n_free: int,
     aspect: Callable[[], float] | None,
     band_share: Callable[[], float],
-    enriched_share: float | None = None,
 ) -> str:
     """The strategy "auto" stands for: "pardiso" from AUTO_PARDISO_MIN_DOFS
-    free dofs when the mkl extra is installed; else "superlu" (in the
-    grid's order) below AUTO_GRID_LU_MAX_DOFS free dofs with at most
-    AUTO_GRID_LU_MAX_ENRICHED of them enriched; else "amg" from
+    free dofs when the mkl extra is installed; else "amg" from
     AUTO_AMG_MIN_DOFS free dofs on meshes with cells up to
     AUTO_AMG_MAX_ASPECT : 1 whose AMG band (the enriched dofs and
     AMG_BAND_LAYERS matrix neighbours, system_facts) holds at most
@@ -338,12 +311,9 @@ def auto_choice(
     aspect() gives the mesh's largest cell aspect ratio (None: the mesh is
     not known, no AMG), band_share() the share of the free dofs in the AMG
     band; each is called only when it decides (the band costs a sparse
-    product per layer).  enriched_share: the share of the free dofs that
-    is enriched (None: not known)."""
+    product per layer)."""
     if n_free >= AUTO_PARDISO_MIN_DOFS and pardiso.available():
         return "pardiso"
-    if grid_lu_preferred(n_free, enriched_share):
-        return "superlu"
     if (
         n_free >= AUTO_AMG_MIN_DOFS
         and aspect is not None
@@ -360,19 +330,18 @@ def choose(
     n_free: int,
     node_xy: np.ndarray | None = None,
     band_share: float | Callable[[], float] = 0.0,
-    enriched_share: float | None = None,
 ) -> str:
     """The strategy of ``linear_solver = method`` for n_free free dofs on the
     mesh with nodes node_xy: method itself, or what "auto" stands for
     (auto_choice).  band_share: a number, or a function called only when it
-    decides; enriched_share as in auto_choice."""
+    decides."""
     if method != "auto":
         return method
     share = band_share if callable(band_share) else _constant(band_share)
     if node_xy is None:
-        return auto_choice(n_free, None, share, enriched_share)
+        return auto_choice(n_free, None, share)
     nodes = node_xy
-    return auto_choice(n_free, lambda: cell_aspect_ratio(nodes), share, enriched_share)
+    return auto_choice(n_free, lambda: cell_aspect_ratio(nodes), share)
 
 
 def planned_solver(
@@ -381,17 +350,15 @@ def planned_solver(
     x: np.ndarray,
     y: np.ndarray,
     band_share: Callable[[], float] | None = None,
-    enriched_share: float | None = None,
 ) -> str:
     """The strategy a run will take (choose) on the rectilinear mesh with
     grid lines x, y and about n_free free dofs, known before the mesh or the
     stiffness is built (the memory estimate asks this).  band_share() as in
-    auto_choice; None: not known yet, taken as 0.  enriched_share as in
-    auto_choice."""
+    auto_choice; None: not known yet, taken as 0."""
     if method != "auto":
         return method
     share = _constant(0.0) if band_share is None else band_share
-    return auto_choice(n_free, lambda: grid_aspect_ratio(x, y), share, enriched_share)
+    return auto_choice(n_free, lambda: grid_aspect_ratio(x, y), share)
 
 
 def _constant(value: float) -> Callable[[], float]:
@@ -700,7 +667,7 @@ class LinearSolver:
             if n
             else 0.0
         )
-        self.method = choose(method, n, node_xy, band_share, self.enriched_share)
+        self.method = choose(method, n, node_xy, band_share)
         if self.method == "amg" and node_xy is None:
             raise ValueError("the AMG linear solver needs the node coordinates")
         if self.method == "pardiso" and not pardiso.available():
@@ -782,20 +749,6 @@ class LinearSolver:
                 100.0 * AUTO_AMG_MAX_BAND,
                 cell_aspect_ratio(node_xy),
                 AUTO_AMG_MAX_ASPECT,
-            )
-        elif (
-            method == "auto"
-            and n >= AUTO_AMG_MIN_DOFS
-            and grid_lu_preferred(n, self.enriched_share)
-        ):
-            logger.debug(
-                "linear solver: superlu (auto: %d free dofs, %.1f %% enriched: "
-                "SuperLU in the grid's order below %d free dofs with at most "
-                "%.0f %% enriched)",
-                n,
-                100.0 * self.enriched_share,
-                AUTO_GRID_LU_MAX_DOFS,
-                100.0 * AUTO_GRID_LU_MAX_ENRICHED,
             )
         elif method == "auto":
             logger.debug(

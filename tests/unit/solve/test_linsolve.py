@@ -180,11 +180,9 @@ def test_case_option(tmp_path):
 @pytest.mark.slow
 def test_default_solver_at_the_amg_size_agrees_with_superlu(monkeypatch):
     """160 x 160 (53k free dofs): "auto" picks AMG with the default band and
-    limits (without the mkl extra) once SuperLU in the grid's order stops
-    at the AMG size; the slip and the Newton iterations equal those of
-    SuperLU."""
+    limits (without the mkl extra); the slip and the Newton iterations
+    equal those of SuperLU."""
     monkeypatch.setattr(linsolve.pardiso, "available", lambda: False)
-    monkeypatch.setattr(linsolve, "AUTO_GRID_LU_MAX_DOFS", linsolve.AUTO_AMG_MIN_DOFS)
     out = {}
     for method in ("auto", "superlu"):
         model = build_model(loads_case(_text(160), CASE))

@@ -15,7 +15,7 @@ from xfemslip.case import build, loads_case
 from xfemslip.simulation import build_model
 from xfemslip.solve import linear as linsolve
 from xfemslip.solve import ordering
-from xfemslip.solve.linear import LinearSolver, choose
+from xfemslip.solve.linear import LinearSolver
 from xfemslip.solve.newton import NewtonSolver
 
 CASE = Path(__file__).resolve().parents[3] / "cases" / "reservoir_depletion.toml"
@@ -174,15 +174,3 @@ def test_a_run_gives_the_same_answer_in_either_order(monkeypatch):
     assert its1 == its2
     assert np.max(np.abs(gt1)) > 1e-4  # it slips
     assert np.max(np.abs(gt1 - gt2)) <= 1e-9 * np.max(np.abs(gt1))
-
-
-def test_auto_takes_superlu_in_the_grid_order_below_its_limits(monkeypatch):
-    monkeypatch.setattr(linsolve.pardiso, "available", lambda: False)
-    xy = _xy(10, 10)
-    top, few = linsolve.AUTO_GRID_LU_MAX_DOFS, linsolve.AUTO_GRID_LU_MAX_ENRICHED
-    assert linsolve.AUTO_AMG_MIN_DOFS < top
-    assert few <= linsolve.GRID_ORDER_MAX_ENRICHED  # the order applies
-    assert choose("auto", top - 1, xy, 0.0, few) == "superlu"
-    assert choose("auto", top, xy, 0.0, few) == "amg"
-    assert choose("auto", top - 1, xy, 0.0, np.nextafter(few, 1.0)) == "amg"
-    assert choose("auto", top - 1, xy, 0.0, None) == "amg"  # not known
