@@ -1081,9 +1081,13 @@ class LinearSolver:
             self.stats["factor_time"] += time.perf_counter() - t
             self._band_lu = (band, Kc, band_lu)
 
+        # the band's rows of A: the band solve needs the residual there only
+        # (a product with the whole of A was about a tenth of a sweep)
+        A_band = A[band]
+
         def sweep(v):
             x = coarse(v)
-            x[band] += band_lu.solve((v - A @ x)[band])
+            x[band] += band_lu.solve(v[band] - A_band @ x)
             if cycles == 2:
                 x += coarse(v - A @ x)
             return x
@@ -1183,7 +1187,7 @@ class LinearSolver:
 
     # ------------------------------------------------------------------ #
     def _setup_amg(self):
-        from xfemslip.solve.amg import geometric, smoothed_aggregation
+        from xfemslip.solve.amg import geometric, smoothed_aggregation, v_cycle
 
         t = time.perf_counter()
         n_std = 2 * self.node_xy.shape[0]
@@ -1204,11 +1208,11 @@ class LinearSolver:
             B = rigid_body_modes(self.node_xy[dof // 2], dof % 2)
             ml = smoothed_aggregation(K_ss, B, AMG_MAX_COARSE)
             kind = "smoothed aggregation"
-        V = ml.aspreconditioner(cycle="V")
+        V = v_cycle(ml)
 
         def cycle(v):
             x = np.zeros(v.shape)
-            x[std] = V @ v[std]
+            x[std] = V(v[std])
             return x
 
         self._amg = cycle

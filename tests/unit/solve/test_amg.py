@@ -23,6 +23,7 @@ from xfemslip.solve.amg import (
     grid_interpolation,
     jacobi_spectral_radius,
     smoothed_aggregation,
+    v_cycle,
 )
 from xfemslip.solve.linear import rigid_body_modes
 
@@ -235,3 +236,16 @@ def test_geometric_preconditioner_is_the_direct_solve(case, keys):
         assert np.abs(x - direct).max() <= 1e-8 * np.abs(direct).max()
         its[name] = count[0]
     assert its["geometric"] <= its["aggregation"] + 1
+
+
+def test_the_v_cycle_is_pyamgs(elasticity):
+    """v_cycle (one V-cycle from zero, without pyamg's residual norms) gives
+    pyamg's preconditioner's answer to round-off, on both hierarchies."""
+    K, B = elasticity
+    _, dof, nodes = _problem(**{"mesh.elements": [40, 40]})
+    b = np.random.default_rng(4).random(K.shape[0])
+    for ml in (geometric(K, nodes, dof, COARSE), smoothed_aggregation(K, B, COARSE)):
+        want = ml.aspreconditioner(cycle="V") @ b
+        got = v_cycle(ml)(b)
+        assert np.abs(got - want).max() <= 1e-12 * np.abs(want).max()
+        assert np.abs(want).max() > 0.0
