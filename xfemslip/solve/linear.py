@@ -43,8 +43,8 @@ them; PARDISO's own machinery is in pardiso.py.
   non-symmetric contact coupling (a second V-cycle after it saves
   iterations but not time: 28 against 42 iterations, 2.0 against 1.5 s
   CPU at 200 x 200 with smoothed aggregation; 21 against 23 iterations,
-  5.6 against 3.6 s at 400 x 400 with the grid's).  The
-  multigrid hierarchy is built once per run (the standard block is part of K_ff);
+  5.6 against 3.6 s at 400 x 400 with the grid's).  The multigrid
+  hierarchy is built once per run (the standard block is part of K_ff);
   only the small band is refactored per Newton system.  A system without
   enriched dofs is solved by AMG-preconditioned CG.
   If the Krylov solve does not converge, that system and the rest of the run
@@ -67,8 +67,8 @@ them; PARDISO's own machinery is in pardiso.py.
   whose AMG band (the enriched dofs and AMG_BAND_LAYERS matrix neighbours:
   what the band LU of every Newton system factors) holds at most
   AUTO_AMG_MAX_BAND of the free dofs (pyamg installed, node coordinates
-  known), ``"superlu"`` otherwise.  All three inputs are known before the first solve
-  (system_facts); the choice is logged at debug level.
+  known), ``"superlu"`` otherwise.  All three inputs are known before the
+  first solve (system_facts); the choice is logged at debug level.
 
 Why SuperLU refactors a single fracture's matrix instead of a low-rank
 (Woodbury) update or a Schur complement on the contact dofs: through
