@@ -79,6 +79,12 @@ def jacobi_spectral_radius(A, steps: int = LANCZOS_STEPS) -> float:
     return float(np.linalg.eigvalsh(T)[-1])
 
 
+# A direction is coarsened while its (median) cell size is at most this
+# times the other's: on elongated cells the point smoother only smooths
+# along the short side, so only that side is coarsened there.
+SEMI_COARSENING = 2.0
+
+
 def grid_interpolation(x: np.ndarray) -> tuple[np.ndarray, sp.csr_matrix]:
     """The coarse grid of the 1-D grid x (m + 1 increasing coordinates):
     the indices of its nodes in x (every other one, and the last), and the
@@ -122,11 +128,14 @@ def geometric(A, node_xy: np.ndarray, dof: np.ndarray, max_coarse: int):
     levels = [MultilevelSolver.Level()]
     levels[-1].A = A
     while len(levels) < 20 and x.size * y.size > max_coarse:
+        hx, hy = (
+            float(np.median(np.diff(v))) if v.size > 1 else np.inf for v in (x, y)
+        )
         (kx, Px), (ky, Py) = (
             grid_interpolation(v)
-            if v.size > 2
+            if v.size > 2 and h <= SEMI_COARSENING * h_other
             else (np.arange(v.size), sp.identity(v.size, format="csr"))
-            for v in (x, y)
+            for v, h, h_other in ((x, hx, hy), (y, hy, hx))
         )
         if kx.size == x.size and ky.size == y.size:
             break

@@ -185,6 +185,19 @@ def test_the_coarse_grids_leave_out_the_fixed_dofs():
     np.testing.assert_allclose((P @ u_c)[rows], u_f[rows], rtol=1e-12, atol=1e-12)
 
 
+def test_elongated_cells_are_coarsened_across_their_short_side_only():
+    """Cells of 1/120 x 1/10 (12:1): the coarse grids halve the 121 columns
+    of nodes (61, 31, 16) and keep the 11 rows until the cells are within
+    2:1, then halve both (9 x 6).  Each level's dofs: two per node, less
+    u_y along the bottom and the pinned u_x where it is a coarse node (the
+    middle of the bottom edge, column 60, is one down to 31 columns)."""
+    K, dof, xy = _problem(**{"mesh.elements": [120, 10]})
+    ml = geometric(K, xy, dof, max_coarse=4)
+    dofs = [level.A.shape[0] for level in ml.levels]
+    want = [2 * 121 * 11 - 122, 2 * 61 * 11 - 62, 2 * 31 * 11 - 32]
+    assert dofs[:5] == [*want, 2 * 16 * 11 - 16, 2 * 9 * 6 - 9]
+
+
 def test_nodes_that_are_not_a_whole_grid_have_no_geometric_hierarchy():
     """A node missing from the grid, or one off its lines: None (the AMG
     path then takes smoothed aggregation)."""
@@ -201,16 +214,18 @@ def test_nodes_that_are_not_a_whole_grid_have_no_geometric_hierarchy():
     [
         (CASE, {"mesh.elements": [40, 40]}),
         (CASE, {"mesh.elements": [33, 47]}),
+        (CASE, {"mesh.elements": [120, 10]}),
         (FIELD, {"mesh.size": 25.0, "mesh.max_size": 200.0}),
     ],
-    ids=["uniform", "odd", "graded-layered"],
+    ids=["uniform", "odd", "elongated", "graded-layered"],
 )
 def test_geometric_preconditioner_is_the_direct_solve(case, keys):
     """CG with one geometric V-cycle per step, to a relative residual of
     1e-10, gives the direct solution to 1e-8 on a uniform grid, one with
-    odd cell counts, and the field section's graded grid with three rock
-    units; in at most one iteration more than smoothed aggregation needs
-    (measured: 11 against 14, 14 against 15 and 26 against 27)."""
+    odd cell counts, one of 12:1 cells and the field section's graded grid
+    with three rock units; in at most one iteration more than smoothed
+    aggregation needs (measured: 11 against 14, 14 against 15, 24 against
+    68 and 26 against 27)."""
     K, dof, xy = _problem(case, **keys)
     b = np.random.default_rng(3).random(K.shape[0])
     direct = spla.spsolve(K.tocsc(), b)
