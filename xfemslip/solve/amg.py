@@ -5,7 +5,8 @@ rectilinear grid.
 Geometric (``geometric``): the standard dofs of a structured Q4 mesh are
 the unknowns of plain elasticity on a rectilinear grid (a fracture enriches
 other dofs), so the coarse grids are every other grid line (the last one
-kept when a direction has an odd number of cells), the prolongation is the
+kept when a direction has an odd number of cells; across the short side
+only where the cells are elongated, SEMI_COARSENING), the prolongation is the
 bilinear interpolation of each displacement component by the node
 coordinates (graded grids too), and the coarse operators are Galerkin
 products P^T A P, so several rock units need no extra care.  A coarse dof
