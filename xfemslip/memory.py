@@ -280,11 +280,7 @@ def enriched_footprint(spec: CaseSpec, mesh, fractures, cand) -> Footprint:
         n_cells=mesh.n_cells,
         n_dofs=n_dofs,
         linear=_linear(
-            spec,
-            mesh.x,
-            mesh.y,
-            n_dofs,
-            lambda: _band_share(mesh, cand, n_dofs),
+            spec, mesh.x, mesh.y, n_dofs, lambda: _band_share(mesh, cand, n_dofs)
         ),
         nnz=NNZ_PER_ENTRY * entries,
         steps=spec.loading.steps,

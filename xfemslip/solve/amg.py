@@ -116,11 +116,10 @@ def geometric(A, node_xy: np.ndarray, dof: np.ndarray, max_coarse: int):
     from pyamg.multilevel import MultilevelSolver
     from pyamg.relaxation.smoothing import change_smoothers
 
-    xy = np.asarray(node_xy, dtype=float)
-    x, col = np.unique(xy[:, 0], return_inverse=True)
-    y, row = np.unique(xy[:, 1], return_inverse=True)
-    col, row = col.ravel(), row.ravel()
-    if x.size * y.size != xy.shape[0] or np.unique(row * x.size + col).size != col.size:
+    from xfemslip.solve.ordering import node_grid
+
+    x, y, col, row = node_grid(node_xy)
+    if x.size * y.size != col.size or np.unique(row * x.size + col).size != col.size:
         return None
     dof = np.asarray(dof, dtype=np.int64)
     # each row's dof on the full grid of this level: 2 (j nx + i) + component

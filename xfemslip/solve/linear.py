@@ -368,7 +368,8 @@ def _constant(value: float) -> Callable[[], float]:
 def cell_aspect_ratio(node_xy: np.ndarray) -> float:
     """Largest cell aspect ratio of a structured rectilinear mesh, from its
     nodes (grid_aspect_ratio of their distinct x and y)."""
-    return grid_aspect_ratio(np.unique(node_xy[:, 0]), np.unique(node_xy[:, 1]))
+    x, y, _, _ = ordering.node_grid(node_xy)
+    return grid_aspect_ratio(x, y)
 
 
 def grid_aspect_ratio(x: np.ndarray, y: np.ndarray) -> float:

@@ -70,15 +70,23 @@ def grid_dissection(nx: int, ny: int, leaf: int = LEAF) -> np.ndarray:
     return rank
 
 
+def node_grid(node_xy) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """The rectilinear grid of the nodes (n_nodes, 2): its distinct x and y
+    lines, increasing, and each node's column and row on them (the ranks of
+    its x and y)."""
+    xy = np.asarray(node_xy, dtype=float)
+    x, col = np.unique(xy[:, 0], return_inverse=True)
+    y, row = np.unique(xy[:, 1], return_inverse=True)
+    return x, y, col.ravel(), row.ravel()
+
+
 def grid_order(dof_node, node_xy) -> np.ndarray:
     """The elimination order (a permutation of the dofs) of the nested
     dissection of the grid (grid_dissection), a node's dofs together in
     their own order.  dof_node : (n,) the node of each dof; node_xy :
-    (n_nodes, 2) the coordinates of the rectilinear grid's nodes (a node's
-    column and row are the ranks of its x and y among the distinct ones)."""
-    col, row = (
-        np.unique(node_xy[:, a], return_inverse=True)[1].ravel() for a in (0, 1)
-    )
+    (n_nodes, 2) the coordinates of the rectilinear grid's nodes
+    (node_grid)."""
+    _, _, col, row = node_grid(node_xy)
     nx, ny = int(col.max(initial=0)), int(row.max(initial=0))
     rank = grid_dissection(nx, ny)[row * (nx + 1) + col]
     return np.argsort(rank[np.asarray(dof_node, dtype=np.int64)], kind="stable")
