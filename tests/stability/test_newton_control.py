@@ -65,8 +65,8 @@ def test_bisection_keeps_the_friction_history_exact(monkeypatch):
     text = stiff_cohesive_case()
     real = solver_module.NewtonSolver._newton
 
-    def capped(self, u, lam, k, steps):
-        out = real(self, u, lam, k, steps)
+    def capped(self, u, lam, k, steps, contact=None):
+        out = real(self, u, lam, k, steps, contact)
         if lam - self._lam_committed > MAX_INCREMENT + 1e-12:
             raise ConvergenceError(
                 f"load step {k} did not converge: forced by the test",
@@ -116,6 +116,96 @@ def test_exhausted_bisection_says_what_was_tried():
     assert "(sub-steps down to 0.25 of it)" in out.error
     assert "fractures[0] cuts the domain in two" in out.error
     assert "prescribe a displacement" in out.error
+
+
+def _fail_first_true_law(monkeypatch, fail=1):
+    """NewtonSolver._newton made to fail on its first ``fail`` calls under
+    the true contact law (contact None); the calls, (load factor, friction
+    factor or None), are recorded."""
+    real = solver_module.NewtonSolver._newton
+    calls = []
+
+    def newton(self, u, lam, k, steps, contact=None):
+        raised = (
+            None
+            if contact is None
+            else float(np.max(contact.friction / self.p.contact.friction))
+        )
+        calls.append((lam, raised))
+        if contact is None and sum(r is None for _, r in calls) <= fail:
+            raise ConvergenceError(
+                f"load step {k} did not converge: forced by the test",
+                step=k,
+                iteration=3,
+                residual=1.0,
+            )
+        return real(self, u, lam, k, steps, contact)
+
+    monkeypatch.setattr(solver_module.NewtonSolver, "_newton", newton)
+    return calls
+
+
+def test_friction_continuation_ends_at_the_plain_answer(monkeypatch):
+    """A load step that fails after bisection is solved again by
+    continuation in friction (1.4, 1.3, ... times it, the true law last):
+    the answer is the step's under the true law, the same as the plain
+    Newton solve's to the tolerance, and nothing of the raised stages is
+    committed before it."""
+    text = reservoir_text(n=12, friction=0.3, steps=2)
+    plain = solve(text, RESERVOIR, max_step_cuts=0)
+    assert plain.converged, plain.error
+    calls = _fail_first_true_law(monkeypatch)
+    cont = solve(text, RESERVOIR, max_step_cuts=0)
+    monkeypatch.undo()
+    assert cont.converged, cont.error
+    # step 1: the forced failure, then 1.4, 1.3, 1.2, 1.1 times the
+    # friction and the true law; step 2 plainly
+    factors = [r for lam, r in calls if lam == 0.5]
+    assert factors[0] is None and factors[-1] is None
+    np.testing.assert_allclose(factors[1:-1], [1.4, 1.3, 1.2, 1.1], rtol=1e-12)
+    assert [r for lam, r in calls if lam == 1.0] == [None]
+    # premise: the step slips, so the friction decides the answer
+    assert np.any(plain.steps[0].contact.state == SLIP)
+    for a, b in zip(plain.steps, cont.steps, strict=True):
+        scale = np.max(np.abs(a.u))
+        assert np.max(np.abs(a.u - b.u)) <= 1e-7 * scale
+        np.testing.assert_allclose(
+            b.contact.slip_plastic,
+            a.contact.slip_plastic,
+            atol=1e-7 * np.max(np.abs(a.contact.slip_plastic)),
+        )
+        assert np.array_equal(a.contact.state, b.contact.state)
+    # the stages' iterations are counted (each stage logs its start too)
+    first = cont.steps[0]
+    assert len(first.residuals) == first.iterations + 5
+
+
+def test_failed_friction_continuation_is_named_and_keeps_the_steps(monkeypatch):
+    """Where the continuation fails too, the error says that bisection and
+    the continuation were tried, and the converged steps are kept."""
+    text = reservoir_text(n=12, friction=0.3, steps=2)
+    calls = _fail_first_true_law(monkeypatch, fail=1000)
+    out = solve(text, RESERVOIR, max_step_cuts=1)
+    assert not out.converged and len(out.steps) == 0
+    assert "even after cutting the load step 1 time(s)" in out.error
+    assert "and a continuation in friction (from 1.4 times it)" in out.error
+    # the stages went down to the true law, were retried at half the
+    # decrement from the last converged one, three times, then gave up
+    tried = [r for _, r in calls if r is not None]
+    np.testing.assert_allclose(
+        tried, [1.4, 1.3, 1.2, 1.1, 1.05, 1.025, 1.0125], rtol=1e-12
+    )
+
+
+def test_frictionless_failure_skips_the_continuation(monkeypatch):
+    """No friction to continue in: the failure is reported as it was."""
+    text = reservoir_text(n=12, friction=0.0)
+    calls = _fail_first_true_law(monkeypatch, fail=1000)
+    out = solve(text, RESERVOIR, max_step_cuts=0)
+    assert not out.converged
+    assert "forced by the test" in out.error
+    assert "continuation" not in out.error
+    assert all(r is None for _, r in calls) and len(calls) == 1
 
 
 def test_cycling_detection_and_frozen_law():

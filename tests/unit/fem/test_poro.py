@@ -298,7 +298,7 @@ def test_deplete_failure_keeps_the_converged_steps(runner, tmp_path, monkeypatch
 
     real = solver_module.NewtonSolver._newton
 
-    def newton(self, u, lam, k, steps):
+    def newton(self, u, lam, k, steps, contact=None):
         if k == 2:
             raise ConvergenceError(
                 "load step 2 did not converge: forced",
@@ -306,7 +306,7 @@ def test_deplete_failure_keeps_the_converged_steps(runner, tmp_path, monkeypatch
                 iteration=3,
                 residual=1.0,
             )
-        return real(self, u, lam, k, steps)
+        return real(self, u, lam, k, steps, contact)
 
     monkeypatch.setattr(solver_module.NewtonSolver, "_newton", newton)
     case = tmp_path / "dep.toml"

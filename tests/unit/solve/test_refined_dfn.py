@@ -6,7 +6,11 @@ and back; stick exceeds the bound), and Newton failed after 5 load-step cuts
 (which cannot help: without cohesion or initial stress the first sub-step is
 the same problem scaled).  The local branch search (xfemslip.contact.branches)
 puts a neighbour in stick and the step converges.  docs/performance.md,
-"Fracture networks", refined meshes."""
+"Fracture networks", refined meshes.
+
+The same base with 100 fractures at 100 x 100 cells: Newton cycles through
+stick/slip sets and stops; the continuation in friction (the last resort
+after bisection, xfemslip.solve.newton) converges to the true law."""
 
 from __future__ import annotations
 
@@ -40,6 +44,52 @@ def test_refined_dfn_realization_converges_to_the_true_law():
     solver = newton_solver(model)
     step = solver.run(1)[-1]
     assert step.searches >= 1  # the remedy was needed and used
+    _assert_true_law(model, solver, step)
+    # slip on about half of the fractures, as on the 50 x 50 mesh (14-15 of 30)
+    res = step.contact
+    assert 10 <= len(set(model.contact.fracture[res.state == SLIP])) <= 20
+
+
+# the same base with 100 fractures: every patch is loaded at once and Newton
+# cycles; the friction continuation after the failed attempt converges
+# (1.4, 1.3, 1.2, 1.1 and 1 times the friction in 4 + 1 + 5 + 7 + 12
+# iterations after 30 without convergence)
+CROWDED = sweep_member(
+    **{
+        "mesh.elements": [100, 100],
+        "network.generate.count": 100,
+        "solver.max_step_cuts": 0,
+        "network.tip": "ramp",
+    }
+)
+
+
+@pytest.mark.slow  # 100 fractures on 100 x 100 cells: ~50 s
+def test_crowded_dfn_from_zero_converges_by_friction_continuation(monkeypatch):
+    import xfemslip.solve.newton as solver_module
+
+    real = solver_module.NewtonSolver._friction_continuation
+    found = []
+
+    def spy(self, *args):
+        found.append(real(self, *args))
+        return found[-1]
+
+    monkeypatch.setattr(solver_module.NewtonSolver, "_friction_continuation", spy)
+    model = build_model(loads_case(CROWDED, HERE / "dfn_crowded.toml"))
+    solver = newton_solver(model)
+    step = solver.run(1)[-1]
+    assert len(found) == 1 and found[0] is not None  # needed, and it converged
+    _assert_true_law(model, solver, step)
+    res = step.contact
+    # slip on most of the 100 fractures, half of the patches
+    assert len(set(model.contact.fracture[res.state == SLIP])) >= 50
+    assert 0.3 <= np.mean(res.state == SLIP) <= 0.7
+
+
+def _assert_true_law(model, solver, step):
+    """The converged step satisfies Coulomb's law on every patch and the
+    bottom edge's reactions carry the applied vertical load."""
     assert step.residuals[-1] <= model.spec.solver.tolerance
     p, c, res = model.problem, model.contact, step.contact
     # the converged tractions satisfy Coulomb's law on every patch
@@ -59,5 +109,3 @@ def test_refined_dfn_realization_converges_to_the_true_law():
     reaction = r[ydofs][~free[ydofs]].sum()
     assert abs(applied) > 1e6  # -40 MPa x 1 m
     assert abs(reaction + applied) <= 1e-6 * abs(applied)
-    # slip on about half of the fractures, as on the 50 x 50 mesh (14-15 of 30)
-    assert 10 <= len(set(c.fracture[res.state == SLIP])) <= 20
