@@ -305,3 +305,19 @@ def test_ping_pong_remedy_accepts_only_the_true_law(monkeypatch):
     np.testing.assert_allclose(
         np.abs(a.contact.pt[slipping]), bound[slipping], rtol=1e-12
     )
+
+
+def test_a_non_finite_residual_is_a_convergence_error_not_a_crash():
+    """A residual with inf or NaN (a forced law gone wrong) stops the
+    Newton solve with a ConvergenceError that names it, before the linear
+    solver sees it (SciPy's dense LU raises ValueError on it)."""
+    text = reservoir_text(n=12, friction=0.3)
+    model = solve(text, RESERVOIR).model
+    solver = solver_module.NewtonSolver(model.problem, 1e-8, 30, "consistent")
+    c = model.contact
+    u = np.zeros(model.problem.n_dofs)
+    res = c.evaluate(u, solver.mode, c.pt_committed, c.gt_committed)
+    r, _ = solver._residual(u, 1.0, res)
+    r[0] = np.nan
+    with pytest.raises(ConvergenceError, match="the residual is not finite"):
+        solver._solve(res, r, 1, 4, float(np.linalg.norm(r)))

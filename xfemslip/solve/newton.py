@@ -495,11 +495,13 @@ class NewtonSolver:
             first.reason,
         )
 
-        def solve(law, u):
+        def solve(law, u, what):
             try:
                 u, res, log = self._newton(u, lam, k, steps, law)
             except ConvergenceError as err:
-                logger.debug("step %d/%d: fixed point: %s", k, steps, err.reason)
+                logger.debug(
+                    "step %d/%d: fixed point, %s: %s", k, steps, what, err.reason
+                )
                 return None
             for name in ("iterations", "freezes", "reversals", "searches", "found"):
                 setattr(total, name, getattr(total, name) + getattr(log, name))
@@ -508,7 +510,11 @@ class NewtonSolver:
             return u, res
 
         raised = FIXED_POINT_START * c.friction
-        out = solve(dataclasses.replace(c, friction=raised, friction_dynamic=raised), u)
+        out = solve(
+            dataclasses.replace(c, friction=raised, friction_dynamic=raised),
+            u,
+            f"the start under {FIXED_POINT_START:g} x the friction",
+        )
         if out is None:
             return None
         u, res = out
@@ -524,7 +530,7 @@ class NewtonSolver:
                 cohesion=bound,
                 cohesion_dynamic=bound,
             )
-            out = solve(tresca, u)
+            out = solve(tresca, u, f"Tresca problem {it}")
             if out is None:
                 return None
             u, res = out
@@ -857,6 +863,8 @@ class NewtonSolver:
                 )
 
     def _solve(self, res, r, k, it, eta):
+        if not np.isfinite(eta):  # a remedy's law evaluated to inf or NaN
+            raise self._fail(k, it, eta, 0, "the residual is not finite")
         try:
             du = self.linear.solve_contact(res.blocks, r)
         except RuntimeError as exc:  # "Factor is exactly singular"

@@ -115,6 +115,22 @@ def slip_reversals(law, u, du, free, mode, regime, pt_prev, gt_prev, held, scrat
     return (mask if mask.any() else None), (stubborn if stubborn.any() else None)
 
 
+def cluster_base(c, law, mask):
+    """``law`` with the patches of ``mask`` given back their own law of
+    ``c``, on which a local search forces its branches: a patch held in
+    stick by a hold gets its finite bound back (a forced slip needs it),
+    and one forced to slip by an earlier search its own committed slip
+    (held in stick with that search's infinite slip, its traction would be
+    infinite: a 100-fracture network's Newton solve stopped on it with
+    NaN in the linear solve)."""
+    return dataclasses.replace(
+        law,
+        cohesion=np.where(mask, c.cohesion, law.cohesion),
+        cohesion_dynamic=np.where(mask, c.cohesion_dynamic, law.cohesion_dynamic),
+        slip_committed=np.where(mask, c.slip_committed, law.slip_committed),
+    )
+
+
 def local_search(c, law, u, res, r, stubborn, c_dofs, K_ff, free, mode):
     """The law with the branches of ``stubborn`` and their neighbours
     forced to a consistent local set (xfemslip.contact.branches), or None
@@ -158,13 +174,7 @@ def local_search(c, law, u, res, r, stubborn, c_dofs, K_ff, free, mode):
         idx.size,
         int(np.count_nonzero(branches != now)),
     )
-    # a patch of the cluster held in stick by a hold gets its own
-    # cohesion back (a forced slip needs the finite bound)
-    base = dataclasses.replace(
-        law,
-        cohesion=np.where(mask, c.cohesion, law.cohesion),
-        cohesion_dynamic=np.where(mask, c.cohesion_dynamic, law.cohesion_dynamic),
-    )
+    base = cluster_base(c, law, mask)
     branches = np.asarray(branches)
     moving = branches != 0
     return force_branches(

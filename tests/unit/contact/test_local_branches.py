@@ -98,3 +98,39 @@ def test_neighbours_are_the_patches_sharing_a_cell():
     # along the fault, a few, not the whole fault
     assert 2 <= int(near.sum()) - 1 <= 6
     assert np.all(np.abs(np.nonzero(near)[0] - c.n // 2) <= 3)
+
+
+def test_a_second_search_may_hold_a_patch_the_first_forced_to_slip():
+    """A patch that one search forced to slip (committed slip -sign x inf)
+    and a later search holds in stick: on cluster_base its committed slip is
+    its own again, so the held patch carries the finite stick traction of
+    the true law (on the first search's law held in stick its traction was
+    infinite, and a crowded network's Newton solve stopped on NaN)."""
+    from xfemslip.conventions import STICK
+    from xfemslip.solve.remedies import cluster_base
+
+    solver, c, u = _setup(0.3)
+    mid = c.n // 2
+    u1, _ = _exact(solver, c, u)  # the slipping solution of the step
+    first = _on_branches(c, np.array([mid]), np.array([1]))
+    # a hold on top (ping-pong or slip reversal): infinite cohesion at mid
+    held = force_branches(first, stick_at=np.array([mid, mid + 1]))
+    mask = np.zeros(c.n, bool)
+    mask[[mid, mid + 1]] = True
+    stale = force_branches(held, stick_at=mask).evaluate(
+        u1, solver.mode, c.pt_committed, c.gt_committed
+    )
+    assert not np.isfinite(stale.pt[mid])  # premise: the failure it fixes
+    base = cluster_base(c, held, mask)
+    np.testing.assert_array_equal(base.slip_committed, c.slip_committed)
+    np.testing.assert_array_equal(base.cohesion, c.cohesion)
+    got = force_branches(base, stick_at=mask).evaluate(
+        u1, solver.mode, c.pt_committed, c.gt_committed
+    )
+    stick = force_branches(c, stick_at=mask).evaluate(
+        u1, solver.mode, c.pt_committed, c.gt_committed
+    )
+    assert np.all(np.isfinite(got.pt)) and np.all(np.isfinite(got.force))
+    assert np.all(got.state[mask] == STICK)
+    np.testing.assert_array_equal(got.pt, stick.pt)
+    np.testing.assert_array_equal(got.force, stick.force)
