@@ -22,12 +22,15 @@ AMG-preconditioned GMRES), which handles the non-symmetric case.
 
 The remedies for a stick/slip set that does not settle (ping-pong freezes,
 slip-reversal holds, the local branch search) are in xfemslip.solve.remedies.
-What stays here, about 700 lines, is one piece: NewtonSolver's load
-stepping with bisection, the Newton loop that applies the remedies and
-restores the true law, the line search and the failure messages share the
-solver's state (free dofs, reduced stiffness, committed history, linear
-solver) from one iteration to the next; cut apart they would pass that
-state back and forth without making either half readable on its own.
+A load step Newton fails on is then solved by a fixed point on the normal
+traction (Tresca problems, each a Newton solve), and where that fails too,
+cut in halves.  What stays here, about 950 lines, is one piece:
+NewtonSolver's load stepping with the fixed point and bisection, the Newton
+loop that applies the remedies and restores the true law, the line search
+and the failure messages share the solver's state (free dofs, reduced
+stiffness, committed history, linear solver) from one iteration to the
+next; cut apart they would pass that state back and forth without making
+either half readable on its own.
 
 Logging: one INFO line per converged load step (its iterations, cuts and
 contact states); every Newton iteration, cut, prediction and remedy at DEBUG
@@ -560,7 +563,8 @@ class NewtonSolver:
 
         Returns (u, contact result, _NewtonLog); raises ConvergenceError.
         Nothing is committed here.  ``contact``: the contact law solved for
-        (the model's by default; friction_continuation's raised friction).
+        (the model's by default; _fixed_point's raised friction and Tresca
+        laws).
         """
         c = self.p.contact if contact is None else contact
         u = u.copy()
