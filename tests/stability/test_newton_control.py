@@ -214,8 +214,7 @@ def test_anderson_acceleration_of_a_linear_fixed_point():
 
 def test_failed_fixed_point_is_named_then_the_step_is_cut(monkeypatch):
     """Where the fixed point fails too, the step is cut as before (the fixed
-    point once per load step), and the error names both; the converged
-    steps are kept."""
+    point once per load step), and the error names both."""
     text = reservoir_text(n=12, friction=0.3, steps=2)
     calls = _fail_true_law(monkeypatch, fail=1000)
     monkeypatch.setattr(solver_module, "FIXED_POINT_MAX", 3)
