@@ -200,6 +200,14 @@ class ContactSet:
             self.cohesion, self.cohesion_dynamic, accumulated, self.slip_distance
         )
 
+    def shear_bound(self, pn, accumulated=None) -> np.ndarray:
+        """(m,) Coulomb's bound on |p_T| [Pa] at the normal traction ``pn``
+        (m,) [Pa], c - f p_N, with the friction and cohesion weakened at the
+        accumulated slip ``accumulated`` (None: the static values)."""
+        if accumulated is None:
+            return self.cohesion - self.friction * pn
+        return self.cohesion_at(accumulated) - self.friction_at(accumulated) * pn
+
     def history(self) -> tuple:
         """Copy of the committed history (what ``restore`` takes back)."""
         return tuple(getattr(self, name).copy() for name in COMMITTED)

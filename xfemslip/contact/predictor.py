@@ -65,7 +65,7 @@ def predict_state(c: ContactSet, pn_committed, stress, d_lambda):
         trac = c.normal @ sig  # sigma . n (sigma symmetric)
         pn = pn + d_lambda * np.einsum("mk,mk->m", trac, c.normal)
         pt = pt + d_lambda * np.einsum("mk,mk->m", trac, c.tangent)
-    bound = c.cohesion - c.friction * pn
+    bound = c.shear_bound(pn)
     # a committed slipping patch sits on its bound (|p_T| = bound up to
     # round-off): it keeps slipping unless the increment moves it inside
     on_bound = (c.state_committed == SLIP) & (

@@ -401,7 +401,7 @@ class _Follower:
         dpn = c.kn * (jx * c.normal[:, 0] + jy * c.normal[:, 1])
         dpt = c.kt * (jx * c.tangent[:, 0] + jy * c.tangent[:, 1])
         f = c.friction_at(c.accumulated_committed)
-        bound = c.cohesion_at(c.accumulated_committed) - f * res.pn
+        bound = c.shear_bound(res.pn, c.accumulated_committed)
         with np.errstate(divide="ignore", invalid="ignore"):
             plus = (bound - res.pt) / (dpt + f * dpn)
             minus = (bound + res.pt) / (f * dpn - dpt)

@@ -525,7 +525,7 @@ class NewtonSolver:
         X, G = [], []  # the last iterates and their changes, for Anderson
         zero = np.zeros_like(c.friction)
         for it in range(1, FIXED_POINT_MAX + 1):
-            bound = c.cohesion - c.friction * np.minimum(x, 0.0)
+            bound = c.shear_bound(np.minimum(x, 0.0))
             tresca = dataclasses.replace(
                 c,
                 friction=zero,
