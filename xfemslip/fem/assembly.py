@@ -26,6 +26,7 @@ from xfemslip.fem.enrichment import (
     carries_jump,
     select_enrichment,
 )
+from xfemslip.kernels.threads import map_in_threads
 
 logger = logging.getLogger(__name__)
 
@@ -316,9 +317,11 @@ def _enriched_entries(mesh, ec, D, material, qp_material, backend):
     rows = np.empty(total, index_type)
     cols = np.empty(total, index_type)
     vals = np.empty(total)
-    p = 0
     chunk = enriched_chunk(ec.slot_cand.shape[1])
-    for lo in range(0, nc, chunk):
+    start = np.zeros(nc + 1, np.int64)  # each cell's first entry
+    np.cumsum(live**2, out=start[1:])
+
+    def entries(lo: int) -> int:
         part = slice(lo, min(lo + chunk, nc))
         K_e, Bbar[part] = _enriched_matrices(
             mesh, ec, D, material, qp_material, backend=backend, rows=part
@@ -326,10 +329,19 @@ def _enriched_entries(mesh, ec, D, material, qp_material, backend):
         diag[part] = np.diagonal(K_e, axis1=1, axis2=2)
         r, c, v = _triplets(dofs[part], K_e, backend)
         del K_e
+        p = start[lo]
         rows[p : p + r.size] = r
         cols[p : p + r.size] = c
         vals[p : p + r.size] = v
-        p += r.size
+        return r.size
+
+    # the compiled kernels release the GIL: the chunks on every core
+    # (xfemslip.kernels.threads); NumPy's, chosen for small runs, in turn
+    chunks = range(0, nc, chunk)
+    if backend == "numba":
+        p = sum(map_in_threads(entries, chunks))
+    else:
+        p = sum(map(entries, chunks))
     assert p == total
     return diag, Bbar, [rows, cols, vals]
 

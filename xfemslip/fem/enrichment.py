@@ -50,6 +50,7 @@ from xfemslip import kernels
 from xfemslip.fem.branch import branch_functions
 from xfemslip.fem.quadrature import DUFFY_POINTS, TRI_BARY, duffy_rule, triangle_rule
 from xfemslip.geometry.fracture import GEOMETRY_TOL
+from xfemslip.kernels.threads import kernel_threads, map_in_threads
 from xfemslip.kernels.vectorized import ranges
 
 logger = logging.getLogger(__name__)
@@ -392,6 +393,47 @@ def _cell_rules(tri_off, tris, branch):
     return xy, w, qp_off, per_tri
 
 
+# Cells per thread below which the sub-cells are cut on one thread
+SUBCELL_THREAD_CELLS = 2000
+
+
+def _subtriangles(backend: str, bounds, lines, tol: float):
+    """kernels.cell_subtriangles of the cells ``bounds`` with their ``lines``
+    (line_offsets, line_point, line_normal, apex_offsets, apex_xy): the
+    compiled kernel on every core in contiguous runs of cells (it releases
+    the GIL; each cell is cut on its own, so the result is the one-call
+    result to the bit), the NumPy one in one call."""
+    cut = kernels.backend(backend).cell_subtriangles
+    nc = bounds.shape[0]
+    threads = kernel_threads() if backend == "numba" else 1
+    parts = max(1, min(threads, nc // SUBCELL_THREAD_CELLS))
+    if parts == 1:
+        return cut(bounds, *lines, tol)
+    line_off, line_point, line_normal, apex_off, apex_xy = lines
+    edges = np.linspace(0, nc, parts + 1).astype(np.int64)
+
+    def run(k: int):
+        a, b = edges[k], edges[k + 1]
+        l0, l1, p0, p1 = line_off[a], line_off[b], apex_off[a], apex_off[b]
+        return cut(
+            bounds[a:b],
+            line_off[a : b + 1] - l0,
+            line_point[l0:l1],
+            line_normal[l0:l1],
+            apex_off[a : b + 1] - p0,
+            apex_xy[p0:p1],
+            tol,
+        )
+
+    pieces = map_in_threads(run, range(parts), parts)
+    tri_off = np.zeros(nc + 1, np.int64)
+    shift = 0
+    for k, (off, _) in enumerate(pieces):
+        tri_off[edges[k] + 1 : edges[k + 1] + 1] = off[1:] + shift
+        shift += off[-1]
+    return tri_off, np.concatenate([t for _, t in pieces])
+
+
 def build_enriched_cells(
     mesh, fractures, cand: Candidates, backend: str = "numpy"
 ) -> EnrichedCells:
@@ -446,8 +488,8 @@ def build_enriched_cells(
     lines = _cell_lines_table(
         mesh, fractures, cand_cells, pair[:, 0], pair[:, 1], branch, tol
     )
-    tri_off, tris = kernels.backend(backend).cell_subtriangles(
-        np.ascontiguousarray(mesh.bounds[cand_cells]), *lines, float(tol)
+    tri_off, tris = _subtriangles(
+        backend, np.ascontiguousarray(mesh.bounds[cand_cells]), lines, float(tol)
     )
     qp_xy, qp_w, qp_off, per_tri = _cell_rules(tri_off, tris, branch)
     centroids = tris.mean(axis=1)
@@ -480,7 +522,9 @@ def build_enriched_cells(
     by_group = np.argsort(group, kind="stable")
     _, starts = np.unique(group[by_group], return_index=True)
     bounds = np.append(starts, group.size).tolist()
-    for lo, hi in zip(bounds[:-1], bounds[1:], strict=True):
+
+    def evaluate(span: tuple[int, int]) -> None:
+        lo, hi = span
         mine = by_group[lo:hi]
         k0 = k_used[mine][0]
         fi, tip = int(cand.fracture[k0]), int(cand.tip[k0])
@@ -528,6 +572,16 @@ def build_enriched_cells(
             nt_cell,
             np.concatenate([[0], np.cumsum(nt_cell[cells])]),
         )
+
+    # the groups write disjoint columns; with the compiled kernels (a large
+    # model) they run on every core: NumPy's functions of many points and
+    # the scatter kernel release the GIL (xfemslip.kernels.threads)
+    spans = list(zip(bounds[:-1], bounds[1:], strict=True))
+    if backend == "numba":
+        map_in_threads(evaluate, spans)
+    else:
+        for span in spans:
+            evaluate(span)
     # the vertex values (for the output) per slot, each its column's
     tri_slot = slot_column[np.repeat(np.arange(nc), nt_cell)]  # (nt, S)
     Fv = np.zeros((tris.shape[0], 3, S))

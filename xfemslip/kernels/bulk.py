@@ -116,7 +116,7 @@ def _gram_to_stiffness(G, nf, D, K):
             )
 
 
-@njit(cache=NUMBA_CACHE)
+@njit(cache=NUMBA_CACHE, nogil=True)
 def enriched_cell_matrices(
     bounds,
     qp_offsets,

@@ -18,7 +18,7 @@ from numba import njit
 from xfemslip.kernels._config import NUMBA_CACHE
 
 
-@njit(cache=NUMBA_CACHE)
+@njit(cache=NUMBA_CACHE, nogil=True)
 def block_triplets(dofs, blocks):
     """(rows, cols, vals) of every entry (i, j) of blocks (m, k, k) whose dofs
     (m, k) int64 are both >= 0, cell by cell and row-major within a cell."""
@@ -152,7 +152,7 @@ def csr_add_entries(indptr, indices, data, rows, cols, vals, to_dof, n):
     return out_ptr.astype(indptr.dtype), out_idx, out_val, -1
 
 
-@njit(cache=NUMBA_CACHE)
+@njit(cache=NUMBA_CACHE, nogil=True)
 def scatter_column_values(
     F,
     gF,

@@ -81,7 +81,7 @@ def _split(poly, k, px, py, nx, ny, tol, d, out_a, out_b):
     return ka, kb
 
 
-@njit(cache=NUMBA_CACHE)
+@njit(cache=NUMBA_CACHE, nogil=True)
 def cell_subtriangles(
     bounds, line_offsets, line_point, line_normal, apex_offsets, apex_xy, tol
 ):

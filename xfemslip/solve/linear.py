@@ -783,10 +783,10 @@ class LinearSolver:
     def blas_threads(self) -> contextlib.AbstractContextManager:
         """The context the Newton solve runs in: OpenBLAS on one thread
         when PARDISO solves (its MKL threads and OpenBLAS's would wait for
-        each other's cores: xfemslip.solve.threads), else nothing."""
+        each other's cores: xfemslip.kernels.threads), else nothing."""
         if self.method != "pardiso":
             return contextlib.nullcontext()
-        from xfemslip.solve.threads import one_openblas_thread
+        from xfemslip.kernels.threads import one_openblas_thread
 
         return one_openblas_thread()
 
