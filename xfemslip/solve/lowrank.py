@@ -216,29 +216,34 @@ class LowRankSystems:
         self.stats["pardiso_analyses"] += 1
         self.stats["factor_time"] += time.perf_counter() - t
 
-    def _tangents(self, blocks):
-        """patch_tangents of `blocks`, read again only on the patches whose
-        blocks changed since the last tangent (most Newton iterations change
-        a few: reading and checking all 988 blocks of a 100-fracture network
-        took 54 ms per system)."""
+    def _changed(self, blocks):
+        """The patches whose blocks differ from the last tangent's (indices),
+        or None when there is no last tangent to compare with."""
         last = self._update
         if last is None or last[0].shape != blocks.shape:
+            return None
+        return changed_patches(blocks, last[0])
+
+    def _tangents(self, blocks, changed):
+        """patch_tangents of `blocks`, read again only on the ``changed``
+        patches (None: all) since the last tangent (most Newton iterations
+        change a few: reading and checking all 988 blocks of a 100-fracture
+        network took 54 ms per system)."""
+        if changed is None:
             return patch_tangents(blocks, self.coef, self.dofs)
-        changed = changed_patches(blocks, last[0])
-        D = last[1].copy()
-        if changed.size:
-            part = patch_tangents(
-                blocks[changed], self.coef[changed], self.dofs[changed]
-            )
-            if part is None:
-                return None
-            D[changed] = part
+        D = self._update[1].copy()
+        part = patch_tangents(blocks[changed], self.coef[changed], self.dofs[changed])
+        if part is None:
+            return None
+        D[changed] = part
         return D
 
-    def _set_tangent(self, blocks):
-        """The dense LU of I + P_V^T G P_U for the tangent of `blocks`."""
+    def _set_tangent(self, blocks, changed=None):
+        """The dense LU of I + P_V^T G P_U for the tangent of `blocks`, of
+        which the ``changed`` patches differ from the last tangent's (None:
+        no last tangent)."""
         t = time.perf_counter()
-        D = self._tangents(blocks)
+        D = self._tangents(blocks, changed)
         if D is None:
             raise PardisoError(0, 0, "contact blocks not of the patch form")
         E = self.D0_mhalf @ (D - self.D0) @ self.D0_mhalf
@@ -259,7 +264,15 @@ class LowRankSystems:
         if not np.all(np.isfinite(cap)):
             raise PardisoError(22, 0)
         lu = sla.lu_factor(cap, check_finite=False) if rows.size else None
-        self._update = (blocks.copy(), D, rows, pu, pv, lu)
+        # the blocks compared with next time: the last copy with its changed
+        # patches replaced (a whole copy took 8 ms per system on the
+        # 100-fracture network), once nothing above can fail any more
+        if changed is None:
+            ref = blocks.copy()
+        else:
+            ref = self._update[0]
+            ref[changed] = blocks[changed]
+        self._update = (ref, D, rows, pu, pv, lu)
         self.stats["lowrank_updates"] += 1
         self.stats["lowrank_rank"] = max(self.stats["lowrank_rank"], int(rows.size))
         self.stats["factor_time"] += time.perf_counter() - t
@@ -315,8 +328,9 @@ class LowRankSystems:
     def solve(self, blocks, symmetric: bool, r) -> np.ndarray:
         if self.G is None:
             self._factor()
-        if self._update is None or not np.array_equal(self._update[0], blocks):
-            self._set_tangent(blocks)
+        changed = self._changed(blocks)
+        if changed is None or changed.size:
+            self._set_tangent(blocks, changed)
         norm = self._norm_bound()
         x, err = refined(self._solve, self._apply, r, norm, self.max_error, self.stats)
         if err <= self.max_error:

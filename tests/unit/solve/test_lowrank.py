@@ -106,12 +106,17 @@ def test_tangents_are_read_again_where_the_blocks_changed():
 
     D = rng.standard_normal((m, 2, 2))
     systems = SimpleNamespace(_update=None, coef=coef, dofs=dofs)
-    first = lowrank.LowRankSystems._tangents(systems, blocks_of(D))
+    LRS = lowrank.LowRankSystems
+    assert LRS._changed(systems, blocks_of(D)) is None  # no last tangent
+    first = LRS._tangents(systems, blocks_of(D), None)
     np.testing.assert_allclose(first, D, rtol=1e-14, atol=0)
     systems._update = (blocks_of(D), first)
+    assert LRS._changed(systems, blocks_of(D)).size == 0
     D2 = D.copy()
     D2[[2, 7]] = rng.standard_normal((2, 2, 2))
-    got = lowrank.LowRankSystems._tangents(systems, blocks_of(D2))
+    changed = LRS._changed(systems, blocks_of(D2))
+    np.testing.assert_array_equal(changed, [2, 7])
+    got = LRS._tangents(systems, blocks_of(D2), changed)
     np.testing.assert_array_equal(
         got[[0, 1, 3, 4, 5, 6, 8]], first[[0, 1, 3, 4, 5, 6, 8]]
     )
@@ -119,7 +124,7 @@ def test_tangents_are_read_again_where_the_blocks_changed():
     np.testing.assert_allclose(got, D2, rtol=1e-13, atol=0)
     bad = blocks_of(D2)
     bad[7, 0, 3] += 1e-6 * np.abs(bad[7]).max()
-    assert lowrank.LowRankSystems._tangents(systems, bad) is None
+    assert LRS._tangents(systems, bad, LRS._changed(systems, bad)) is None
 
 
 def test_stick_tangent_is_the_kernels():
