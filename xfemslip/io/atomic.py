@@ -11,7 +11,7 @@ from __future__ import annotations
 import contextlib
 import logging
 import os
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 from pathlib import Path
 
 import numpy as np
@@ -75,8 +75,11 @@ def atomic_path(final: Path | str) -> Iterator[Path]:
     logger.debug("wrote %s", final)
 
 
-def refuse_non_finite(value, name: str) -> None:
-    """Never write NaN or inf: raise OutputError naming the array.
+def refuse_non_finite(value, name: str | Callable[[], str]) -> None:
+    """Never write NaN or inf: raise OutputError naming the array (``name``,
+    or a function giving it, called only then: an HDF5 object's path is a
+    library call, 10 us of each of the thousands of datasets of a network's
+    result).
 
     The last line of defence; ``simulation`` turns a non-finite solution into a
     ConvergenceError before any writer is called.
@@ -84,6 +87,7 @@ def refuse_non_finite(value, name: str) -> None:
     array = np.asarray(value)
     if array.dtype.kind in "fc" and not np.all(np.isfinite(array)):
         bad = int(np.count_nonzero(~np.isfinite(array)))
+        label = name() if callable(name) else name
         raise OutputError(
-            f"refusing to write {name}: {bad} non-finite value(s) (NaN or inf)"
+            f"refusing to write {label}: {bad} non-finite value(s) (NaN or inf)"
         )

@@ -272,7 +272,7 @@ def _write_fracture(group: h5py.Group, fracture: FractureFields) -> None:
         value = _as_array(getattr(fracture, name), dtype, (n_points, *trailing), name)
         dataset = _dataset(group, name, value, units)
         if name == "state":
-            dataset.attrs["codes"] = STATE_CODES
+            h5py.Dataset(dataset).attrs["codes"] = STATE_CODES
     normal = _as_array(
         fracture.normal_traction, np.float64, (n_points,), "normal_traction"
     )
@@ -420,7 +420,7 @@ def _write_depletion(h5, table: DepletionTable) -> None:
 
 def _dataset(
     group: h5py.Group, name: str, value: np.ndarray, units: str, nan: bool = False
-) -> h5py.Dataset:
+) -> h5py.h5d.DatasetID:
     """Create one dataset without timestamps and tag it with its units
     (``nan``: NaN stands for "undefined" in it; inf is refused all the same).
 
@@ -432,7 +432,8 @@ def _dataset(
     third of the time of a study's sample)."""
     interrupt.checkpoint()  # between data sets: a deferred signal stops here
     refuse_non_finite(
-        np.where(np.isnan(value), 0.0, value) if nan else value, f"{group.name}/{name}"
+        np.where(np.isnan(value), 0.0, value) if nan else value,
+        lambda: f"{group.name}/{name}",
     )
     value = np.ascontiguousarray(value)
     dataset = h5py.h5d.create(
@@ -445,10 +446,16 @@ def _dataset(
     dataset.write(h5py.h5s.ALL, h5py.h5s.ALL, value)
     attr = h5py.h5a.create(dataset, b"units", _STRING[0], _SCALAR_SPACE)
     try:
-        attr.write(np.array(units, dtype=_STRING_DTYPE), mtype=_STRING[1])
+        attr.write(_units_value(units), mtype=_STRING[1])
     finally:
         attr.close()
-    return h5py.Dataset(dataset)
+    return dataset
+
+
+@functools.cache
+def _units_value(units: str) -> np.ndarray:
+    """The units attribute's value as h5py writes a str (made once per units)."""
+    return np.array(units, dtype=_STRING_DTYPE)
 
 
 # a str attribute as h5py stores it: variable-length UTF-8, a scalar space

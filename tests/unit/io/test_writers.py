@@ -297,7 +297,7 @@ def _high_level_dataset(group, name, value, units, nan=False):
         name, data=value, track_times=False, fletcher32=np.ndim(value) > 0
     )
     dataset.attrs["units"] = units
-    return dataset
+    return dataset.id
 
 
 @pytest.mark.parametrize("content", ["steps", "mesh"])
@@ -574,3 +574,14 @@ def test_read_only_directory_gives_output_error(tmp_path):
             write_pvd(out / "result.pvd", [(1.0, "result.vtu")])
     finally:
         out.chmod(0o700)
+
+
+def test_a_non_finite_field_is_refused_by_its_path(tmp_path):
+    """NaN or inf in a fracture field: OutputError naming the data set's
+    path in the file (built only then; the last step's copy at the root is
+    written first), and no file written."""
+    step = _step(2)
+    step.fractures[0].slip[1] = np.inf
+    with pytest.raises(OutputError, match=r"write /fractures/0/slip: 1 non-finite"):
+        _write(tmp_path / "a.h5", steps=[_step(1), step])
+    assert not (tmp_path / "a.h5").exists()
