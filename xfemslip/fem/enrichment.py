@@ -222,8 +222,7 @@ def find_candidates(mesh, fractures) -> Candidates:
         branch = set()
         if fr.tip_mode == "branch":
             for ti, tip in enumerate(fr.tips):
-                dist = np.linalg.norm(mesh.nodes - tip.point, axis=1)
-                near = set(np.nonzero(dist <= fr.tip_radius)[0].tolist())
+                near = set(mesh.nodes_within(tip.point, fr.tip_radius).tolist())
                 k = 0 if tip.end == 0 else -1
                 near |= set(mesh.cells[fr.piece_cell[k]].tolist())
                 branch |= near
