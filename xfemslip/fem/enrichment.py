@@ -481,7 +481,11 @@ def build_enriched_cells(
 
     # pass 1: sub-cells and quadrature of every cell (one kernel call)
     e_used, s_used = np.nonzero(used)
-    pair = np.unique(np.column_stack([e_used, cand.fracture[k_used]]), axis=0)
+    # the (cell row, fracture) pairs in lexicographic order, as one key each
+    # (np.unique of the rows, axis=0, took 0.09 s on a 100-fracture network)
+    n_frac = max(len(fractures), 1)
+    key = np.unique(e_used * n_frac + cand.fracture[k_used])
+    pair = np.column_stack([key // n_frac, key % n_frac])
     branch = np.zeros(nc, bool)
     branch[e_used[cand.func[k_used] != HEAVISIDE]] = True
     lines = _cell_lines_table(

@@ -150,6 +150,7 @@ def interface_points(
         k: [] for k in ("fracture", "cell", "xy", "s", "weight", "normal", "tangent")
     }
     for fi, fr in enumerate(fractures):
+        lo, hi, sub_cell, sub_seg = [], [], [], []  # sub-pieces [lo, hi] of t
         for cell, seg, (ta, tb) in zip(
             fr.piece_cell, fr.piece_seg, fr.piece_t, strict=True
         ):
@@ -168,15 +169,31 @@ def interface_points(
             cuts = np.sort(found)
             tol = GEOMETRY_TOL * min_cell if min_cell else 1e-12 * fr.length[seg]
             keep = np.diff(cuts) * fr.length[seg] > tol
-            for a, b in zip(cuts[:-1][keep], cuts[1:][keep], strict=True):
-                t = 0.5 * (a + b) + 0.5 * (b - a) * LINE_POINTS
-                cols["fracture"].append(np.full(t.size, fi))
-                cols["cell"].append(np.full(t.size, cell))
-                cols["xy"].append(p0 + t[:, None] * d)
-                cols["s"].append(fr.arc_length(np.full(t.size, seg), t))
-                cols["weight"].append(0.5 * (b - a) * fr.length[seg] * LINE_WEIGHTS)
-                cols["normal"].append(np.tile(fr.normal[seg], (t.size, 1)))
-                cols["tangent"].append(np.tile(fr.tangent[seg], (t.size, 1)))
+            lo.append(cuts[:-1][keep])
+            hi.append(cuts[1:][keep])
+            sub_cell.append(np.full(lo[-1].size, cell))
+            sub_seg.append(np.full(lo[-1].size, seg))
+        # the fracture's sub-pieces at once (per sub-piece, these small arrays
+        # took half of the function's 0.2 s on a 100-fracture network)
+        if not lo:
+            continue
+        a, b = np.concatenate(lo), np.concatenate(hi)
+        seg_of, k = np.concatenate(sub_seg), LINE_POINTS.size
+        t = 0.5 * (a + b)[:, None] + (0.5 * (b - a))[:, None] * LINE_POINTS
+        p0 = fr.points[seg_of]
+        d = fr.points[seg_of + 1] - p0
+        seg_q = np.repeat(seg_of, k)
+        cols["fracture"].append(np.full(t.size, fi))
+        cols["cell"].append(np.repeat(np.concatenate(sub_cell), k))
+        cols["xy"].append(
+            (p0[:, None, :] + t[:, :, None] * d[:, None, :]).reshape(-1, 2)
+        )
+        cols["s"].append(fr.arc_length(seg_q, t.ravel()))
+        cols["weight"].append(
+            ((0.5 * (b - a) * fr.length[seg_of])[:, None] * LINE_WEIGHTS).ravel()
+        )
+        cols["normal"].append(fr.normal[seg_q])
+        cols["tangent"].append(fr.tangent[seg_q])
     if not cols["fracture"]:
         empty2 = np.zeros((0, 2))
         return InterfacePoints(
