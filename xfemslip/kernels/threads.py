@@ -22,9 +22,8 @@ cores (map_in_threads), each chunk's result written to its own slice: the
 answer is the same to the bit on any number of threads.  OpenBLAS runs on
 one thread meanwhile (the cell kernels' dense products are small; two
 threads each wanting two BLAS threads on 2 cores ran slower than one thread
-alone).  Measured on the
-100-fracture network (200 x 200 cells): the enriched-cell entries 0.8-1.1 s
-serial, 0.45-0.7 s on 2 threads.
+alone).  Measured on the 100-fracture network (200 x 200 cells, 3 runs
+each): the enriched-cell entries 0.8-1.1 s on one thread, 0.45-0.7 s on 2.
 """
 
 from __future__ import annotations
