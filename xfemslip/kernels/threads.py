@@ -48,17 +48,39 @@ def one_openblas_thread() -> contextlib.AbstractContextManager:
     return ThreadpoolController().select(internal_api="openblas").limit(limits=1)
 
 
-def kernel_threads() -> int:
-    """Threads for the kernels' chunks: NUMBA_NUM_THREADS when set to a
-    positive integer (the variable Numba's own threads follow), else the
-    cores this process may run on."""
-    given = os.environ.get("NUMBA_NUM_THREADS", "").strip()
-    if given.isdigit() and int(given) > 0:
-        return int(given)
+def process_cores() -> int:
+    """The cores this process may run on."""
     try:
         return len(os.sched_getaffinity(0))
     except AttributeError:  # not on Linux
         return os.cpu_count() or 1
+
+
+class _Share:
+    """The kernel threads of a process that shares the cores with others
+    (share_cores); None: the cores are all this process's."""
+
+    threads: int | None = None
+
+
+def share_cores(processes: int) -> None:
+    """This process is one of ``processes`` working at once (a sweep's
+    workers): its kernels take their share of the cores, at least one
+    thread, unless NUMBA_NUM_THREADS says otherwise."""
+    _Share.threads = max(1, process_cores() // max(1, int(processes)))
+
+
+def kernel_threads() -> int:
+    """Threads for the kernels' chunks: NUMBA_NUM_THREADS when set to a
+    positive integer (the variable Numba's own threads follow), else this
+    process's share of the cores (share_cores), else the cores this process
+    may run on."""
+    given = os.environ.get("NUMBA_NUM_THREADS", "").strip()
+    if given.isdigit() and int(given) > 0:
+        return int(given)
+    if _Share.threads is not None:
+        return _Share.threads
+    return process_cores()
 
 
 def map_in_threads(

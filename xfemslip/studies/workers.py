@@ -46,6 +46,7 @@ from multiprocessing.connection import wait
 from typing import Any
 
 from xfemslip import interrupt
+from xfemslip.kernels.threads import share_cores
 
 # A worker that has not unwound its task this long after SIGTERM is killed.
 GRACE_S = 1.0
@@ -133,9 +134,13 @@ def _run_guarded(fn: Callable, task):
         os._exit(128 + (signal.SIGTERM if term else signal.SIGINT))
 
 
-def _worker_main(conn, parent: int, fn: Callable) -> None:
+def _worker_main(conn, parent: int, fn: Callable, jobs: int = 1) -> None:
     """A worker of :func:`run_local`: tasks in, results out, until told to
-    stop (None), its pipe closes, or a signal or its parent's death ends it."""
+    stop (None), its pipe closes, or a signal or its parent's death ends it.
+    Its kernels take 1/``jobs`` of the cores (the pool's workers run at
+    once: two workers each building a model on every core of 2 would run
+    four threads on them)."""
+    share_cores(jobs)
     _stop_with_signals()
     _watch_parent(parent)
     while True:
@@ -174,11 +179,11 @@ def _ended(exitcode: int | None) -> str:
 class _Worker:
     """One worker process and the task it holds."""
 
-    def __init__(self, context, fn: Callable) -> None:
+    def __init__(self, context, fn: Callable, jobs: int = 1) -> None:
         self.conn, child = context.Pipe()
         self.process = context.Process(
             target=_worker_main,
-            args=(child, os.getpid(), fn),
+            args=(child, os.getpid(), fn, jobs),
             name="xfemslip-sweep-worker",
             daemon=True,
         )
@@ -218,7 +223,7 @@ class LocalPool:
             self.abort()
 
     def _start(self) -> _Worker:
-        worker = _Worker(self.context, self.fn)
+        worker = _Worker(self.context, self.fn, self.jobs)
         self.workers.append(worker)
         return worker
 

@@ -166,3 +166,27 @@ def test_threaded_model_build_is_the_serial_one_to_the_bit(monkeypatch):
     threaded = _model_arrays(monkeypatch, 2)
     for name, value in serial.items():
         assert np.array_equal(threaded[name], value), name
+
+
+def _worker_threads(task) -> int:
+    """A sweep worker's task: the kernel threads it would use."""
+    return kernel_threads()
+
+
+def test_sweep_workers_share_the_cores(monkeypatch):
+    """Two local workers each take half the cores (at least one thread);
+    NUMBA_NUM_THREADS still decides when it is set; this process keeps
+    them all."""
+    from xfemslip.kernels import threads
+    from xfemslip.studies.workers import run_local
+
+    monkeypatch.delenv("NUMBA_NUM_THREADS", raising=False)
+    cores = threads.process_cores()
+    got = list(run_local([0, 1], 2, _worker_threads, lambda task, why: why))
+    assert got == [max(1, cores // 2)] * 2
+    assert kernel_threads() == cores
+    monkeypatch.setattr(threads._Share, "threads", None)
+    threads.share_cores(3)
+    assert kernel_threads() == max(1, cores // 3)
+    monkeypatch.setenv("NUMBA_NUM_THREADS", "2")
+    assert kernel_threads() == 2
