@@ -26,7 +26,7 @@ from xfemslip.fem.enrichment import (
     carries_jump,
     select_enrichment,
 )
-from xfemslip.kernels.threads import map_in_threads
+from xfemslip.kernels.threads import map_kernels
 
 logger = logging.getLogger(__name__)
 
@@ -335,13 +335,8 @@ def _enriched_entries(mesh, ec, D, material, qp_material, backend):
         vals[p : p + r.size] = v
         return r.size
 
-    # the compiled kernels release the GIL: the chunks on every core
-    # (xfemslip.kernels.threads); NumPy's, chosen for small runs, in turn
-    chunks = range(0, nc, chunk)
-    if backend == "numba":
-        p = sum(map_in_threads(entries, chunks))
-    else:
-        p = sum(map(entries, chunks))
+    # with the compiled kernels, the chunks on every core
+    p = sum(map_kernels(backend, entries, range(0, nc, chunk)))
     assert p == total
     return diag, Bbar, [rows, cols, vals]
 

@@ -50,7 +50,7 @@ from xfemslip import kernels
 from xfemslip.fem.branch import branch_functions
 from xfemslip.fem.quadrature import DUFFY_POINTS, TRI_BARY, duffy_rule, triangle_rule
 from xfemslip.geometry.fracture import GEOMETRY_TOL
-from xfemslip.kernels.threads import kernel_threads, map_in_threads
+from xfemslip.kernels.threads import backend_threads, map_in_threads, map_kernels
 from xfemslip.kernels.vectorized import ranges
 
 logger = logging.getLogger(__name__)
@@ -404,8 +404,7 @@ def _subtriangles(backend: str, bounds, lines, tol: float):
     result to the bit), the NumPy one in one call."""
     cut = kernels.backend(backend).cell_subtriangles
     nc = bounds.shape[0]
-    threads = kernel_threads() if backend == "numba" else 1
-    parts = max(1, min(threads, nc // SUBCELL_THREAD_CELLS))
+    parts = max(1, min(backend_threads(backend), nc // SUBCELL_THREAD_CELLS))
     if parts == 1:
         return cut(bounds, *lines, tol)
     line_off, line_point, line_normal, apex_off, apex_xy = lines
@@ -578,13 +577,8 @@ def build_enriched_cells(
 
     # the groups write disjoint columns; with the compiled kernels (a large
     # model) they run on every core: NumPy's functions of many points and
-    # the scatter kernel release the GIL (xfemslip.kernels.threads)
-    spans = list(zip(bounds[:-1], bounds[1:], strict=True))
-    if backend == "numba":
-        map_in_threads(evaluate, spans)
-    else:
-        for span in spans:
-            evaluate(span)
+    # the scatter kernel release the GIL
+    map_kernels(backend, evaluate, zip(bounds[:-1], bounds[1:], strict=True))
     # the vertex values (for the output) per slot, each its column's
     tri_slot = slot_column[np.repeat(np.arange(nc), nt_cell)]  # (nt, S)
     Fv = np.zeros((tris.shape[0], 3, S))

@@ -102,3 +102,23 @@ def map_in_threads(
             return list(pool.map(fn, items))
         finally:
             pool.shutdown(wait=True, cancel_futures=True)
+
+
+# the kernel backend whose loops release the GIL (xfemslip.kernels: "numba")
+COMPILED = "numba"
+
+
+def backend_threads(backend: str) -> int:
+    """Threads the kernel loops of ``backend`` run on: kernel_threads() for
+    the compiled kernels; one for NumPy's, chosen for small models, where a
+    pool would cost more than it saves."""
+    return kernel_threads() if backend == COMPILED else 1
+
+
+def map_kernels(backend: str, fn: Callable[[T], R], items: Iterable[T]) -> list[R]:
+    """[fn(item) for item in items], a loop over the kernels of
+    ``backend``: map_in_threads for the compiled kernels, in turn (OpenBLAS
+    left alone) for NumPy's."""
+    if backend != COMPILED:
+        return [fn(item) for item in items]
+    return map_in_threads(fn, items)

@@ -745,10 +745,10 @@ class NewtonSolver:
                 res = law.evaluate(u, TANGENT_CONSISTENT, pt_prev, gt_prev)
         raise AssertionError("unreachable")
 
-    def _guess(self, u, lam, regime, Ku=None):
-        """(contact result, residual) at u under the predicted stick/slip set
-        (predictor.py), or None without a prediction or when it is the set
-        of the true law at u already."""
+    def _guess(self, u, lam, regime, Ku):
+        """(contact result, residual) at u (K u: ``Ku``) under the predicted
+        stick/slip set (predictor.py), or None without a prediction or when
+        it is the set of the true law at u already."""
         if not self.predictor:
             return None
         c = self.p.contact
@@ -771,7 +771,7 @@ class NewtonSolver:
         )
         return res, self._residual(u, lam, res, Ku)[0]
 
-    def _line_search(self, u, du, lam, eta0, pt_prev, gt_prev, law=None, Ku=None):
+    def _line_search(self, u, du, lam, eta0, pt_prev, gt_prev, law, Ku):
         """Backtracking on eta along the Newton direction (Armijo on the norm).
 
         The full step is tried first and kept whenever it lowers eta, so
@@ -782,16 +782,13 @@ class NewtonSolver:
         Returns (u, contact result, residual, eta, K u) of the kept trial.
 
         K u is linear along the line: a shorter step's is (1 - a) K u + a
-        K u_full from the start's (``Ku``, computed when None) and the full
+        K u_full from the start's (``Ku``) and the full
         step's, each a product with K, so a backtracking trial costs no
         product (a product took 10 ms of the 21 ms of a residual on a
         100-fracture network), and the error of the combination is
         round-off of the internal forces, not of the sum K_ij u_j: nothing
         accumulates over the iterations.
         """
-        c = self.p.contact if law is None else law
-        if Ku is None:
-            Ku = self.p.K @ u
         Ku_full = None
         best = None
         alpha = 1.0
@@ -805,7 +802,7 @@ class NewtonSolver:
             # (up to 6 more per iteration of a stalling Newton solve) is an
             # array of 8 m (2J)^2 bytes, 10.7 MB on a crowded network.
             scratch = None if alpha == 1.0 else self._scratch_blocks()
-            res = c.evaluate(trial, self.mode, pt_prev, gt_prev, scratch=scratch)
+            res = law.evaluate(trial, self.mode, pt_prev, gt_prev, scratch=scratch)
             if Ku_full is None:
                 Ku_full = Ku_trial = self.p.K @ trial
             else:
@@ -819,7 +816,7 @@ class NewtonSolver:
         if best[1].blocks is None:  # the same evaluation, with its tangent
             best = (
                 best[0],
-                c.evaluate(best[0], self.mode, pt_prev, gt_prev),
+                law.evaluate(best[0], self.mode, pt_prev, gt_prev),
                 *best[2:],
             )
         if alpha < 1.0:
