@@ -2,7 +2,10 @@
 
 - ``"numba"``: bulk.py, contact.py, scatter.py, shape.py, subcells.py (gathered in
   jit.py), compiled by Numba (``cache=True``: once per install).  All Numba
-  code of xfemslip lives in this subpackage, and only here.
+  code of xfemslip lives in this subpackage, and only here.  jit.py also
+  holds the sparse triangular substitutions of triangular.py, which have no
+  NumPy twin (a substitution is a sequential loop): with the NumPy backend
+  their caller solves whole systems with SuperLU instead.
 - ``"numpy"``: vectorized.py, the same functions as whole-array NumPy code.
   It imports no Numba, so a small run skips Numba's import and its target
   set-up at the first dispatch (about 0.5 s of a 1 s warm run, and the 9 s of
@@ -75,7 +78,7 @@ COMPILING = (
     "later runs load them from Numba's cache"
 )
 # the modules whose functions Numba compiles (one cache index per function)
-JIT_MODULES = ("bulk", "contact", "scatter", "shape", "subcells")
+JIT_MODULES = ("bulk", "contact", "scatter", "shape", "subcells", "triangular")
 
 
 def _cache_folders() -> list[Path]:

@@ -9,6 +9,7 @@ from xfemslip.kernels.scatter import (
     scatter_column_values,
 )
 from xfemslip.kernels.subcells import cell_subtriangles
+from xfemslip.kernels.triangular import lower_unit_forward, upper_backward
 
 __all__ = [
     "block_triplets",
@@ -19,4 +20,6 @@ __all__ = [
     "enriched_cell_matrices",
     "rectangle_stiffness",
     "scatter_column_values",
+    "lower_unit_forward",
+    "upper_backward",
 ]

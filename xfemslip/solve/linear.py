@@ -854,6 +854,7 @@ class LinearSolver:
                 LU_BACKWARD_ERROR,
                 self.stats,
                 LU_FAST,
+                kernels=self.kernels,
             )
             if self._network_hint:
                 logger.info(
