@@ -1,5 +1,6 @@
-"""xfemslip.kernels.threads: OpenBLAS on one thread while PARDISO solves,
-and the model build's kernel chunks on threads (same arrays to the bit)."""
+"""xfemslip.kernels.threads: OpenBLAS on one thread while PARDISO or the
+bordered SuperLU factorization of a network solves, and the model build's
+kernel chunks on threads (same arrays to the bit)."""
 
 from __future__ import annotations
 
@@ -86,6 +87,33 @@ def test_a_run_solves_with_one_openblas_thread_on_pardiso(monkeypatch):
     ref = np.abs(slip["superlu"]).max()
     assert ref > 0.0
     assert np.abs(slip["pardiso"] - slip["superlu"]).max() <= 1e-8 * ref
+
+
+def test_the_bordered_superlu_network_solves_with_one_openblas_thread(monkeypatch):
+    """A network on the one bordered SuperLU factorization (AugmentedLU:
+    the shipped network with its contact dofs sent past the Schur limit)
+    solves with one OpenBLAS thread, the count back after the run; the
+    systems that do not take that path keep the process's count."""
+    _openblas()
+    monkeypatch.setattr(pardiso, "SCHUR_MAX_DOFS", 0)
+    seen = []
+    solve = LinearSolver.solve_contact
+
+    def spy(self, blocks, r):
+        x = solve(self, blocks, r)
+        seen.append((self._augmented is not False, tuple(_threads())))
+        return x
+
+    monkeypatch.setattr(LinearSolver, "solve_contact", spy)
+    text = NETWORK.read_text().replace(
+        "[solver]", '[solver]\nlinear_solver = "superlu"'
+    )
+    assert 'linear_solver = "superlu"' in text
+    with _openblas().limit(limits=2):
+        n = len(_threads())
+        run_case(loads_case(text, NETWORK))
+        assert _threads() == [2] * n
+    assert seen and set(seen) == {(True, (1,) * n)}
 
 
 # --------------------------------------------------- the kernels' chunks on threads
