@@ -131,9 +131,10 @@ PARDISO_GAIN = (1.7, 5.2)
 # (lowrank.AugmentedLU), below that size, what the whole run gained with it:
 # 100 branch-tipped fractures on 200 x 200 cells (147k dofs), whole
 # processes without thread variables (benchmarks/network_floor.py, docs/
-# performance/network_floor.md): 26.5 s by default against 14.4 s with
-# PARDISO, and 29.2 against 16.4 s on a slower day.
-PARDISO_NETWORK_GAIN = 1.8
+# performance/network_floor.md, medians of 5): 12.9 s by default against
+# 6.5 s with PARDISO on a quiet machine, 21.6 against 9.4 s on a loaded one
+# before the default path's one-pass solves.
+PARDISO_NETWORK_GAIN = 2.0
 AUTO_AMG_MAX_ASPECT = 4.0
 # ... and whose AMG band (enriched dofs and AMG_BAND_LAYERS neighbours) holds
 # at most this share of the free dofs.  Measured on generated networks of
