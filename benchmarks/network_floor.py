@@ -3,8 +3,15 @@
 PARDISO floor, whole processes, alternated in the same run.
 
     python benchmarks/network_floor.py [--runs 3] [--configs floor,pardiso,default]
-        [--count 100] [--n 200] [--seed 1] [--json FILE]
+        [--count 100] [--n 200] [--seed 1] [--trees DIR ...] [--json FILE]
         [--markdown docs/performance/network_floor.md]
+
+``--trees`` compares versions: each run and configuration other than the
+floor is run once per source tree (a git worktree of another commit, say,
+or ``.``), that tree put first on PYTHONPATH, alternated with the others.
+The children start in a temporary directory and report the package they
+imported: a ``python -c`` child started in the project root would import
+the root's ``xfemslip`` whatever PYTHONPATH says.
 
 The runs get the caller's thread variables (MKL_NUM_THREADS,
 OPENBLAS_NUM_THREADS, NUMBA_NUM_THREADS), written under the table; the
@@ -95,6 +102,8 @@ def case_text(count: int, n: int, seed: int, cracked: bool) -> str:
 RUN = """
 import sys
 {hide}
+import xfemslip
+print("xfemslip imported from", xfemslip.__file__, flush=True)
 from xfemslip.cli import main
 sys.argv = ["xfemslip", "run", "-q", "--overwrite", {case!r}, "-o", {out!r}]
 main()
@@ -120,21 +129,48 @@ print(json.dumps(dict(dofs=int(K.shape[0]), build=t1 - t0, solve=t2 - t1)))
 """
 
 
+def split(config: str) -> tuple[str, str | None]:
+    """("pardiso", tree) of a configuration "pardiso@tree" (None: no tree)."""
+    name, _, tree = config.partition("@")
+    return name, tree or None
+
+
+def expanded(configs: list[str], trees: list[str] | None) -> list[str]:
+    """The configurations of a run: with trees, each one but the floor once
+    per tree ("pardiso@tree"), in the order given."""
+    if not trees:
+        return list(configs)
+    return [
+        c if c == "floor" else f"{c}@{t}"
+        for c in configs
+        for t in (trees if c != "floor" else [None])
+    ]
+
+
 def child(config: str, work: Path, args) -> dict:
-    case = work / f"{config}.toml"
-    case.write_text(case_text(args.count, args.n, args.seed, config != "floor"))
-    out = work / f"out_{config}"
-    if config == "floor":
+    name, tree = split(config)
+    tag = "".join(ch if ch.isalnum() else "_" for ch in config)
+    case = work / f"{tag}.toml"
+    case.write_text(case_text(args.count, args.n, args.seed, name != "floor"))
+    out = work / f"out_{tag}"
+    if name == "floor":
         code = FLOOR.format(case=str(case))
     else:
-        hide = 'sys.modules["pypardiso"] = None' if config == "default" else ""
+        hide = 'sys.modules["pypardiso"] = None' if name == "default" else ""
         code = RUN.format(hide=hide, case=str(case), out=str(out))
+    env = dict(os.environ)
+    if tree:
+        env["PYTHONPATH"] = str(Path(tree).resolve())
     log = work / "child.log"
     load = os.getloadavg()[0]
     start = time.perf_counter()
     with open(log, "w") as fh:
         proc = subprocess.Popen(
-            [sys.executable, "-c", code], stdout=fh, stderr=subprocess.STDOUT, cwd=work
+            [sys.executable, "-c", code],
+            stdout=fh,
+            stderr=subprocess.STDOUT,
+            cwd=work,
+            env=env,
         )
         timer = threading.Timer(args.timeout, proc.kill)
         timer.start()
@@ -145,6 +181,19 @@ def child(config: str, work: Path, args) -> dict:
     text = log.read_text()
     if code != 0:
         sys.exit(f"{config} failed ({code}): {text.strip()[-800:]}")
+    if tree:
+        imported = next(
+            (
+                ln.split(" from ", 1)[1]
+                for ln in text.splitlines()
+                if ln.startswith("xfemslip imported")
+            ),
+            "",
+        )
+        if not Path(imported).resolve().is_relative_to(Path(tree).resolve()):
+            sys.exit(
+                f"{config}: the child imported {imported or 'nothing'}, not {tree}"
+            )
     row = dict(
         config=config,
         wall=wall,
@@ -182,6 +231,13 @@ LABELS = {
 }
 
 
+def label(config: str) -> str:
+    """The table's name of a configuration (with its tree, if any)."""
+    name, tree = split(config)
+    text = LABELS.get(name, name)
+    return f"{text}, tree `{tree}`" if tree else text
+
+
 def markdown(rows, configs, args) -> str:
     """The table of the measured rows (each a child's dict): per
     configuration the median wall time, its ratio to the floor's median, the
@@ -196,7 +252,7 @@ def markdown(rows, configs, args) -> str:
         newton = mine[0].get("newton")
         out.append(
             [
-                LABELS.get(config, config),
+                label(config),
                 f"{med:.2f} ({min(walls):.2f}, {max(walls):.2f})",
                 f"{med / floor:.1f}",
                 f"{statistics.median(r['cpu'] for r in mine):.1f}",
@@ -204,7 +260,7 @@ def markdown(rows, configs, args) -> str:
                 "-" if not newton else " + ".join(str(k) for k in newton),
             ]
         )
-    dofs = {r["config"]: r.get("dofs") for r in rows}
+    dofs = {split(r["config"])[0]: r.get("dofs") for r in rows}
     env = rows[0].get("env") or {k: os.environ.get(k, "-") for k in THREADS}
     how = (
         f"{args.count} generated fractures (seed {args.seed}, branch tips) on "
@@ -226,6 +282,12 @@ def main() -> int:
     ap.add_argument("--seed", type=int, default=1)
     ap.add_argument("--timeout", type=float, default=3600.0)
     ap.add_argument("--no-warmup", action="store_true")
+    ap.add_argument(
+        "--trees",
+        nargs="+",
+        metavar="DIR",
+        help="source trees to compare (each put first on PYTHONPATH in turn)",
+    )
     ap.add_argument("--json")
     ap.add_argument(
         "--from-json",
@@ -234,19 +296,20 @@ def main() -> int:
     )
     mdtable.add_option(ap, "docs/performance/network_floor.md")
     args = ap.parse_args()
-    configs = args.configs.split(",")
+    configs = expanded(args.configs.split(","), args.trees)
     if args.from_json:
         rows = json.loads(Path(args.from_json).read_text())
         args.runs = max(r["run"] for r in rows) + 1
         mdtable.write(args.markdown, markdown(rows, configs, args))
         return 0
-    compileall.compile_dir(str(ROOT / "xfemslip"), quiet=1)
+    for tree in [ROOT, *(Path(t) for t in args.trees or [])]:
+        compileall.compile_dir(str(tree / "xfemslip"), quiet=1)
     rows = []
     with tempfile.TemporaryDirectory() as tmp:
         work = Path(tmp)
         if not args.no_warmup:
             for config in configs:
-                if config != "default":  # compiles what the others load
+                if split(config)[0] != "default":  # compiles what the others load
                     child(config, work, args)
         for run in range(args.runs):
             for config in configs:

@@ -354,6 +354,47 @@ def test_network_floor_table(bench):
     assert text.rstrip().endswith("load average 1.0-1.3.")
 
 
+def test_network_floor_trees_table(bench):
+    """--trees: each configuration but the floor once per tree, in order,
+    labelled with its tree; the ratios to the one floor."""
+    nf = bench("network_floor")
+    configs = nf.expanded(["floor", "pardiso", "default"], ["/w/base", "."])
+    assert configs == [
+        "floor",
+        "pardiso@/w/base",
+        "pardiso@.",
+        "default@/w/base",
+        "default@.",
+    ]
+    assert nf.split("default@/w/base") == ("default", "/w/base")
+    assert nf.split("floor") == ("floor", None)
+    assert nf.expanded(["floor", "pardiso"], None) == ["floor", "pardiso"]
+
+    def row(config, wall):
+        return {
+            "config": config,
+            "wall": wall,
+            "cpu": wall,
+            "rss_mib": 100.0,
+            "load": 1.0,
+            "dofs": 80600 if config == "floor" else 147524,
+            "newton": None if config == "floor" else [11, 6],
+            "run": 0,
+        }
+
+    rows = [row("floor", 2.0), row("pardiso@/w/base", 8.0), row("pardiso@.", 6.0)]
+    args = type("A", (), {"count": 100, "seed": 1, "n": 200, "runs": 1})()
+    text = nf.markdown(rows, ["floor", "pardiso@/w/base", "pardiso@."], args)
+    body = rows_of(text)[1:]
+    assert [r[0] for r in body] == [
+        nf.LABELS["floor"],
+        nf.LABELS["pardiso"] + ", tree `/w/base`",
+        nf.LABELS["pardiso"] + ", tree `.`",
+    ]
+    assert [r[2] for r in body] == ["1.0", "4.0", "3.0"]
+    assert "147524 dofs" in text
+
+
 # docs/performance/<file>: the benchmark that writes it, and a synthetic
 # result that gives the header its writer prints
 def _headers(bench) -> dict[str, list[str]]:
