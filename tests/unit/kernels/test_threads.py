@@ -46,7 +46,7 @@ def test_one_thread_inside_and_the_counts_back_after():
         assert _threads() == before
 
 
-def test_only_the_pardiso_solver_limits_openblas():
+def test_pardiso_limits_openblas_and_superlu_without_a_network_does_not():
     _openblas()
     K = sp.identity(4, format="csr")
     with _openblas().limit(limits=2):
@@ -92,8 +92,7 @@ def test_a_run_solves_with_one_openblas_thread_on_pardiso(monkeypatch):
 def test_the_bordered_superlu_network_solves_with_one_openblas_thread(monkeypatch):
     """A network on the one bordered SuperLU factorization (AugmentedLU:
     the shipped network with its contact dofs sent past the Schur limit)
-    solves with one OpenBLAS thread, the count back after the run; the
-    systems that do not take that path keep the process's count."""
+    solves with one OpenBLAS thread, the count back after the run."""
     _openblas()
     monkeypatch.setattr(pardiso, "SCHUR_MAX_DOFS", 0)
     seen = []
