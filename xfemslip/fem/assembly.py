@@ -312,14 +312,14 @@ def _enriched_entries(mesh, ec, D, material, qp_material, backend):
     Bbar = np.zeros((nc, 3, nd))
     dofs = _candidate_dofs(mesh, ec)
     live = np.count_nonzero(dofs >= 0, axis=1).astype(np.int64)
-    total = int(np.sum(live**2))
+    start = np.zeros(nc + 1, np.int64)  # each cell's first entry
+    np.cumsum(live**2, out=start[1:])
+    total = int(start[-1])
     index_type = np.int32 if dofs.max(initial=0) < 2**31 - 1 else np.int64
     rows = np.empty(total, index_type)
     cols = np.empty(total, index_type)
     vals = np.empty(total)
     chunk = enriched_chunk(ec.slot_cand.shape[1])
-    start = np.zeros(nc + 1, np.int64)  # each cell's first entry
-    np.cumsum(live**2, out=start[1:])
 
     def entries(lo: int) -> int:
         part = slice(lo, min(lo + chunk, nc))
